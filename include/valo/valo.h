@@ -1,0 +1,131 @@
+/* valo.h — the public C API of valo, a physically based global-illumination renderer.
+ *
+ * The command-line tool uses nothing but this header. Objects are opaque handles:
+ *   valo_scene   an immutable scene loaded from a JSON scene file or a mesh file
+ *                (OBJ/MTL, glTF 2.0, PLY … through Assimp);
+ *   valo_render  one rendering of a scene with given options; owns its film.
+ * Every function that can fail returns a valo_status and, when `err` is not NULL, fills
+ * it with a message naming the file (and line:column for parse errors) and the problem.
+ * No function calls exit() or abort(). Unless said otherwise, functions are not
+ * thread-safe on the same handle; distinct handles may be used from distinct threads.
+ */
+#ifndef VALO_VALO_H
+#define VALO_VALO_H
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(VALO_BUILDING)
+#define VALO_API __attribute__((visibility("default")))
+#else
+#define VALO_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum valo_status {
+  VALO_OK = 0,
+  VALO_ERR_IO = 1,          /* a file could not be opened, read or written */
+  VALO_ERR_PARSE = 2,       /* malformed file content (JSON syntax, mesh data) */
+  VALO_ERR_INVALID = 3,     /* well-formed but wrong: unknown key, wrong type, bad value */
+  VALO_ERR_UNSUPPORTED = 4, /* format or feature not supported */
+  VALO_ERR_NOMEM = 5,       /* allocation failed */
+  VALO_ERR_CANCELLED = 6    /* valo_render_cancel was called */
+} valo_status;
+
+typedef struct valo_error {
+  valo_status status;
+  char message[1024];
+} valo_error;
+
+/* Render options. Fields left at VALO_UNSET (or empty strings) take the scene file's
+ * value, or the default given beside each field. */
+#define VALO_UNSET (-1)
+#define VALO_DEPTH_UNSET (-2)
+typedef struct valo_options {
+  int width, height;      /* film size in pixels; default 256x256, at most 16384 each */
+  int spp;                /* samples per pixel; default 16, at most 1048576 */
+  double time_budget;     /* seconds; > 0 stops after the pass that exceeds it (spp then
+                             bounds the total); VALO_UNSET or <= 0: no time limit */
+  int threads;            /* worker threads; default: all cores */
+  int64_t seed;           /* random seed (>= 0); default 1 */
+  int max_depth;          /* path length limit; -1 (default): unlimited, ended by Russian
+                             roulette (a safety cap of 1024 bounces applies);
+                             VALO_DEPTH_UNSET when not given */
+  char integrator[32];    /* "path" (default) */
+  char accel[16];         /* "kdtree" (default) or "embree" */
+} valo_options;
+
+/* Sets every field of `o` to "unset". */
+VALO_API void valo_options_init(valo_options *o);
+
+typedef struct valo_scene valo_scene;
+typedef struct valo_render valo_render;
+
+/* Loads a scene. `path` names a .json scene file, or any mesh file Assimp reads
+ * (camera taken from the file when it has one, otherwise framed automatically).
+ * On success *out owns the scene; free with valo_scene_destroy. */
+VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_error *err);
+VALO_API void valo_scene_destroy(valo_scene *scene);
+/* The options the scene file itself asks for (unset fields stay VALO_UNSET). */
+VALO_API void valo_scene_file_options(const valo_scene *scene, valo_options *out);
+VALO_API uint64_t valo_scene_triangle_count(const valo_scene *scene);
+
+/* Progress callback: called from the rendering thread after every pass, with the
+ * fraction done in [0,1], samples per pixel finished so far and seconds elapsed. Return
+ * non-zero to cancel. May be NULL. */
+typedef int (*valo_progress_fn)(void *user, double fraction, int spp_done, double seconds);
+
+/* Creates a render of `scene` (which must outlive it) with `opts` applied over the
+ * scene file's options; builds the acceleration structure. */
+VALO_API valo_status valo_render_create(const valo_scene *scene, const valo_options *opts,
+                                        valo_render **out, valo_error *err);
+/* Renders until the sample or time budget is met. */
+VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user,
+                                     valo_error *err);
+/* Asks a running render to stop after the current pass; thread-safe. */
+VALO_API void valo_render_cancel(valo_render *r);
+
+typedef struct valo_stats {
+  uint64_t triangles;
+  double build_seconds;   /* acceleration structure */
+  double render_seconds;
+  uint64_t rays;          /* all rays traced: camera, bounce and shadow */
+  int spp_done;
+  int width, height;
+  int threads;
+  char integrator[32];
+  char accel[16];
+} valo_stats;
+VALO_API void valo_render_stats(const valo_render *r, valo_stats *out);
+
+/* Output settings for display-referred formats (PNG). EXR/PFM are always linear. */
+typedef struct valo_output_options {
+  float exposure;         /* stops; 0 by default */
+  char tonemap[16];       /* "clamp" (default) — more come with the display work */
+} valo_output_options;
+VALO_API void valo_output_options_init(valo_output_options *o);
+
+/* Writes the film; the format follows the extension: .exr (linear float, OpenEXRCore),
+ * .pfm (linear float), .png (8-bit sRGB). Written to a temporary file in the same folder
+ * and renamed, so a reader never sees a partial file. */
+VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
+                                       const valo_output_options *o, valo_error *err);
+/* Copies the linear RGB film (width*height*3 floats, row-major, top row first). */
+VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out);
+VALO_API void valo_render_destroy(valo_render *r);
+
+/* Where warnings go (default: standard error, prefixed "valo: warning: "). */
+typedef void (*valo_log_fn)(void *user, const char *message);
+VALO_API void valo_set_warning_handler(valo_log_fn fn, void *user);
+
+VALO_API const char *valo_version(void);
+VALO_API const char *valo_status_string(valo_status s);
+/* The names of the registered integrators, NULL-terminated. */
+VALO_API const char *const *valo_integrator_names(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

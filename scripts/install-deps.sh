@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Installs the Debian packages valo builds against, only when something is missing.
+set -euo pipefail
+pkgs=(build-essential cmake pkg-config libassimp-dev libstb-dev libopenexr-dev libcjson-dev libembree-dev)
+missing=()
+for p in "${pkgs[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then exit 0; fi
+echo "valo: installing ${missing[*]}" >&2
+SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

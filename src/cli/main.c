@@ -1,0 +1,273 @@
+/* main.c — owns the `valo` command line: argument parsing, the progress bar (with
+ * samples/s and ETA on a terminal, periodic plain lines otherwise), the final summary,
+ * Ctrl-C handling and exit codes (0 success, 1 error, 2 usage, 130 interrupted).
+ * Uses only the public API in valo/valo.h. */
+#include "valo/valo.h"
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#define EXIT_USAGE 2
+#define EXIT_INTERRUPTED 130
+#define MAX_OUTPUTS 16
+
+static valo_render *volatile g_render;
+static volatile sig_atomic_t g_interrupted;
+
+static void on_sigint(int sig) {
+  (void)sig;
+  g_interrupted = 1;
+  if (g_render) valo_render_cancel(g_render);
+}
+
+static void usage_main(FILE *f) {
+  fprintf(f,
+          "valo %s — physically based global-illumination renderer\n\n"
+          "Usage:\n"
+          "  valo render SCENE [options]   render a scene (JSON scene file, or an OBJ/glTF/PLY mesh)\n"
+          "  valo --help                   this text\n"
+          "  valo render --help            the render options\n"
+          "  valo --version                print the version\n\n"
+          "Exit codes: 0 success, 1 error (bad input, failed write), 2 usage error, 130 interrupted.\n",
+          valo_version());
+}
+
+static void usage_render(FILE *f) {
+  fprintf(f,
+          "Usage: valo render SCENE [options]\n\n"
+          "SCENE is a .json scene file (docs/scene-format.md) or a mesh file read by Assimp\n"
+          "(OBJ/MTL, glTF 2.0, PLY, ...; its camera is used, or the view is framed automatically).\n"
+          "Options override the scene file:\n"
+          "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
+          "                         repeat for several outputs (default: SCENE-NAME.png)\n"
+          "  --spp N                samples per pixel (default 16)\n"
+          "  --time SECONDS         time budget: stop after the pass that reaches it\n"
+          "                         (with --spp, whichever comes first)\n"
+          "  --threads N            worker threads (default: all cores)\n"
+          "  --seed N               random seed (default 1); same seed, same image, any thread count\n"
+          "  --res WxH              film resolution (default 256x256)\n"
+          "  --integrator NAME      integrator:");
+  for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(f, " %s", *n);
+  fprintf(f,
+          " (default path)\n"
+          "  --accel NAME           kdtree (default) or embree\n"
+          "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
+          "  --exposure STOPS       PNG exposure (default 0)\n"
+          "  -q, --quiet            no progress or summary\n"
+          "  -h, --help             this text\n");
+}
+
+static int parse_int(const char *s, long lo, long hi, long *out) {
+  char *end;
+  errno = 0;
+  long v = strtol(s, &end, 10);
+  if (errno || end == s || *end || v < lo || v > hi) return -1;
+  *out = v;
+  return 0;
+}
+static int parse_double(const char *s, double lo, double hi, double *out) {
+  char *end;
+  errno = 0;
+  double v = strtod(s, &end);
+  if (errno || end == s || *end || !(v >= lo && v <= hi)) return -1;
+  *out = v;
+  return 0;
+}
+
+typedef struct progress_state { int tty; int quiet; double last_print; int spp_total; double time_budget; } progress_state;
+
+static void fmt_time(double s, char *buf, size_t n) {
+  if (!(s >= 0) || s > 1e7) { snprintf(buf, n, "--:--"); return; }
+  long t = (long)(s + 0.5);
+  if (t >= 3600) snprintf(buf, n, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  else snprintf(buf, n, "%02ld:%02ld", t / 60, t % 60);
+}
+
+static int on_progress(void *user, double frac, int spp_done, double seconds) {
+  progress_state *p = user;
+  if (p->quiet) return 0;
+  double rate = seconds > 0 ? spp_done / seconds : 0;
+  double eta = frac > 0 ? seconds * (1 - frac) / frac : -1;
+  char e[32], el[32];
+  fmt_time(eta, e, sizeof e);
+  fmt_time(seconds, el, sizeof el);
+  if (p->tty) {
+    int width = 30, fill = (int)(frac * width + 0.5);
+    char bar[64];
+    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
+    bar[width] = 0;
+    fprintf(stderr, "\r[%s] %3d%%  %d/%d spp  %.2f spp/s  elapsed %s  ETA %s ", bar, (int)(frac * 100 + 0.5), spp_done,
+            p->spp_total, rate, el, e);
+    fflush(stderr);
+  } else if (seconds - p->last_print >= 5.0 || frac >= 1.0) {
+    fprintf(stderr, "valo: %3d%% %d/%d spp, %.2f spp/s, elapsed %s, ETA %s\n", (int)(frac * 100 + 0.5), spp_done, p->spp_total,
+            rate, el, e);
+    p->last_print = seconds;
+  }
+  return g_interrupted;
+}
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmd_render(int argc, char **argv) {
+  valo_options opt;
+  valo_options_init(&opt);
+  valo_output_options oo;
+  valo_output_options_init(&oo);
+  const char *scene_path = NULL, *outputs[MAX_OUTPUTS];
+  int nout = 0, quiet = 0;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+    long lv;
+    double dv;
+#define NEED_VALUE()                                                            \
+  do {                                                                          \
+    if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; } \
+    i++;                                                                        \
+  } while (0)
+#define BAD_VALUE(what)                                                                             \
+  do {                                                                                              \
+    fprintf(stderr, "valo: %s: invalid value \"%s\" (%s)\n", a, val, what);                         \
+    return EXIT_USAGE;                                                                              \
+  } while (0)
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) { usage_render(stdout); return 0; }
+    else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
+    else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      NEED_VALUE();
+      if (nout == MAX_OUTPUTS) { fprintf(stderr, "valo: at most %d outputs\n", MAX_OUTPUTS); return EXIT_USAGE; }
+      outputs[nout++] = val;
+    } else if (!strcmp(a, "--spp")) {
+      NEED_VALUE();
+      if (parse_int(val, 1, 1048576, &lv)) BAD_VALUE("a whole number from 1 to 1048576");
+      opt.spp = (int)lv;
+    } else if (!strcmp(a, "--time")) {
+      NEED_VALUE();
+      if (parse_double(val, 0.001, 1e8, &dv)) BAD_VALUE("seconds, > 0");
+      opt.time_budget = dv;
+      if (opt.spp == VALO_UNSET) opt.spp = 1048576;
+    } else if (!strcmp(a, "--threads")) {
+      NEED_VALUE();
+      if (parse_int(val, 1, 1024, &lv)) BAD_VALUE("a whole number from 1 to 1024");
+      opt.threads = (int)lv;
+    } else if (!strcmp(a, "--seed")) {
+      NEED_VALUE();
+      if (parse_int(val, 0, LONG_MAX, &lv)) BAD_VALUE("a whole number >= 0");
+      opt.seed = lv;
+    } else if (!strcmp(a, "--res")) {
+      NEED_VALUE();
+      int w = 0, h = 0;
+      char extra;
+      if (sscanf(val, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384)
+        BAD_VALUE("WIDTHxHEIGHT, each 1..16384");
+      opt.width = w; opt.height = h;
+    } else if (!strcmp(a, "--integrator")) {
+      NEED_VALUE();
+      snprintf(opt.integrator, sizeof opt.integrator, "%s", val);
+    } else if (!strcmp(a, "--accel")) {
+      NEED_VALUE();
+      if (strcmp(val, "kdtree") && strcmp(val, "embree")) BAD_VALUE("kdtree or embree");
+      snprintf(opt.accel, sizeof opt.accel, "%s", val);
+    } else if (!strcmp(a, "--max-depth")) {
+      NEED_VALUE();
+      if (parse_int(val, -1, 100000, &lv)) BAD_VALUE("-1 or a whole number >= 0");
+      opt.max_depth = (int)lv;
+    } else if (!strcmp(a, "--exposure")) {
+      NEED_VALUE();
+      if (parse_double(val, -100, 100, &dv)) BAD_VALUE("stops, -100..100");
+      oo.exposure = (float)dv;
+    } else if (a[0] == '-' && a[1]) {
+      fprintf(stderr, "valo: unknown option \"%s\" (see valo render --help)\n", a);
+      return EXIT_USAGE;
+    } else if (!scene_path) scene_path = a;
+    else { fprintf(stderr, "valo: more than one scene given (\"%s\" and \"%s\")\n", scene_path, a); return EXIT_USAGE; }
+  }
+  if (!scene_path) { fprintf(stderr, "valo: no scene given\n"); usage_render(stderr); return EXIT_USAGE; }
+  char default_out[1024];
+  if (nout == 0) {
+    const char *base = strrchr(scene_path, '/');
+    base = base ? base + 1 : scene_path;
+    const char *dot = strrchr(base, '.');
+    int len = dot ? (int)(dot - base) : (int)strlen(base);
+    snprintf(default_out, sizeof default_out, "%.*s.png", len, base);
+    outputs[nout++] = default_out;
+  }
+  for (int i = 0; i < nout; i++) {
+    const char *dot = strrchr(outputs[i], '.');
+    if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
+      fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);
+      return EXIT_USAGE;
+    }
+  }
+
+  valo_error err;
+  double t0 = now_seconds();
+  valo_scene *sc = NULL;
+  if (valo_scene_load(scene_path, &sc, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
+  double load_s = now_seconds() - t0;
+  valo_render *r = NULL;
+  if (valo_render_create(sc, &opt, &r, &err)) {
+    fprintf(stderr, "valo: error: %s\n", err.message);
+    valo_scene_destroy(sc);
+    return 1;
+  }
+  valo_stats st;
+  valo_render_stats(r, &st);
+  valo_options eff;
+  valo_scene_file_options(sc, &eff);
+  int spp_total = opt.spp != VALO_UNSET ? opt.spp : (eff.spp != VALO_UNSET ? eff.spp : 16);
+  progress_state ps = {isatty(2), quiet, -1e9, spp_total, opt.time_budget};
+  if (!quiet)
+    fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %d spp, %s integrator, %s, %d threads\n", scene_path,
+            (unsigned long long)st.triangles, st.width, st.height, spp_total, st.integrator, st.accel, st.threads);
+  g_render = r;
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_sigint;
+  sigaction(SIGINT, &sa, NULL);
+  valo_status rs = valo_render_run(r, on_progress, &ps, &err);
+  g_render = NULL;
+  if (ps.tty && !quiet) fprintf(stderr, "\n");
+  int rc = 0;
+  if (rs == VALO_ERR_CANCELLED || g_interrupted) {
+    fprintf(stderr, "valo: interrupted%s\n", rs == VALO_OK ? "" : "; no image written");
+    rc = EXIT_INTERRUPTED;
+  } else if (rs) {
+    fprintf(stderr, "valo: error: %s\n", err.message);
+    rc = 1;
+  }
+  valo_render_stats(r, &st);
+  if (rc == 0 || (rc == EXIT_INTERRUPTED && rs == VALO_OK && st.spp_done > 0)) {
+    for (int i = 0; i < nout; i++) {
+      if (valo_render_write(r, outputs[i], &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
+      else if (!quiet) fprintf(stderr, "valo: wrote %s\n", outputs[i]);
+    }
+  }
+  if (!quiet) {
+    fprintf(stderr,
+            "valo: summary: %llu triangles; load %.2f s, build %.2f s, render %.2f s; %d spp; %.3g rays, %.2f Mrays/s\n",
+            (unsigned long long)st.triangles, load_s, st.build_seconds, st.render_seconds, st.spp_done, (double)st.rays,
+            st.render_seconds > 0 ? st.rays / st.render_seconds * 1e-6 : 0.0);
+  }
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return rc;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) { usage_main(stderr); return EXIT_USAGE; }
+  if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) { usage_main(stdout); return 0; }
+  if (!strcmp(argv[1], "--version")) { printf("valo %s\n", valo_version()); return 0; }
+  if (!strcmp(argv[1], "render")) return cmd_render(argc - 2, argv + 2);
+  fprintf(stderr, "valo: unknown command \"%s\" (see valo --help)\n", argv[1]);
+  return EXIT_USAGE;
+}

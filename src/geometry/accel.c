@@ -1,0 +1,13 @@
+/* accel.c — owns choosing an acceleration backend by name (see accel.h). */
+#include "geometry/accel.h"
+#include "core/error.h"
+#include <string.h>
+
+valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
+                         accel **out, valo_error *err) {
+  (void)threads;
+  if (!kind || !*kind || !strcmp(kind, "kdtree")) return kdtree_create(pos, idx, ntris, out, err);
+  if (!strcmp(kind, "embree")) return embree_create(pos, idx, ntris, out, err);
+  *out = NULL;
+  return err_set(err, VALO_ERR_INVALID, "unknown accelerator \"%s\" (kdtree, embree)", kind);
+}

@@ -1,0 +1,40 @@
+/* accel.h — owns the one ray-query interface (ARCHITECTURE "Acceleration"): a small ops
+ * table {intersect, occluded, destroy} implemented by the SAH kd-tree (kdtree.c) and by
+ * Embree 3 (embree.c), chosen by name when a render is created. Rays have no tmin: origins
+ * are offset robustly instead (offset.h), and hits need t > 0. */
+#ifndef VALO_ACCEL_H
+#define VALO_ACCEL_H
+#include "core/vec.h"
+#include "valo/valo.h"
+
+typedef struct ray { vec3 o, d; float tmax; } ray;
+/* b1, b2: barycentric weights of the triangle's second and third vertex. */
+typedef struct hit { float t, b1, b2; uint32_t tri; } hit;
+
+typedef struct accel accel;
+typedef struct accel_ops {
+  const char *name;
+  /* Closest hit with 0 < t < r->tmax; returns 1 and fills h on a hit. */
+  int (*intersect)(const accel *a, const ray *r, hit *h);
+  /* Any hit with 0 < t < r->tmax. */
+  int (*occluded)(const accel *a, const ray *r);
+  void (*destroy)(accel *a);
+} accel_ops;
+struct accel { const accel_ops *ops; };
+
+/* kind: "kdtree" or "embree". Triangles are given as indexed vertices; the structure
+ * keeps its own copy. threads: used by builders that can use them. */
+valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
+                         accel **out, valo_error *err);
+static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return a->ops->intersect(a, r, h); }
+static inline int accel_occluded(const accel *a, const ray *r) { return a->ops->occluded(a, r); }
+static inline void accel_destroy(accel *a) { if (a) a->ops->destroy(a); }
+
+valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err);
+valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err);
+int embree_available(void);
+
+/* Statistics of a built kd-tree (for benchmarks and tests). */
+typedef struct kd_stats { uint32_t nodes, leaves, empty_leaves, max_depth; uint64_t refs; size_t bytes; } kd_stats;
+void kdtree_stats(const accel *a, kd_stats *st);
+#endif

@@ -1,0 +1,55 @@
+/* triangle.h — owns the watertight ray–triangle test of Woop, Benthin and Wald (JCGT
+ * 2013): per-ray shear constants, then edge functions in the sheared frame, falling back
+ * to double precision when an edge function is exactly zero. */
+#ifndef VALO_TRIANGLE_H
+#define VALO_TRIANGLE_H
+#include "core/vec.h"
+
+typedef struct ray_shear { int kx, ky, kz; float sx, sy, sz; vec3 o; } ray_shear;
+
+static inline ray_shear ray_shear_make(vec3 o, vec3 d) {
+  ray_shear s;
+  vec3 a = v3_abs(d);
+  int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+  int kx = kz + 1 == 3 ? 0 : kz + 1, ky = kx + 1 == 3 ? 0 : kx + 1;
+  if (v3_get(d, kz) < 0) { int t = kx; kx = ky; ky = t; }
+  s.kx = kx; s.ky = ky; s.kz = kz;
+  float dz = v3_get(d, kz);
+  s.sx = v3_get(d, kx) / dz;
+  s.sy = v3_get(d, ky) / dz;
+  s.sz = 1.0f / dz;
+  s.o = o;
+  return s;
+}
+
+/* Returns 1 if the ray hits (v0,v1,v2) at 0 < t < tmax; fills t and weights of v1, v2. */
+static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, float *t_out, float *b1_out, float *b2_out) {
+  const float *p0 = v, *p1 = v + 3, *p2 = v + 6;
+  float o[3] = {s->o.x, s->o.y, s->o.z};
+  float ax = p0[s->kx] - o[s->kx], ay = p0[s->ky] - o[s->ky], az = p0[s->kz] - o[s->kz];
+  float bx = p1[s->kx] - o[s->kx], by = p1[s->ky] - o[s->ky], bz = p1[s->kz] - o[s->kz];
+  float cx = p2[s->kx] - o[s->kx], cy = p2[s->ky] - o[s->ky], cz = p2[s->kz] - o[s->kz];
+  ax -= s->sx * az; ay -= s->sy * az;
+  bx -= s->sx * bz; by -= s->sy * bz;
+  cx -= s->sx * cz; cy -= s->sy * cz;
+  float u = cx * by - cy * bx, w1 = ax * cy - ay * cx, w = bx * ay - by * ax;
+  if (u == 0 || w1 == 0 || w == 0) {
+    u = (float)((double)cx * by - (double)cy * bx);
+    w1 = (float)((double)ax * cy - (double)ay * cx);
+    w = (float)((double)bx * ay - (double)by * ax);
+  }
+  if ((u < 0 || w1 < 0 || w < 0) && (u > 0 || w1 > 0 || w > 0)) return 0;
+  float det = u + w1 + w;
+  if (det == 0) return 0;
+  az *= s->sz; bz *= s->sz; cz *= s->sz;
+  float T = u * az + w1 * bz + w * cz;
+  if (det < 0 ? (T >= 0 || T < tmax * det) : (T <= 0 || T > tmax * det)) return 0;
+  float inv = 1.0f / det;
+  float t = T * inv;
+  if (!(t < tmax) || !(t > 0)) return 0;
+  *t_out = t;
+  *b1_out = w1 * inv;
+  *b2_out = w * inv;
+  return 1;
+}
+#endif

@@ -1,0 +1,231 @@
+/* image_io.c — see image_io.h. */
+#include "image/image_io.h"
+#include "core/error.h"
+#include <OpenEXR/openexr.h>
+#include <stb_image_write.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <unistd.h>
+#include <stdatomic.h>
+
+static const char *ext_of(const char *path) {
+  const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+  if (!dot || (slash && dot < slash)) return "";
+  return dot + 1;
+}
+
+static void temp_name(const char *path, char *out, size_t n) {
+  static atomic_uint counter;
+  unsigned k = atomic_fetch_add(&counter, 1);
+  const char *slash = strrchr(path, '/');
+  if (slash) snprintf(out, n, "%.*s/.%s.tmp%ld.%u", (int)(slash - path), path, slash + 1, (long)getpid(), k);
+  else snprintf(out, n, ".%s.tmp%ld.%u", path, (long)getpid(), k);
+}
+
+static valo_status commit_temp(const char *tmp, const char *path, valo_error *err) {
+  if (rename(tmp, path) != 0) {
+    int e = errno;
+    remove(tmp);
+    return err_set(err, VALO_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+  }
+  return VALO_OK;
+}
+
+static valo_status write_pfm(const char *tmp, int w, int h, const float *rgb) {
+  FILE *f = fopen(tmp, "wb");
+  if (!f) return VALO_ERR_IO;
+  fprintf(f, "PF\n%d %d\n-1.0\n", w, h);
+  int ok = 1;
+  for (int y = h - 1; y >= 0 && ok; y--) ok = fwrite(&rgb[(size_t)y * w * 3], sizeof(float), (size_t)w * 3, f) == (size_t)w * 3;
+  if (fclose(f) != 0) ok = 0;
+  return ok ? VALO_OK : VALO_ERR_IO;
+}
+
+static valo_status write_exr(const char *tmp, int w, int h, const float *rgb, char *msg, size_t msglen) {
+  exr_context_t ctx = NULL;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+  int part = 0;
+  if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, "rgb", EXR_STORAGE_SCANLINE, &part);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP);
+  const char *names[3] = {"B", "G", "R"};
+  for (int c = 0; c < 3 && rv == EXR_ERR_SUCCESS; c++) {
+    int r = exr_add_channel(ctx, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+    if (r != EXR_ERR_SUCCESS) rv = r;
+  }
+  if (rv == EXR_ERR_SUCCESS) rv = exr_set_version(ctx, part, 1);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
+  int32_t lines = 1;
+  if (rv == EXR_ERR_SUCCESS) rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
+  exr_encode_pipeline_t enc;
+  memset(&enc, 0, sizeof enc);
+  int have_enc = 0;
+  for (int y = 0; y < h && rv == EXR_ERR_SUCCESS; y += lines) {
+    exr_chunk_info_t ci;
+    rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
+    if (rv != EXR_ERR_SUCCESS) break;
+    if (!have_enc) { rv = exr_encoding_initialize(ctx, part, &ci, &enc); have_enc = rv == EXR_ERR_SUCCESS; }
+    else rv = exr_encoding_update(ctx, part, &ci, &enc);
+    if (rv != EXR_ERR_SUCCESS) break;
+    for (int c = 0; c < enc.channel_count; c++) {
+      const char *nm = enc.channels[c].channel_name;
+      int off = nm[0] == 'R' ? 0 : (nm[0] == 'G' ? 1 : 2);
+      enc.channels[c].user_pixel_stride = 3 * sizeof(float);
+      enc.channels[c].user_line_stride = w * 3 * (int32_t)sizeof(float);
+      enc.channels[c].user_bytes_per_element = sizeof(float);
+      enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+      enc.channels[c].encode_from_ptr = (const uint8_t *)&rgb[(size_t)y * w * 3 + off];
+    }
+    if (have_enc && y == 0) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
+  }
+  if (have_enc) exr_encoding_destroy(ctx, &enc);
+  if (rv != EXR_ERR_SUCCESS) snprintf(msg, msglen, "%s", exr_get_default_error_message(rv));
+  exr_result_t fr = exr_finish(&ctx);
+  if (rv == EXR_ERR_SUCCESS && fr != EXR_ERR_SUCCESS) { rv = fr; snprintf(msg, msglen, "%s", exr_get_default_error_message(fr)); }
+  return rv == EXR_ERR_SUCCESS ? VALO_OK : VALO_ERR_IO;
+}
+
+static inline float srgb_encode(float v) {
+  if (!(v > 0)) return 0;
+  if (v >= 1) return 1;
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1 / 2.4f) - 0.055f;
+}
+
+void image_to_srgb8(int w, int h, const float *rgb, const valo_output_options *o, unsigned char *out) {
+  float scale = exp2f(o ? o->exposure : 0);
+  for (size_t i = 0; i < (size_t)w * h * 3; i++) {
+    float v = srgb_encode(rgb[i] * scale);
+    out[i] = (unsigned char)lrintf(v * 255.0f);
+  }
+}
+
+valo_status image_write(const char *path, int w, int h, const float *rgb, const valo_output_options *o, valo_error *err) {
+  const char *ext = ext_of(path);
+  int kind = !strcasecmp(ext, "exr") ? 0 : !strcasecmp(ext, "pfm") ? 1 : !strcasecmp(ext, "png") ? 2 : -1;
+  if (kind < 0) return err_set(err, VALO_ERR_UNSUPPORTED, "%s: unknown output format \".%s\" (use .exr, .pfm or .png)", path, ext);
+  char tmp[4200];
+  temp_name(path, tmp, sizeof tmp);
+  valo_status st = VALO_OK;
+  char msg[256] = "";
+  if (kind == 0) st = write_exr(tmp, w, h, rgb, msg, sizeof msg);
+  else if (kind == 1) st = write_pfm(tmp, w, h, rgb);
+  else {
+    unsigned char *px = malloc((size_t)w * h * 3);
+    if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    image_to_srgb8(w, h, rgb, o, px);
+    st = stbi_write_png(tmp, w, h, 3, px, w * 3) ? VALO_OK : VALO_ERR_IO;
+    free(px);
+  }
+  if (st) {
+    int e = errno;
+    remove(tmp);
+    return err_set(err, VALO_ERR_IO, "%s: cannot write: %s", path, msg[0] ? msg : strerror(e));
+  }
+  return commit_temp(tmp, path, err);
+}
+
+void image_free(image *im) { free(im->rgb); im->rgb = NULL; im->w = im->h = 0; }
+
+static valo_status read_pfm(const char *path, image *out, valo_error *err) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  char magic[3] = {0};
+  int w = 0, h = 0;
+  float scale = 0;
+  if (fscanf(f, "%2s %d %d %f", magic, &w, &h, &scale) != 4 || strcmp(magic, "PF") || w <= 0 || h <= 0 || w > 65536 || h > 65536 || scale >= 0) {
+    fclose(f);
+    return err_set(err, VALO_ERR_PARSE, "%s: not a little-endian RGB PFM file", path);
+  }
+  fgetc(f);
+  out->w = w; out->h = h;
+  out->rgb = malloc((size_t)w * h * 3 * sizeof(float));
+  if (!out->rgb) { fclose(f); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (int y = h - 1; y >= 0; y--)
+    if (fread(&out->rgb[(size_t)y * w * 3], sizeof(float), (size_t)w * 3, f) != (size_t)w * 3) {
+      fclose(f); image_free(out);
+      return err_set(err, VALO_ERR_PARSE, "%s: truncated PFM", path);
+    }
+  fclose(f);
+  return VALO_OK;
+}
+
+static valo_status read_exr(const char *path, image *out, valo_error *err) {
+  exr_context_t ctx = NULL;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.flags |= EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE;
+  init.error_handler_fn = NULL;
+  exr_result_t rv = exr_start_read(&ctx, path, &init);
+  if (rv != EXR_ERR_SUCCESS) return err_set(err, VALO_ERR_PARSE, "%s: cannot read EXR: %s", path, exr_get_default_error_message(rv));
+  valo_status st = VALO_OK;
+  exr_attr_box2i_t dw;
+  exr_storage_t storage;
+  float *buf = NULL;
+  exr_decode_pipeline_t dec;
+  memset(&dec, 0, sizeof dec);
+  int have_dec = 0;
+  if (exr_get_storage(ctx, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE) {
+    st = err_set(err, VALO_ERR_UNSUPPORTED, "%s: only scanline EXR images are supported", path);
+    goto done;
+  }
+  exr_get_data_window(ctx, 0, &dw);
+  int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+  if (w <= 0 || h <= 0 || w > 65536 || h > 65536) { st = err_set(err, VALO_ERR_PARSE, "%s: bad data window", path); goto done; }
+  buf = calloc((size_t)w * h * 3, sizeof(float));
+  if (!buf) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+  int32_t lines = 1;
+  exr_get_scanlines_per_chunk(ctx, 0, &lines);
+  for (int y = dw.min.y; y <= dw.max.y; y += lines) {
+    exr_chunk_info_t ci;
+    rv = exr_read_scanline_chunk_info(ctx, 0, y, &ci);
+    if (rv == EXR_ERR_SUCCESS) {
+      if (!have_dec) { rv = exr_decoding_initialize(ctx, 0, &ci, &dec); have_dec = rv == EXR_ERR_SUCCESS; }
+      else rv = exr_decoding_update(ctx, 0, &ci, &dec);
+    }
+    if (rv != EXR_ERR_SUCCESS) break;
+    int row = ci.start_y - dw.min.y;
+    for (int c = 0; c < dec.channel_count; c++) {
+      const char *nm = dec.channels[c].channel_name;
+      const char *base = strrchr(nm, '.');
+      base = base ? base + 1 : nm;
+      int off = !strcmp(base, "R") ? 0 : !strcmp(base, "G") ? 1 : !strcmp(base, "B") ? 2 : !strcmp(base, "Y") ? 3 : -1;
+      if (off < 0 || dec.channels[c].height == 0) { dec.channels[c].decode_to_ptr = NULL; continue; }
+      if (off == 3) off = 0; /* luminance: fill R, then copy below */
+      dec.channels[c].user_pixel_stride = 3 * sizeof(float);
+      dec.channels[c].user_line_stride = w * 3 * (int32_t)sizeof(float);
+      dec.channels[c].user_bytes_per_element = sizeof(float);
+      dec.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+      dec.channels[c].decode_to_ptr = (uint8_t *)&buf[((size_t)row * w) * 3 + off];
+    }
+    rv = exr_decoding_choose_default_routines(ctx, 0, &dec);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_decoding_run(ctx, 0, &dec);
+    if (rv != EXR_ERR_SUCCESS) break;
+  }
+  if (rv != EXR_ERR_SUCCESS) { st = err_set(err, VALO_ERR_PARSE, "%s: cannot decode EXR: %s", path, exr_get_default_error_message(rv)); goto done; }
+  {
+    const exr_attr_chlist_t *cl = NULL;
+    int has_g = 0;
+    if (exr_get_channels(ctx, 0, &cl) == EXR_ERR_SUCCESS)
+      for (int i = 0; i < cl->num_channels; i++) if (!strcmp(cl->entries[i].name.str, "G")) has_g = 1;
+    if (!has_g)
+      for (size_t i = 0; i < (size_t)w * h; i++) buf[3 * i + 1] = buf[3 * i + 2] = buf[3 * i];
+  }
+  out->w = w; out->h = h; out->rgb = buf; buf = NULL;
+done:
+  if (have_dec) exr_decoding_destroy(ctx, &dec);
+  free(buf);
+  exr_finish(&ctx);
+  return st;
+}
+
+valo_status image_read(const char *path, image *out, valo_error *err) {
+  out->w = out->h = 0; out->rgb = NULL;
+  const char *ext = ext_of(path);
+  if (!strcasecmp(ext, "exr")) return read_exr(path, out, err);
+  if (!strcasecmp(ext, "pfm")) return read_pfm(path, out, err);
+  return err_set(err, VALO_ERR_UNSUPPORTED, "%s: cannot read \".%s\" images (exr, pfm)", path, ext);
+}

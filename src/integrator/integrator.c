@@ -1,0 +1,73 @@
+/* integrator.c — owns the integrator registry and the shared helpers declared in
+ * integrator.h (surface interactions, shadow segments, next-event estimation + MIS). */
+#include "integrator/integrator.h"
+#include "core/sampling.h"
+#include <string.h>
+
+extern const integrator_ops integrator_path;
+static const integrator_ops *const registry[] = {&integrator_path, NULL};
+static const char *const names[] = {"path", NULL};
+
+const integrator_ops *integrator_find(const char *name) {
+  for (int i = 0; registry[i]; i++)
+    if (!strcmp(registry[i]->name, name)) return registry[i];
+  return NULL;
+}
+VALO_API const char *const *valo_integrator_names(void) { return names; }
+
+void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
+  (void)r;
+  const uint32_t *ix = &s->idx[3 * h->tri];
+  vec3 p0 = s->pos[ix[0]], p1 = s->pos[ix[1]], p2 = s->pos[ix[2]];
+  it->p = tri_point(p0, p1, p2, h->b1, h->b2, &it->perr);
+  it->ng = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+  it->tri = h->tri;
+  it->m = &s->mats[s->tri_mat[h->tri]];
+  float b0 = 1 - h->b1 - h->b2;
+  it->ns = it->ng;
+  if (s->tri_flags[h->tri] & TRI_HAS_NORMALS) {
+    vec3 n = v3_add(v3_add(v3_scale(s->nrm[ix[0]], b0), v3_scale(s->nrm[ix[1]], h->b1)), v3_scale(s->nrm[ix[2]], h->b2));
+    float l2 = v3_len2(n);
+    if (l2 > 0 && isfinite(l2)) it->ns = v3_scale(n, 1 / sqrtf(l2));
+  }
+  it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
+  it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+}
+
+int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
+  vec3 d0 = v3_sub(p_to, it->p);
+  vec3 o = offset_origin_isect(it, d0);
+  vec3 target = p_to;
+  if (v3_len2(n_to) > 0) {
+    vec3 err = v3_scale(v3_abs(p_to), fp_gamma(7));
+    target = offset_origin(p_to, err, n_to, v3_neg(d0));
+  }
+  ray r;
+  r.o = o;
+  r.d = v3_sub(target, o);
+  r.tmax = 1 - 1e-4f;
+  ts->rays++;
+  return accel_occluded(c->acc, &r);
+}
+
+rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                    thread_stats *ts) {
+  float ul = sampler_1d(smp), u1 = sampler_1d(smp), u2 = sampler_1d(smp);
+  if (c->ls.table.n == 0) return c3(0, 0, 0);
+  float pmf;
+  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
+  const light *l = &c->s->lights[li];
+  light_li ls;
+  if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return c3(0, 0, 0);
+  vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
+  rgb f = bsdf_eval(b, wo_l, wi_l);
+  if (c3_black(f)) return c3(0, 0, 0);
+  /* Reflection must stay on wo's side of the true surface too (no leaks through
+   * shading normals). */
+  if (v3_dot(ls.wi, it->ng) * v3_dot(wo, it->ng) <= 0) return c3(0, 0, 0);
+  f = c3_scale(f, fabsf(wi_l.z));
+  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return c3(0, 0, 0);
+  float light_pdf = pmf * ls.pdf;
+  float w = ls.delta ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
+  return c3_scale(c3_mul(f, ls.L), w / light_pdf);
+}

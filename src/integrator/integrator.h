@@ -1,0 +1,70 @@
+/* integrator.h — owns the integrator interface and the helpers every integrator shares:
+ * the render context (scene, accelerator, light selector, limits), surface interactions
+ * built from hits, ray spawning with robust offsets, counted ray queries, and next-event
+ * estimation with MIS. Integrators are an ops table in a registry (integrator.c); each
+ * one is a file that writes its li(). */
+#ifndef VALO_INTEGRATOR_H
+#define VALO_INTEGRATOR_H
+#include "scene/scene.h"
+#include "geometry/accel.h"
+#include "light/light.h"
+#include "material/bsdf.h"
+#include "core/rng.h"
+#include "geometry/offset.h"
+
+typedef struct thread_stats { uint64_t rays; uint64_t bad_samples; char pad[48]; } thread_stats;
+
+typedef struct render_ctx {
+  const scene *s;
+  const accel *acc;
+  light_sampler ls;
+  int max_depth;           /* -1: unlimited (Russian roulette, capped at PATH_HARD_CAP) */
+} render_ctx;
+#define PATH_HARD_CAP 1024
+
+typedef struct integrator_ops {
+  const char *name;
+  const char *description;
+  /* Radiance arriving along camera ray r. */
+  rgb (*li)(const render_ctx *c, ray r, sampler *smp, thread_stats *ts);
+} integrator_ops;
+
+const integrator_ops *integrator_find(const char *name);
+
+typedef struct isect {
+  vec3 p, perr;       /* point and its floating-point error bound */
+  vec3 ng;            /* unit geometric normal (counter-clockwise winding side) */
+  vec3 ns;            /* unit shading normal (interpolated, or ng) */
+  float u, v;
+  uint32_t tri;
+  const material *m;
+} isect;
+
+void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
+static inline vec3 offset_origin_isect(const isect *it, vec3 d) { return offset_origin(it->p, it->perr, it->ng, d); }
+static inline int ctx_intersect(const render_ctx *c, const ray *r, hit *h, thread_stats *ts) {
+  ts->rays++;
+  return accel_intersect(c->acc, r, h);
+}
+/* Is the segment from it (leaving towards p_to) blocked? p_to is offset too when n_to is
+ * non-zero (a point on a surface). */
+int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);
+static inline ray spawn_ray(const isect *it, vec3 d) {
+  ray r;
+  r.o = offset_origin_isect(it, d);
+  r.d = d;
+  r.tmax = INFINITY;
+  return r;
+}
+
+/* Next-event estimation at it: picks a light in proportion to power, samples it, traces
+ * a shadow ray, and returns f * Li * |cos| / pdf with the power-heuristic MIS weight
+ * against BSDF sampling (weight 1 for delta lights). fr: frame of the shading normal
+ * (already faced for opaque BSDFs). */
+rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                    thread_stats *ts);
+/* Probability that estimate_direct picks light index li. */
+static inline float light_select_pmf(const render_ctx *c, uint32_t li) {
+  return c->ls.table.n ? alias_pmf(&c->ls.table, li) : 0;
+}
+#endif

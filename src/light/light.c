@@ -1,0 +1,100 @@
+/* light.c — owns area, point, spot, directional and constant-environment lights and the
+ * power-proportional light selector (see light.h). */
+#include "light/light.h"
+#include "core/sampling.h"
+#include <stdlib.h>
+
+float light_power(const scene *s, const light *l) {
+  switch (l->type) {
+  case LIGHT_AREA: return PI_F * l->area * c3_avg(l->L) * (l->two_sided ? 2.0f : 1.0f);
+  case LIGHT_POINT: return 4 * PI_F * c3_avg(l->L);
+  case LIGHT_SPOT: return 2 * PI_F * c3_avg(l->L) * (1 - 0.5f * (l->cos_inner + l->cos_outer));
+  case LIGHT_DIRECTIONAL: return PI_F * s->radius * s->radius * c3_avg(l->L);
+  case LIGHT_ENV: return PI_F * PI_F * s->radius * s->radius * c3_avg(l->L);
+  }
+  return 0;
+}
+
+int light_sampler_init(light_sampler *ls, const scene *s) {
+  ls->table.bins = NULL; ls->table.n = 0; ls->env_index = -1;
+  if (s->nlights == 0) return 0;
+  float *w = malloc(s->nlights * sizeof *w);
+  if (!w) return -1;
+  for (uint32_t i = 0; i < s->nlights; i++) {
+    w[i] = light_power(s, &s->lights[i]);
+    if (!(w[i] >= 0) || !isfinite(w[i])) w[i] = 0;
+    if (s->lights[i].type == LIGHT_ENV) ls->env_index = (int)i;
+  }
+  int rc = alias_build(&ls->table, w, s->nlights);
+  free(w);
+  if (rc) { ls->table.bins = NULL; ls->table.n = 0; } /* all lights black: nothing to sample */
+  return 0;
+}
+void light_sampler_free(light_sampler *ls) { alias_free(&ls->table); }
+
+static float spot_falloff(const light *l, float cos_t) {
+  if (cos_t >= l->cos_inner) return 1;
+  if (cos_t <= l->cos_outer) return 0;
+  float d = (cos_t - l->cos_outer) / (l->cos_inner - l->cos_outer);
+  return d * d * (3 - 2 * d); /* smoothstep, as pbrt-v4 */
+}
+
+int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *o) {
+  o->delta = 0;
+  switch (l->type) {
+  case LIGHT_AREA: {
+    const uint32_t *ix = &s->idx[3 * l->tri];
+    float b0, b1;
+    sample_uniform_triangle(u1, u2, &b0, &b1);
+    vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+    vec3 pl = v3_add(v3_add(v3_scale(a, b0), v3_scale(b, b1)), v3_scale(c, 1 - b0 - b1));
+    vec3 n = v3_norm(scene_tri_ng(s, l->tri));
+    vec3 d = v3_sub(pl, p);
+    float d2 = v3_len2(d);
+    if (!(d2 > 0)) return 0;
+    float dist = sqrtf(d2);
+    vec3 wi = v3_scale(d, 1 / dist);
+    float cos_l = fabsf(v3_dot(n, wi));
+    if (!(cos_l > 0)) return 0;
+    o->L = light_area_emitted(l, n, v3_neg(wi));
+    if (c3_black(o->L)) return 0;
+    o->wi = wi; o->dist = dist; o->p_light = pl; o->n_light = n;
+    o->pdf = d2 / (cos_l * l->area);
+    return isfinite(o->pdf) && o->pdf > 0;
+  }
+  case LIGHT_POINT:
+  case LIGHT_SPOT: {
+    vec3 d = v3_sub(l->p, p);
+    float d2 = v3_len2(d);
+    if (!(d2 > 0)) return 0;
+    float dist = sqrtf(d2);
+    o->wi = v3_scale(d, 1 / dist);
+    o->dist = dist; o->p_light = l->p; o->n_light = v3(0, 0, 0);
+    float fall = l->type == LIGHT_SPOT ? spot_falloff(l, v3_dot(v3_neg(o->wi), l->dir)) : 1.0f;
+    o->L = c3_scale(l->L, fall / d2);
+    o->pdf = 1; o->delta = 1;
+    return !c3_black(o->L);
+  }
+  case LIGHT_DIRECTIONAL:
+    o->wi = v3_neg(l->dir); o->dist = INFINITY; o->L = l->L; o->pdf = 1; o->delta = 1;
+    o->p_light = v3_add(p, v3_scale(o->wi, 2 * s->radius));
+    o->n_light = v3(0, 0, 0);
+    return 1;
+  case LIGHT_ENV:
+    o->wi = sample_uniform_sphere(u1, u2); o->dist = INFINITY; o->L = l->L; o->pdf = uniform_sphere_pdf();
+    o->p_light = v3_add(p, v3_scale(o->wi, 2 * s->radius));
+    o->n_light = v3(0, 0, 0);
+    return 1;
+  }
+  return 0;
+}
+
+float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 pl, vec3 nl) {
+  (void)s;
+  vec3 d = v3_sub(pl, p);
+  float d2 = v3_len2(d);
+  float cos_l = fabsf(v3_dot(nl, v3_scale(d, 1 / sqrtf(d2))));
+  if (!(cos_l > 0) || !(d2 > 0)) return 0;
+  return d2 / (cos_l * l->area);
+}
+float light_pdf_env(const light *l, vec3 wi) { (void)l; (void)wi; return uniform_sphere_pdf(); }

@@ -1,0 +1,38 @@
+/* light.h — owns light sampling for next-event estimation: the power-proportional light
+ * selector (alias table) and, per light type (one switch), sampling an incident direction
+ * at a reference point, the solid-angle density of that sampling, and emitted radiance.
+ * Area lights sample the triangle uniformly by area and convert to solid angle with
+ * pdf_w = pdf_A * d^2 / |cos theta_l|. */
+#ifndef VALO_LIGHT_H
+#define VALO_LIGHT_H
+#include "scene/scene.h"
+#include "core/alias.h"
+
+typedef struct light_sampler { alias_table table; int env_index; } light_sampler;
+
+int light_sampler_init(light_sampler *ls, const scene *s);
+void light_sampler_free(light_sampler *ls);
+
+typedef struct light_li {
+  vec3 wi;       /* unit direction from the reference point towards the light */
+  float dist;    /* distance to the sampled point (INFINITY for directional/env) */
+  vec3 p_light;  /* sampled point on the light (area/point/spot) */
+  vec3 n_light;  /* its geometric normal (area) */
+  rgb L;         /* incident radiance (area/env) or intensity/d^2 (delta lights) */
+  float pdf;     /* solid-angle density (area/env), 1 for delta lights */
+  int delta;
+} light_li;
+
+/* Samples light l as seen from p; returns 0 if it contributes nothing. */
+int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *out);
+/* Solid-angle density with which light_sample picks direction wi from p to point
+ * p_light with normal n_light on area light l (env: the direction alone). */
+float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 p_light, vec3 n_light);
+float light_pdf_env(const light *l, vec3 wi);
+/* Radiance an area light emits from its surface with normal ng towards direction w. */
+static inline rgb light_area_emitted(const light *l, vec3 ng, vec3 w) {
+  float c = v3_dot(ng, w);
+  return (c > 0 || (l->two_sided && c < 0)) ? l->L : c3(0, 0, 0);
+}
+float light_power(const scene *s, const light *l);
+#endif

@@ -1,0 +1,129 @@
+/* bsdf.c — owns the five BSDF models of the core renderer (digest 000): Lambertian,
+ * energy-conserving normalised Phong (Lafortune & Willems 1994: kd/pi + ks (n+2)/(2pi)
+ * cos^n alpha) with mixture sampling of its lobes, diffuse + ideal mirror (MTL illum 5),
+ * smooth dielectric (Fresnel reflection/refraction, total internal reflection, radiance
+ * scaled by 1/eta^2 across the boundary as in pbrt-v4) and smooth conductor (complex
+ * Fresnel). */
+#include "material/bsdf.h"
+#include "material/fresnel.h"
+#include "core/sampling.h"
+
+static float lobe_prob(rgb a, rgb b) {
+  float wa = c3_avg(a), wb = c3_avg(b);
+  return wa + wb > 0 ? wa / (wa + wb) : 1.0f;
+}
+
+bsdf bsdf_from_material(const material *m) {
+  bsdf b;
+  memset(&b, 0, sizeof b);
+  b.kd = m->kd; b.ks = m->ks; b.exponent = m->exponent; b.eta = m->ior;
+  b.cond_eta = m->eta; b.cond_k = m->k;
+  b.p_first = 1;
+  switch (m->type) {
+  case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
+  case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
+  case MAT_MIRROR: b.type = BSDF_MIRROR; b.p_first = lobe_prob(m->kd, m->ks); break;
+  case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
+  case MAT_CONDUCTOR: b.type = BSDF_CONDUCTOR; break;
+  }
+  return b;
+}
+
+int bsdf_has_smooth(const bsdf *b) {
+  switch (b->type) {
+  case BSDF_DIFFUSE: case BSDF_PHONG: return 1;
+  case BSDF_MIRROR: return b->p_first > 0;
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return 0;
+  }
+  return 0;
+}
+
+static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
+  vec3 r = v3(-wo.x, -wo.y, wo.z); /* mirror direction of wo about z */
+  return v3_dot(r, wi);
+}
+
+rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+  if (wo.z <= 0 || wi.z <= 0) return c3(0, 0, 0);
+  switch (b->type) {
+  case BSDF_DIFFUSE: return c3_scale(b->kd, INV_PI_F);
+  case BSDF_MIRROR: return c3_scale(b->kd, INV_PI_F);
+  case BSDF_PHONG: {
+    float ca = phong_cos_alpha(wo, wi);
+    float lobe = ca > 0 ? (b->exponent + 2) * (0.5f * INV_PI_F) * powf(ca, b->exponent) : 0;
+    return c3_add(c3_scale(b->kd, INV_PI_F), c3_scale(b->ks, lobe));
+  }
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return c3(0, 0, 0);
+  }
+  return c3(0, 0, 0);
+}
+
+float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+  if (wo.z <= 0 || wi.z <= 0) return 0;
+  switch (b->type) {
+  case BSDF_DIFFUSE: return cosine_hemisphere_pdf(wi.z);
+  case BSDF_MIRROR: return b->p_first * cosine_hemisphere_pdf(wi.z);
+  case BSDF_PHONG:
+    return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * phong_lobe_pdf(phong_cos_alpha(wo, wi), b->exponent);
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return 0;
+  }
+  return 0;
+}
+
+int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
+  s->delta = 0;
+  s->eta_scale = 1;
+  switch (b->type) {
+  case BSDF_DIFFUSE:
+  case BSDF_MIRROR:
+  case BSDF_PHONG: {
+    if (wo.z <= 0) return 0;
+    if (b->type == BSDF_MIRROR && ulobe >= b->p_first) {
+      s->wi = v3(-wo.x, -wo.y, wo.z);
+      s->weight = c3_scale(b->ks, 1.0f / (1 - b->p_first));
+      s->pdf = 0;
+      s->delta = 1;
+      return 1;
+    }
+    if (b->type == BSDF_PHONG && ulobe >= b->p_first) {
+      vec3 r = v3(-wo.x, -wo.y, wo.z);
+      frame f = frame_from_n(r);
+      s->wi = frame_to_world(&f, sample_phong_lobe(u1, u2, b->exponent));
+    } else {
+      s->wi = sample_cosine_hemisphere(u1, u2);
+    }
+    if (s->wi.z <= 0) return 0; /* Phong lobe below the surface: rejected (digest 000) */
+    s->pdf = bsdf_pdf(b, wo, s->wi);
+    if (!(s->pdf > 0)) return 0;
+    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
+    return 1;
+  }
+  case BSDF_CONDUCTOR: {
+    if (wo.z <= 0) return 0;
+    s->wi = v3(-wo.x, -wo.y, wo.z);
+    s->weight = fresnel_conductor(wo.z, b->cond_eta, b->cond_k);
+    s->pdf = 0;
+    s->delta = 1;
+    return 1;
+  }
+  case BSDF_DIELECTRIC: {
+    float F = fresnel_dielectric(wo.z, b->eta);
+    s->pdf = 0;
+    s->delta = 1;
+    if (ulobe < F) {
+      s->wi = v3(-wo.x, -wo.y, wo.z);
+      s->weight = c3(1, 1, 1);
+      return 1;
+    }
+    vec3 n = v3(0, 0, wo.z > 0 ? 1.0f : -1.0f);
+    float etap = wo.z > 0 ? b->eta : 1 / b->eta;
+    vec3 wt;
+    if (!refract_dir(wo, n, etap, &wt)) return 0; /* cannot happen: F = 1 under TIR */
+    s->wi = wt;
+    s->eta_scale = 1 / (etap * etap);
+    s->weight = c3(s->eta_scale, s->eta_scale, s->eta_scale);
+    return 1;
+  }
+  }
+  return 0;
+}

@@ -1,0 +1,41 @@
+/* bsdf.h — owns the BSDF interface: a tagged union held by value, with eval / sample /
+ * pdf dispatched by one switch each (no default: -Wswitch names a forgotten case).
+ * Directions are in the local shading frame (z = shading normal), both pointing away
+ * from the surface. Opaque BSDFs expect wo.z > 0 (the integrator faces the frame
+ * towards wo); the dielectric uses the sign of wo.z for inside/outside. */
+#ifndef VALO_BSDF_H
+#define VALO_BSDF_H
+#include "core/vec.h"
+#include "scene/scene.h"
+
+typedef enum bsdf_type { BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR } bsdf_type;
+
+typedef struct bsdf {
+  bsdf_type type;
+  rgb kd, ks;
+  float exponent;
+  float eta;          /* dielectric: interior index / exterior index */
+  rgb cond_eta, cond_k;
+  float p_first;      /* probability of the first lobe (diffuse) in mixtures */
+} bsdf;
+
+typedef struct bsdf_sample {
+  vec3 wi;
+  rgb weight;         /* f * |cos| / pdf */
+  float pdf;          /* solid-angle pdf (of the whole mixture); 0 for a delta lobe */
+  int delta;          /* sampled a specular (Dirac) lobe */
+  float eta_scale;    /* radiance scale across refraction (1 otherwise) */
+} bsdf_sample;
+
+bsdf bsdf_from_material(const material *m);
+/* Non-delta part of f(wo, wi). */
+rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi);
+/* Density of bsdf_sample producing wi through a non-delta lobe. */
+float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi);
+/* Samples wi; returns 0 when no direction was produced (the path ends). */
+int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s);
+/* 1 if the BSDF has any non-delta lobe (so light sampling can help). */
+int bsdf_has_smooth(const bsdf *b);
+/* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
+static inline int bsdf_transmits(const bsdf *b) { return b->type == BSDF_DIELECTRIC; }
+#endif

@@ -1,0 +1,308 @@
+/* render.c — owns the public API objects (valo_scene, valo_render), the film (double
+ * accumulation per pixel, box filter: each jittered sample counts for its own pixel) and
+ * the render loop: passes of samples over 16x16 tiles on the thread pool, with sample
+ * and time budgets, cancellation and progress. Every sample draws its random numbers
+ * from (seed, pixel, sample index, dimension), and each pixel's samples are summed in
+ * sample order, so images are bit-identical for any thread count. */
+#include "valo/valo.h"
+#include "scene/scene.h"
+#include "geometry/accel.h"
+#include "integrator/integrator.h"
+#include "image/image_io.h"
+#include "core/threadpool.h"
+#include "core/error.h"
+#include "core/sampling.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <time.h>
+#include <stdio.h>
+
+#define TILE 16
+#define MAX_RES 16384
+#define MAX_SPP 1048576
+#define MAX_PIXEL_SAMPLES 4.0e12
+
+struct valo_scene { scene *s; };
+
+struct valo_render {
+  const scene *s;
+  valo_options opt;
+  render_ctx ctx;
+  const integrator_ops *integ;
+  accel *acc;
+  double *sum;            /* 3 doubles per pixel */
+  int spp_done;
+  double build_seconds, render_seconds;
+  uint64_t rays, bad_samples;
+  atomic_int cancel;
+  /* camera basis */
+  vec3 cam_o, cam_fwd, cam_right, cam_up;
+  float tan_half, aspect;
+};
+
+static double now_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+VALO_API const char *valo_version(void) { return VALO_VERSION_STRING; }
+
+VALO_API void valo_options_init(valo_options *o) {
+  memset(o, 0, sizeof *o);
+  o->width = o->height = o->spp = o->threads = o->max_depth = VALO_UNSET;
+  o->time_budget = VALO_UNSET;
+  o->seed = VALO_UNSET;
+  o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
+}
+
+VALO_API void valo_output_options_init(valo_output_options *o) {
+  memset(o, 0, sizeof *o);
+  snprintf(o->tonemap, sizeof o->tonemap, "clamp");
+}
+
+static int ends_with(const char *s, const char *suf) {
+  size_t n = strlen(s), m = strlen(suf);
+  return n >= m && !strcasecmp(s + n - m, suf);
+}
+
+VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_error *err) {
+  *out = NULL;
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  if (!path || !*path) return err_set(err, VALO_ERR_INVALID, "no scene file given");
+  scene *s = scene_new(path);
+  valo_scene *vs = calloc(1, sizeof *vs);
+  if (!s || !vs) { scene_free(s); free(vs); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  valo_status st = ends_with(path, ".json") ? load_json(s, path, err) : load_mesh(s, path, NULL, UINT32_MAX, 1, err);
+  if (st == VALO_OK) st = scene_commit(s, err);
+  if (st) { scene_free(s); free(vs); return st; }
+  vs->s = s;
+  *out = vs;
+  return VALO_OK;
+}
+
+VALO_API void valo_scene_destroy(valo_scene *vs) {
+  if (!vs) return;
+  scene_free(vs->s);
+  free(vs);
+}
+VALO_API void valo_scene_file_options(const valo_scene *vs, valo_options *out) { *out = vs->s->file_opts; }
+VALO_API uint64_t valo_scene_triangle_count(const valo_scene *vs) { return vs->s->ntris; }
+
+static void merge_options(valo_options *dst, const valo_options *file, const valo_options *cli) {
+  valo_options_init(dst);
+  const valo_options *src[2] = {file, cli};
+  for (int i = 0; i < 2; i++) {
+    const valo_options *o = src[i];
+    if (!o) continue;
+    if (o->width != VALO_UNSET) dst->width = o->width;
+    if (o->height != VALO_UNSET) dst->height = o->height;
+    if (o->spp != VALO_UNSET) dst->spp = o->spp;
+    if (o->time_budget != VALO_UNSET) dst->time_budget = o->time_budget;
+    if (o->threads != VALO_UNSET) dst->threads = o->threads;
+    if (o->seed != VALO_UNSET) dst->seed = o->seed;
+    if (o->max_depth != VALO_DEPTH_UNSET) dst->max_depth = o->max_depth;
+    if (o->integrator[0]) memcpy(dst->integrator, o->integrator, sizeof dst->integrator);
+    if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
+  }
+  if (dst->width == VALO_UNSET) dst->width = 256;
+  if (dst->height == VALO_UNSET) dst->height = 256;
+  if (dst->spp == VALO_UNSET) dst->spp = 16;
+  if (dst->threads == VALO_UNSET || dst->threads == 0) dst->threads = threads_available();
+  if (dst->seed == VALO_UNSET) dst->seed = 1;
+  if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
+  if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
+  if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
+}
+
+VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options *opts, valo_render **out, valo_error *err) {
+  *out = NULL;
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  const scene *s = vs->s;
+  valo_options o;
+  merge_options(&o, &s->file_opts, opts);
+  if (o.width < 1 || o.height < 1 || o.width > MAX_RES || o.height > MAX_RES)
+    return err_set(err, VALO_ERR_INVALID, "resolution %dx%d is out of range (1..%d per side)", o.width, o.height, MAX_RES);
+  if (o.spp < 1 || o.spp > MAX_SPP) return err_set(err, VALO_ERR_INVALID, "sample count %d is out of range (1..%d)", o.spp, MAX_SPP);
+  if ((double)o.width * o.height * o.spp > MAX_PIXEL_SAMPLES)
+    return err_set(err, VALO_ERR_INVALID, "%dx%d at %d spp is more than %.0e samples", o.width, o.height, o.spp, MAX_PIXEL_SAMPLES);
+  if (o.threads < 1 || o.threads > 1024) return err_set(err, VALO_ERR_INVALID, "thread count %d is out of range (1..1024)", o.threads);
+  if (o.seed < 0) return err_set(err, VALO_ERR_INVALID, "seed must not be negative");
+  if (o.max_depth < -1) return err_set(err, VALO_ERR_INVALID, "max_depth must be -1 (unlimited) or >= 0");
+  const integrator_ops *integ = integrator_find(o.integrator);
+  if (!integ) {
+    char list[256] = "";
+    for (const char *const *n = valo_integrator_names(); *n; n++) { strncat(list, " ", sizeof list - strlen(list) - 1); strncat(list, *n, sizeof list - strlen(list) - 1); }
+    return err_set(err, VALO_ERR_INVALID, "unknown integrator \"%s\" (available:%s)", o.integrator, list);
+  }
+  valo_render *r = calloc(1, sizeof *r);
+  if (!r) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  r->s = s;
+  r->opt = o;
+  r->integ = integ;
+  atomic_init(&r->cancel, 0);
+  r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
+  if (!r->sum) { free(r); return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height); }
+  double t0 = now_seconds();
+  valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, &r->acc, err);
+  if (st) { free(r->sum); free(r); return st; }
+  r->build_seconds = now_seconds() - t0;
+  if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  r->ctx.s = s;
+  r->ctx.acc = r->acc;
+  r->ctx.max_depth = o.max_depth;
+  /* Camera basis. */
+  const camera *c = &s->cam;
+  r->cam_o = c->pos;
+  r->cam_fwd = v3_norm(v3_sub(c->look_at, c->pos));
+  r->cam_right = v3_norm(v3_cross(r->cam_fwd, c->up));
+  r->cam_up = v3_cross(r->cam_right, r->cam_fwd);
+  r->tan_half = tanf(0.5f * c->fov_deg * PI_F / 180.0f);
+  r->aspect = (float)o.width / (float)o.height;
+  if (!v3_finite(r->cam_right) || !(v3_len2(r->cam_right) > 0.5f)) {
+    valo_render_destroy(r);
+    return err_set(err, VALO_ERR_INVALID, "%s: camera up vector is parallel to the view direction", s->path);
+  }
+  *out = r;
+  return VALO_OK;
+}
+
+static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
+  float jx = sampler_1d(smp), jy = sampler_1d(smp);
+  float sx = (2.0f * ((float)px + jx) / (float)r->opt.width - 1.0f) * r->tan_half * r->aspect;
+  float sy = (1.0f - 2.0f * ((float)py + jy) / (float)r->opt.height) * r->tan_half;
+  vec3 d = v3_norm(v3_add(r->cam_fwd, v3_add(v3_scale(r->cam_right, sx), v3_scale(r->cam_up, sy))));
+  ray ry;
+  ry.o = r->cam_o;
+  ry.tmax = INFINITY;
+  const camera *c = &r->s->cam;
+  float lu = sampler_1d(smp), lv = sampler_1d(smp);
+  if (c->aperture_radius > 0) {
+    /* Thin lens: every ray through the lens meets at the plane of focus. */
+    float ft = c->focus_distance / v3_dot(d, r->cam_fwd);
+    vec3 pf = v3_add(r->cam_o, v3_scale(d, ft));
+    float dx, dy;
+    sample_concentric_disk(lu, lv, &dx, &dy);
+    ry.o = v3_add(r->cam_o, v3_add(v3_scale(r->cam_right, dx * c->aperture_radius), v3_scale(r->cam_up, dy * c->aperture_radius)));
+    d = v3_norm(v3_sub(pf, ry.o));
+  }
+  ry.d = d;
+  return ry;
+}
+
+typedef struct pass_job {
+  valo_render *r;
+  int s0, s1;          /* sample indices [s0, s1) */
+  int tiles_x;
+  thread_stats *ts;    /* one per thread */
+} pass_job;
+
+static void render_tile(void *user, int64_t item, int thread) {
+  pass_job *j = user;
+  valo_render *r = j->r;
+  if (atomic_load_explicit(&r->cancel, memory_order_relaxed)) return;
+  thread_stats *ts = &j->ts[thread];
+  int tx = (int)(item % j->tiles_x), ty = (int)(item / j->tiles_x);
+  int x0 = tx * TILE, y0 = ty * TILE;
+  int x1 = x0 + TILE < r->opt.width ? x0 + TILE : r->opt.width;
+  int y1 = y0 + TILE < r->opt.height ? y0 + TILE : r->opt.height;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      uint64_t pix = (uint64_t)y * (uint64_t)r->opt.width + (uint64_t)x;
+      double *acc = &r->sum[3 * pix];
+      for (int si = j->s0; si < j->s1; si++) {
+        sampler smp = sampler_make((uint64_t)r->opt.seed, pix, (uint64_t)si);
+        ray ry = camera_ray(r, x, y, &smp);
+        ts->rays++;
+        rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
+        if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
+        acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
+      }
+    }
+}
+
+VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  int threads = r->opt.threads;
+  thread_stats *ts = calloc((size_t)threads, sizeof *ts);
+  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  int tiles_x = (r->opt.width + TILE - 1) / TILE, tiles_y = (r->opt.height + TILE - 1) / TILE;
+  double t0 = now_seconds();
+  double budget = r->opt.time_budget > 0 ? r->opt.time_budget : 0;
+  int pass_spp = 1;
+  valo_status st = VALO_OK;
+  /* Passes grow until one takes about a second, so progress stays lively. */
+  while (r->spp_done < r->opt.spp) {
+    int n = pass_spp;
+    if (r->spp_done + n > r->opt.spp) n = r->opt.spp - r->spp_done;
+    pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
+    double p0 = now_seconds();
+    parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
+    double pt = now_seconds() - p0;
+    if (atomic_load(&r->cancel)) {
+      /* A cancelled pass is partial: the film keeps whole passes only. */
+      memset(r->sum, 0, (size_t)r->opt.width * r->opt.height * 3 * sizeof(double));
+      r->spp_done = 0;
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled");
+      break;
+    }
+    r->spp_done += n;
+    double el = now_seconds() - t0;
+    double frac = (double)r->spp_done / r->opt.spp;
+    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+    if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+    if (budget > 0 && el >= budget) break;
+    if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
+  }
+  r->render_seconds += now_seconds() - t0;
+  for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
+  free(ts);
+  if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
+  return st;
+}
+
+VALO_API void valo_render_cancel(valo_render *r) { atomic_store(&r->cancel, 1); }
+
+VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
+  memset(o, 0, sizeof *o);
+  o->triangles = r->s->ntris;
+  o->build_seconds = r->build_seconds;
+  o->render_seconds = r->render_seconds;
+  o->rays = r->rays;
+  o->spp_done = r->spp_done;
+  o->width = r->opt.width;
+  o->height = r->opt.height;
+  o->threads = r->opt.threads;
+  snprintf(o->integrator, sizeof o->integrator, "%s", r->opt.integrator);
+  snprintf(o->accel, sizeof o->accel, "%s", r->opt.accel);
+}
+
+VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) {
+  size_t n = (size_t)r->opt.width * r->opt.height * 3;
+  double inv = r->spp_done > 0 ? 1.0 / r->spp_done : 0;
+  for (size_t i = 0; i < n; i++) rgb_out[i] = (float)(r->sum[i] * inv);
+}
+
+VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  valo_output_options def;
+  valo_output_options_init(&def);
+  if (!o) o = &def;
+  if (strcmp(o->tonemap, "clamp")) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp)", o->tonemap);
+  float *px = malloc((size_t)r->opt.width * r->opt.height * 3 * sizeof(float));
+  if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  valo_render_pixels(r, px);
+  valo_status st = image_write(path, r->opt.width, r->opt.height, px, o, err);
+  free(px);
+  return st;
+}
+
+VALO_API void valo_render_destroy(valo_render *r) {
+  if (!r) return;
+  accel_destroy(r->acc);
+  light_sampler_free(&r->ctx.ls);
+  free(r->sum);
+  free(r);
+}

@@ -1,0 +1,266 @@
+/* load_assimp.c — owns mesh-file import through Assimp's C API (OBJ/MTL, glTF 2.0, PLY
+ * and the rest Assimp reads): node transforms, triangulated faces, normals and UVs,
+ * MTL material meanings (../shared/scenes/README.md: Kd, Ke front-sided, illum 5 mirror,
+ * illum 7 glass, illum 2 Phong), a file camera, and the input checks (NaN/Inf vertices,
+ * out-of-range indices, degenerate or empty meshes). */
+#include "scene/scene.h"
+#include "core/error.h"
+#include <assimp/cimport.h>
+#include <assimp/scene.h>
+#include <assimp/postprocess.h>
+#include <assimp/material.h>
+#include <assimp/ObjMaterial.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct mat34 { float m[3][4]; } mat34;
+
+static mat34 m34_identity(void) {
+  mat34 r = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+  return r;
+}
+static mat34 m34_mul(const mat34 *a, const mat34 *b) {
+  mat34 r;
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 4; j++) {
+      float v = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] + a->m[i][2] * b->m[2][j];
+      if (j == 3) v += a->m[i][3];
+      r.m[i][j] = v;
+    }
+  return r;
+}
+static vec3 m34_point(const mat34 *a, vec3 p) {
+  return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z + a->m[0][3],
+            a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z + a->m[1][3],
+            a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z + a->m[2][3]);
+}
+static vec3 m34_vector(const mat34 *a, vec3 p) {
+  return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z, a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z,
+            a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z);
+}
+static float m34_det(const mat34 *a) {
+  const float(*m)[4] = a->m;
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+/* Cofactor matrix = det * inverse transpose: transforms normals (normalised after). */
+static mat34 m34_normal_matrix(const mat34 *a) {
+  const float(*m)[4] = a->m;
+  mat34 r = m34_identity();
+  r.m[0][0] = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+  r.m[0][1] = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+  r.m[0][2] = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+  r.m[1][0] = m[0][2] * m[2][1] - m[0][1] * m[2][2];
+  r.m[1][1] = m[0][0] * m[2][2] - m[0][2] * m[2][0];
+  r.m[1][2] = m[0][1] * m[2][0] - m[0][0] * m[2][1];
+  r.m[2][0] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
+  r.m[2][1] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
+  r.m[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+  return r;
+}
+static mat34 m34_from_ai(const struct aiMatrix4x4 *t) {
+  mat34 r = {{{t->a1, t->a2, t->a3, t->a4}, {t->b1, t->b2, t->b3, t->b4}, {t->c1, t->c2, t->c3, t->c4}}};
+  return r;
+}
+
+static rgb ai_color(const struct aiMaterial *m, const char *key, unsigned type, unsigned idx, rgb def, int *found) {
+  struct aiColor4D c;
+  if (aiGetMaterialColor(m, key, type, idx, &c) == aiReturn_SUCCESS) {
+    if (found) *found = 1;
+    return c3(c.r, c.g, c.b);
+  }
+  if (found) *found = 0;
+  return def;
+}
+static float ai_float(const struct aiMaterial *m, const char *key, unsigned type, unsigned idx, float def) {
+  ai_real v;
+  unsigned int n = 1;
+  if (aiGetMaterialFloatArray(m, key, type, idx, &v, &n) == aiReturn_SUCCESS && n == 1) return (float)v;
+  return def;
+}
+
+static material convert_material(const struct aiMaterial *am) {
+  material m = material_default();
+  struct aiString name;
+  if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS) snprintf(m.name, sizeof m.name, "%s", name.data);
+  int has_base = 0;
+  rgb base = ai_color(am, AI_MATKEY_BASE_COLOR, c3(1, 1, 1), &has_base);
+  m.kd = ai_color(am, AI_MATKEY_COLOR_DIFFUSE, m.kd, NULL);
+  if (has_base) m.kd = base;
+  m.ks = ai_color(am, AI_MATKEY_COLOR_SPECULAR, c3(0, 0, 0), NULL);
+  m.exponent = ai_float(am, AI_MATKEY_SHININESS, 1.0f);
+  m.ior = ai_float(am, AI_MATKEY_REFRACTI, 1.5f);
+  m.emission = ai_color(am, AI_MATKEY_COLOR_EMISSIVE, c3(0, 0, 0), NULL);
+  float strength = ai_float(am, AI_MATKEY_EMISSIVE_INTENSITY, 1.0f);
+  m.emission = c3_scale(m.emission, strength);
+  int illum = -1;
+  unsigned int n = 1;
+  if (aiGetMaterialIntegerArray(am, AI_MATKEY_OBJ_ILLUM, &illum, &n) != aiReturn_SUCCESS) illum = -1;
+  if (illum == 5) m.type = MAT_MIRROR;
+  else if (illum == 7) m.type = MAT_DIELECTRIC;
+  else if (illum >= 2 && c3_max(m.ks) > 0) m.type = MAT_PHONG;
+  else m.type = MAT_DIFFUSE;
+  if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
+  if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
+  return m;
+}
+
+typedef struct load_ctx {
+  scene *s;
+  const char *path;
+  const struct aiScene *ai;
+  uint32_t mat_base;
+  uint32_t override_mat;
+  uint64_t added, degenerate;
+  valo_error *err;
+} load_ctx;
+
+static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 *xf) {
+  scene *s = c->s;
+  if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return VALO_OK;
+  if (scene_reserve(s, mesh->mNumVertices, mesh->mNumFaces)) return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
+  mat34 nm = m34_normal_matrix(xf);
+  int flip = m34_det(xf) < 0;
+  uint32_t base = s->nverts;
+  for (unsigned v = 0; v < mesh->mNumVertices; v++) {
+    const struct aiVector3D *p = &mesh->mVertices[v];
+    vec3 pv = v3(p->x, p->y, p->z);
+    if (!v3_finite(pv))
+      return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' vertex %u is not finite (%g %g %g)", c->path,
+                     mesh->mName.data, v, (double)p->x, (double)p->y, (double)p->z);
+    pv = m34_point(xf, pv);
+    if (!v3_finite(pv)) return err_set(c->err, VALO_ERR_INVALID, "%s: vertex %u is not finite after the transform", c->path, v);
+    s->pos[base + v] = pv;
+    vec3 n = v3(0, 0, 0);
+    if (mesh->mNormals) {
+      n = v3(mesh->mNormals[v].x, mesh->mNormals[v].y, mesh->mNormals[v].z);
+      n = v3_finite(n) ? v3_norm(m34_vector(&nm, n)) : v3(0, 0, 0);
+      if (!v3_finite(n)) n = v3(0, 0, 0);
+    }
+    s->nrm[base + v] = n;
+    float u = 0, w = 0;
+    if (mesh->mTextureCoords[0]) { u = mesh->mTextureCoords[0][v].x; w = mesh->mTextureCoords[0][v].y; }
+    s->uv[2 * (base + v)] = isfinite(u) ? u : 0;
+    s->uv[2 * (base + v) + 1] = isfinite(w) ? w : 0;
+  }
+  s->nverts += mesh->mNumVertices;
+  uint32_t mat = c->override_mat != UINT32_MAX ? c->override_mat : c->mat_base + mesh->mMaterialIndex;
+  if (mat >= s->nmats) return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' names material %u that does not exist", c->path, mesh->mName.data, mesh->mMaterialIndex);
+  for (unsigned f = 0; f < mesh->mNumFaces; f++) {
+    const struct aiFace *face = &mesh->mFaces[f];
+    if (face->mNumIndices != 3) continue; /* points and lines */
+    uint32_t i0 = face->mIndices[0], i1 = face->mIndices[1], i2 = face->mIndices[2];
+    if (i0 >= mesh->mNumVertices || i1 >= mesh->mNumVertices || i2 >= mesh->mNumVertices)
+      return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' face %u has a vertex index out of range (mesh has %u vertices)",
+                     c->path, mesh->mName.data, f, mesh->mNumVertices);
+    if (flip) { uint32_t t = i1; i1 = i2; i2 = t; }
+    uint32_t ti = s->ntris;
+    s->idx[3 * ti] = base + i0; s->idx[3 * ti + 1] = base + i1; s->idx[3 * ti + 2] = base + i2;
+    vec3 ng = scene_tri_ng(s, ti);
+    float a2 = v3_len2(ng);
+    if (!(a2 > 0) || !isfinite(a2)) { c->degenerate++; continue; }
+    uint8_t fl = 0;
+    if (mesh->mNormals && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
+      fl |= TRI_HAS_NORMALS;
+    if (mesh->mTextureCoords[0]) fl |= TRI_HAS_UVS;
+    s->tri_mat[ti] = mat;
+    s->tri_flags[ti] = fl;
+    s->ntris++;
+    c->added++;
+  }
+  return VALO_OK;
+}
+
+static valo_status walk(load_ctx *c, const struct aiNode *node, const mat34 *parent) {
+  mat34 local = m34_from_ai(&node->mTransformation);
+  mat34 xf = m34_mul(parent, &local);
+  for (unsigned i = 0; i < node->mNumMeshes; i++) {
+    if (node->mMeshes[i] >= c->ai->mNumMeshes)
+      return err_set(c->err, VALO_ERR_INVALID, "%s: node '%s' names mesh %u that does not exist", c->path, node->mName.data, node->mMeshes[i]);
+    valo_status st = add_mesh(c, c->ai->mMeshes[node->mMeshes[i]], &xf);
+    if (st) return st;
+  }
+  for (unsigned i = 0; i < node->mNumChildren; i++) {
+    valo_status st = walk(c, node->mChildren[i], &xf);
+    if (st) return st;
+  }
+  return VALO_OK;
+}
+
+static const struct aiNode *find_node(const struct aiNode *n, const char *name, mat34 *acc, const mat34 *parent) {
+  mat34 local = m34_from_ai(&n->mTransformation);
+  mat34 xf = m34_mul(parent, &local);
+  if (!strcmp(n->mName.data, name)) { *acc = xf; return n; }
+  for (unsigned i = 0; i < n->mNumChildren; i++) {
+    const struct aiNode *r = find_node(n->mChildren[i], name, acc, &xf);
+    if (r) return r;
+  }
+  return NULL;
+}
+
+static void take_file_camera(load_ctx *c, const mat34 *xf) {
+  const struct aiCamera *cam = c->ai->mCameras[0];
+  mat34 node_xf = m34_identity(), id = m34_identity();
+  if (!find_node(c->ai->mRootNode, cam->mName.data, &node_xf, &id)) node_xf = m34_identity();
+  mat34 full = m34_mul(xf, &node_xf);
+  vec3 pos = m34_point(&full, v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z));
+  vec3 look = m34_vector(&full, v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
+  vec3 up = m34_vector(&full, v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
+  if (!v3_finite(pos) || !(v3_len2(look) > 0) || !(v3_len2(up) > 0)) return;
+  float aspect = cam->mAspect > 0 ? cam->mAspect : 1.0f;
+  float half_h = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f;
+  float vfov = 2.0f * atanf(tanf(half_h) / aspect);
+  c->s->cam.pos = pos;
+  c->s->cam.look_at = v3_add(pos, v3_norm(look));
+  c->s->cam.up = v3_norm(up);
+  c->s->cam.fov_deg = vfov * 180.0f / PI_F;
+  c->s->cam.aperture_radius = 0;
+  c->s->cam.focus_distance = 1;
+  c->s->has_camera = 1;
+  if (cam->mAspect > 0 && c->s->file_opts.width == VALO_UNSET) {
+    c->s->file_opts.height = 256;
+    c->s->file_opts.width = (int)lroundf(256 * cam->mAspect);
+  }
+}
+
+valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_error *err) {
+  FILE *f = fopen(path, "rb");
+  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  fclose(f);
+  unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  const struct aiScene *ai = aiImportFile(path, flags);
+  if (!ai) {
+    const char *msg = aiGetErrorString();
+    return err_set(err, VALO_ERR_PARSE, "%s: cannot read mesh: %s", path, msg && *msg ? msg : "unknown format");
+  }
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err};
+  valo_status st = VALO_OK;
+  if (override_mat == UINT32_MAX) {
+    for (unsigned i = 0; i < ai->mNumMaterials; i++)
+      if (scene_add_material(s, &(material){0}) == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+    for (unsigned i = 0; i < ai->mNumMaterials; i++) s->mats[c.mat_base + i] = convert_material(ai->mMaterials[i]);
+    if (ai->mNumMaterials == 0) {
+      material d = material_default();
+      c.override_mat = scene_add_material(s, &d);
+      if (c.override_mat == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+    }
+  }
+  mat34 x = m34_identity();
+  if (xf12) memcpy(x.m, xf12, sizeof x.m);
+  if (!ai->mRootNode) { st = err_set(err, VALO_ERR_PARSE, "%s: the file has no scene graph", path); goto done; }
+  st = walk(&c, ai->mRootNode, &x);
+  if (st) goto done;
+  if (c.added == 0) {
+    st = err_set(err, VALO_ERR_INVALID, "%s: no usable triangles (%llu degenerate); is it a point cloud, a tristrip or empty?",
+                 path, (unsigned long long)c.degenerate);
+    goto done;
+  }
+  if (c.degenerate)
+    log_warning("%s: skipped %llu degenerate (zero-area) triangles", path, (unsigned long long)c.degenerate);
+  if (take_camera && ai->mNumCameras > 0) take_file_camera(&c, &x);
+done:
+  aiReleaseImport(ai);
+  return st;
+}

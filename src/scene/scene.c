@@ -1,0 +1,193 @@
+/* scene.c — owns scene construction: growable arrays, commit (bounds, area lights,
+ * automatic camera framing), tessellated spheres and conductor presets. */
+#include "scene/scene.h"
+#include "core/error.h"
+#include <stdlib.h>
+#include <string.h>
+#include <stdio.h>
+
+scene *scene_new(const char *path) {
+  scene *s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  snprintf(s->path, sizeof s->path, "%s", path ? path : "");
+  valo_options_init(&s->file_opts);
+  return s;
+}
+
+void scene_free(scene *s) {
+  if (!s) return;
+  free(s->pos); free(s->nrm); free(s->uv); free(s->idx); free(s->tri_mat); free(s->tri_flags);
+  free(s->mats); free(s->lights); free(s->tri_light);
+  free(s);
+}
+
+static int grow(void **p, uint32_t *cap, uint64_t need, size_t elem) {
+  if (need <= *cap) return 0;
+  if (need > 0xFFFFFFF0u) return -1;
+  uint64_t nc = *cap ? *cap : 64;
+  while (nc < need) nc *= 2;
+  if (nc > 0xFFFFFFF0u) nc = 0xFFFFFFF0u;
+  void *q = realloc(*p, (size_t)nc * elem);
+  if (!q) return -1;
+  *p = q;
+  *cap = (uint32_t)nc;
+  return 0;
+}
+
+int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris) {
+  uint64_t nv = (uint64_t)s->nverts + more_verts, nt = (uint64_t)s->ntris + more_tris;
+  if (nv > 0xFFFFFFF0u || nt > 0xFFFFFFF0u) return -1;
+  if (nv > s->cap_verts) {
+    uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts;
+    if (grow((void **)&s->pos, &c, nv, sizeof(vec3)) || grow((void **)&s->nrm, &c2, nv, sizeof(vec3)) ||
+        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)))
+      return -1;
+    s->cap_verts = c;
+  }
+  if (nt > s->cap_tris) {
+    uint32_t c = s->cap_tris, c2 = s->cap_tris, c3 = s->cap_tris;
+    if (grow((void **)&s->idx, &c, nt, 3 * sizeof(uint32_t)) || grow((void **)&s->tri_mat, &c2, nt, sizeof(uint32_t)) ||
+        grow((void **)&s->tri_flags, &c3, nt, 1))
+      return -1;
+    s->cap_tris = c;
+  }
+  return 0;
+}
+
+material material_default(void) {
+  material m;
+  memset(&m, 0, sizeof m);
+  m.type = MAT_DIFFUSE;
+  m.kd = c3(0.8f, 0.8f, 0.8f);
+  m.exponent = 1;
+  m.ior = 1.5f;
+  snprintf(m.name, sizeof m.name, "default");
+  return m;
+}
+
+uint32_t scene_add_material(scene *s, const material *m) {
+  if (grow((void **)&s->mats, &s->cap_mats, (uint64_t)s->nmats + 1, sizeof *m)) return UINT32_MAX;
+  s->mats[s->nmats] = *m;
+  return s->nmats++;
+}
+
+int scene_add_light(scene *s, const light *l) {
+  if (grow((void **)&s->lights, &s->cap_lights, (uint64_t)s->nlights + 1, sizeof *l)) return -1;
+  s->lights[s->nlights++] = *l;
+  return 0;
+}
+
+valo_status scene_commit(scene *s, valo_error *err) {
+  if (s->ntris == 0 && s->nlights == 0 && !s->has_env)
+    return err_set(err, VALO_ERR_INVALID, "%s: the scene has no geometry and no lights", s->path);
+  bbox b = bbox_empty();
+  for (uint32_t i = 0; i < s->nverts; i++) b = bbox_add(b, s->pos[i]);
+  for (uint32_t i = 0; i < s->nlights; i++)
+    if (s->lights[i].type == LIGHT_POINT || s->lights[i].type == LIGHT_SPOT) b = bbox_add(b, s->lights[i].p);
+  if (b.lo.x > b.hi.x) b.lo = b.hi = v3(0, 0, 0);
+  s->bounds = b;
+  s->center = v3_scale(v3_add(b.lo, b.hi), 0.5f);
+  s->radius = fmaxf(0.5f * v3_len(v3_sub(b.hi, b.lo)), 1e-3f);
+
+  /* One area light per emissive triangle (emission is never counted twice: the path
+   * integrator weights hits on these by MIS against light sampling). */
+  free(s->tri_light);
+  s->tri_light = malloc((size_t)(s->ntris ? s->ntris : 1) * sizeof(int32_t));
+  if (!s->tri_light) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  for (uint32_t t = 0; t < s->ntris; t++) {
+    s->tri_light[t] = -1;
+    const material *m = &s->mats[s->tri_mat[t]];
+    if (c3_black(m->emission)) continue;
+    light l;
+    memset(&l, 0, sizeof l);
+    l.type = LIGHT_AREA;
+    l.tri = t;
+    l.area = 0.5f * v3_len(scene_tri_ng(s, t));
+    l.L = m->emission;
+    l.two_sided = m->two_sided;
+    if (!(l.area > 0)) continue;
+    s->tri_light[t] = (int32_t)s->nlights;
+    if (scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  }
+  if (s->has_env) {
+    light l;
+    memset(&l, 0, sizeof l);
+    l.type = LIGHT_ENV;
+    l.L = s->env_radiance;
+    if (!c3_black(l.L) && scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  }
+  if (!s->has_camera) {
+    /* Frame the bounds from +z, looking down -z, 40 degree vertical fov. */
+    s->cam.fov_deg = 40;
+    float dist = s->radius / sinf(0.5f * 40 * PI_F / 180) * 1.05f;
+    s->cam.look_at = s->center;
+    s->cam.pos = v3_add(s->center, v3(0, 0, dist));
+    s->cam.up = v3(0, 1, 0);
+    s->cam.aperture_radius = 0;
+    s->cam.focus_distance = dist;
+    s->has_camera = 1;
+  }
+  return VALO_OK;
+}
+
+/* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
+ * are not shared between faces (flat arrays stay simple); normals are exact. */
+valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, uint32_t mat, valo_error *err) {
+  if (subdiv < 0 || subdiv > 7) return err_set(err, VALO_ERR_INVALID, "%s: sphere subdivisions must be 0..7", s->path);
+  if (!(r > 0) || !isfinite(r)) return err_set(err, VALO_ERR_INVALID, "%s: sphere radius must be positive", s->path);
+  const float t = (1.0f + sqrtf(5.0f)) / 2.0f;
+  vec3 iv[12] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  uint32_t nf = 20u << (2 * subdiv);
+  vec3 *tris = malloc((size_t)nf * 3 * sizeof(vec3)), *tmp = malloc((size_t)nf * 3 * sizeof(vec3));
+  if (!tris || !tmp || scene_reserve(s, nf * 3, nf)) { free(tris); free(tmp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (int i = 0; i < 20; i++)
+    for (int k = 0; k < 3; k++) tris[3 * i + k] = v3_norm(iv[f[i][k]]);
+  uint32_t n = 20;
+  for (int d = 0; d < subdiv; d++) {
+    for (uint32_t i = 0; i < n; i++) {
+      vec3 a = tris[3 * i], b = tris[3 * i + 1], cc = tris[3 * i + 2];
+      vec3 ab = v3_norm(v3_add(a, b)), bc = v3_norm(v3_add(b, cc)), ca = v3_norm(v3_add(cc, a));
+      vec3 *o = &tmp[12 * i];
+      o[0] = a; o[1] = ab; o[2] = ca; o[3] = ab; o[4] = b; o[5] = bc;
+      o[6] = ca; o[7] = bc; o[8] = cc; o[9] = ab; o[10] = bc; o[11] = ca;
+    }
+    vec3 *sw = tris; tris = tmp; tmp = sw;
+    n *= 4;
+  }
+  for (uint32_t i = 0; i < n; i++) {
+    uint32_t base = s->nverts;
+    for (int k = 0; k < 3; k++) {
+      int kk = flip ? 2 - k : k;
+      vec3 u = tris[3 * i + kk];
+      s->pos[base + k] = v3_add(c, v3_scale(u, r));
+      s->nrm[base + k] = flip ? v3_neg(u) : u;
+      s->uv[2 * (base + k)] = 0.5f + atan2f(u.z, u.x) / (2 * PI_F);
+      s->uv[2 * (base + k) + 1] = acosf(clampf(u.y, -1, 1)) / PI_F;
+    }
+    s->nverts += 3;
+    uint32_t ti = s->ntris++;
+    s->idx[3 * ti] = base; s->idx[3 * ti + 1] = base + 1; s->idx[3 * ti + 2] = base + 2;
+    s->tri_mat[ti] = mat;
+    s->tri_flags[ti] = TRI_HAS_NORMALS | TRI_HAS_UVS;
+  }
+  free(tris); free(tmp);
+  return VALO_OK;
+}
+
+/* Complex indices of refraction sampled at ~650/550/450 nm (the usual RGB stand-ins,
+ * from the measured data pbrt and Mitsuba ship). */
+int conductor_preset(const char *name, rgb *eta, rgb *k) {
+  static const struct { const char *n; rgb eta, k; } t[] = {
+      {"Au", {0.143f, 0.374f, 1.442f}, {3.983f, 2.385f, 1.603f}},
+      {"Ag", {0.155f, 0.117f, 0.138f}, {4.828f, 3.122f, 2.147f}},
+      {"Cu", {0.200f, 0.924f, 1.102f}, {3.912f, 2.452f, 2.142f}},
+      {"Al", {1.657f, 0.880f, 0.521f}, {9.224f, 6.270f, 4.837f}},
+  };
+  for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+    if (!strcmp(name, t[i].n)) { *eta = t[i].eta; *k = t[i].k; return 0; }
+  return -1;
+}

@@ -1,0 +1,102 @@
+/* scene.h — owns the scene model: flattened world-space triangle geometry (flat arrays),
+ * materials, lights, camera and the file's render settings. Loaders (load_json.c,
+ * load_assimp.c) append through the scene_add_* builders; scene_commit() then validates
+ * and derives what rendering needs (bounds, area lights). After commit the scene is
+ * immutable and shared by all threads without locks. */
+#ifndef VALO_SCENE_H
+#define VALO_SCENE_H
+#include "core/vec.h"
+#include "valo/valo.h"
+
+typedef enum mat_type {
+  MAT_DIFFUSE,     /* Lambertian kd */
+  MAT_PHONG,       /* kd/pi + normalised Phong lobe ks (n+2)/(2pi) cos^n */
+  MAT_MIRROR,      /* kd/pi + ideal mirror ks, no Fresnel (MTL illum 5; JSON mirror: kd=0) */
+  MAT_DIELECTRIC,  /* smooth dielectric, index ior */
+  MAT_CONDUCTOR    /* smooth conductor, complex index eta + i k per channel */
+} mat_type;
+
+typedef struct material {
+  mat_type type;
+  rgb kd, ks;
+  float exponent;
+  float ior;
+  rgb eta, k;
+  rgb emission;      /* emitted radiance (front side unless two_sided) */
+  int two_sided;     /* emission on both sides */
+  char name[64];
+} material;
+
+typedef enum light_type { LIGHT_AREA, LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL, LIGHT_ENV } light_type;
+typedef struct light {
+  light_type type;
+  vec3 p;          /* point/spot position */
+  vec3 dir;        /* spot axis, or directional light's direction of travel (unit) */
+  rgb L;           /* area/env radiance; point/spot intensity; directional irradiance */
+  float cos_inner, cos_outer; /* spot falloff */
+  uint32_t tri;    /* area: triangle index */
+  float area;      /* area: triangle area */
+  int two_sided;
+} light;
+
+typedef struct camera {
+  vec3 pos, look_at, up;
+  float fov_deg;          /* vertical */
+  float aperture_radius, focus_distance;
+} camera;
+
+/* Triangle flags. */
+enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2 };
+
+typedef struct scene {
+  char path[1024];
+  /* geometry */
+  vec3 *pos, *nrm;         /* per vertex; nrm may hold zeros where the file had none */
+  float *uv;               /* 2 per vertex */
+  uint32_t nverts, cap_verts;
+  uint32_t *idx;           /* 3 per triangle */
+  uint32_t *tri_mat;
+  uint8_t *tri_flags;
+  uint32_t ntris, cap_tris;
+  material *mats;
+  uint32_t nmats, cap_mats;
+  light *lights;
+  uint32_t nlights, cap_lights;
+  int32_t *tri_light;      /* per triangle: its area light or -1 (after commit) */
+  rgb env_radiance;        /* constant environment */
+  int has_env;
+  camera cam;
+  int has_camera;
+  valo_options file_opts;
+  bbox bounds;
+  vec3 center;
+  float radius;
+} scene;
+
+scene *scene_new(const char *path);
+void scene_free(scene *s);
+/* Builders: return 0 or -1 on out of memory. */
+int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris);
+uint32_t scene_add_material(scene *s, const material *m); /* UINT32_MAX on OOM */
+int scene_add_light(scene *s, const light *l);
+material material_default(void);
+/* Validates and derives bounds and area lights; frames a camera if none was given. */
+valo_status scene_commit(scene *s, valo_error *err);
+/* Geometric (unnormalised cross product) normal of triangle t. */
+static inline vec3 scene_tri_ng(const scene *s, uint32_t t) {
+  const uint32_t *i = &s->idx[3 * t];
+  return v3_cross(v3_sub(s->pos[i[1]], s->pos[i[0]]), v3_sub(s->pos[i[2]], s->pos[i[0]]));
+}
+
+/* Loaders (one per file kind). */
+valo_status load_json(scene *s, const char *path, valo_error *err);
+/* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
+ * override_mat: material index for every triangle, or UINT32_MAX to keep the file's. */
+valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat,
+                      int take_camera, valo_error *err);
+/* Adds a tessellated sphere (icosphere with `subdiv` subdivisions). */
+valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,
+                             uint32_t mat, valo_error *err);
+/* Conductor presets: 0 on success. */
+int conductor_preset(const char *name, rgb *eta, rgb *k);
+#endif
