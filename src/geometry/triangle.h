@@ -47,6 +47,16 @@ static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, 
   float inv = 1.0f / det;
   float t = T * inv;
   if (!(t < tmax) || !(t > 0)) return 0;
+  /* Conservative t > 0 (pbrt-v3 §3.9.6): reject hits whose t is within the rounding
+   * error of the computation, which would otherwise re-hit a surface a ray leaves. */
+  float max_z = fmaxf(fabsf(az), fmaxf(fabsf(bz), fabsf(cz)));
+  float max_x = fmaxf(fabsf(ax), fmaxf(fabsf(bx), fabsf(cx)));
+  float max_y = fmaxf(fabsf(ay), fmaxf(fabsf(by), fabsf(cy)));
+  float dz = fp_gamma(3) * max_z, dx = fp_gamma(5) * (max_x + max_z), dy = fp_gamma(5) * (max_y + max_z);
+  float de = 2 * (fp_gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
+  float max_e = fmaxf(fabsf(u), fmaxf(fabsf(w1), fabsf(w)));
+  float dt = 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
+  if (t <= dt) return 0;
   *t_out = t;
   *b1_out = w1 * inv;
   *b2_out = w * inv;

@@ -1,0 +1,75 @@
+/* harness.c — see harness.h. */
+#include "harness.h"
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#ifndef VALO_SHARED_DIR
+#define VALO_SHARED_DIR "../shared"
+#endif
+
+int test_full(void) {
+  const char *e = getenv("VALO_TEST_FULL");
+  return e && *e && strcmp(e, "0");
+}
+
+const char *shared_file(const char *rel) {
+  static char buf[8][2048];
+  static int slot;
+  char *b = buf[slot++ & 7];
+  const char *root = getenv("VALO_SHARED");
+  snprintf(b, 2048, "%s/%s", root && *root ? root : VALO_SHARED_DIR, rel);
+  if (access(b, R_OK) != 0) {
+    fprintf(stderr, "skipped: %s is not there (the shared scenes folder is absent)\n", b);
+    return NULL;
+  }
+  return b;
+}
+
+const char *scratch_dir(void) {
+  static char dir[1024];
+  if (!dir[0]) {
+    snprintf(dir, sizeof dir, "valo-test-scratch-%ld", (long)getpid());
+    mkdir(dir, 0777);
+  }
+  return dir;
+}
+
+const char *scratch_file(const char *name, const char *text) {
+  static char buf[8][1200];
+  static int slot;
+  char *b = buf[slot++ & 7];
+  snprintf(b, 1200, "%s/%s", scratch_dir(), name);
+  FILE *f = fopen(b, "wb");
+  if (!f) return NULL;
+  fputs(text, f);
+  fclose(f);
+  return b;
+}
+
+static void cleanup_scratch(void) {
+  char cmd[1200];
+  const char *d = scratch_dir();
+  snprintf(cmd, sizeof cmd, "rm -rf '%s'", d);
+  if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", d);
+}
+
+int test_main(int argc, char **argv, const test_case *cases) {
+  int failed = 0, ran = 0;
+  int rc_single = -1;
+  for (const test_case *c = cases; c->name; c++) {
+    if (argc > 1 && strcmp(argv[1], c->name)) continue;
+    ran++;
+    fprintf(stderr, "== %s\n", c->name);
+    int rc = c->fn();
+    if (rc == TEST_SKIP) fprintf(stderr, "-- %s: skipped\n", c->name);
+    else if (rc) { fprintf(stderr, "-- %s: FAILED\n", c->name); failed++; }
+    else fprintf(stderr, "-- %s: ok\n", c->name);
+    if (argc > 1) rc_single = rc;
+  }
+  cleanup_scratch();
+  if (ran == 0) { fprintf(stderr, "no test case named %s\n", argc > 1 ? argv[1] : "(none)"); return 2; }
+  if (rc_single >= 0) return rc_single == TEST_SKIP ? TEST_SKIP : (rc_single ? 1 : 0);
+  return failed ? 1 : 0;
+}

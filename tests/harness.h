@@ -1,0 +1,31 @@
+/* harness.h — owns the tiny test harness: each test executable holds a {name, fn} table;
+ * `exe NAME` runs one case (how ctest registers them), `exe` runs all. A case returns 0
+ * (pass), 1 (fail) or TEST_SKIP (77: skipped, e.g. ../shared is missing). */
+#ifndef VALO_TEST_HARNESS_H
+#define VALO_TEST_HARNESS_H
+#include <stdio.h>
+#include <stddef.h>
+
+#define TEST_SKIP 77
+typedef struct test_case { const char *name; int (*fn)(void); } test_case;
+
+#define CHECK(cond, ...)                                                         \
+  do {                                                                           \
+    if (!(cond)) {                                                               \
+      fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond);   \
+      fprintf(stderr, __VA_ARGS__);                                              \
+      fputc('\n', stderr);                                                       \
+      return 1;                                                                  \
+    }                                                                            \
+  } while (0)
+
+int test_main(int argc, char **argv, const test_case *cases);
+/* Path of a file under ../shared (VALO_SHARED_DIR), or NULL (with a message) if absent. */
+const char *shared_file(const char *rel);
+/* 1 when the full (heavy) statistical form is asked for: VALO_TEST_FULL=1. */
+int test_full(void);
+/* Writes text to a file in the test's scratch folder; returns its path (static buffer
+ * per call slot 0..7). */
+const char *scratch_file(const char *name, const char *text);
+const char *scratch_dir(void);
+#endif

@@ -1,0 +1,85 @@
+/* test_reference.c — valo's `path` renders against independent Blender Cycles references
+ * (../shared/references): mean radiance per channel within 1 %, every lit block within
+ * 3 % (16x16 blocks; 32x32 for scenes with caustics). Sample counts are chosen so valo's
+ * own block noise is several times below the tolerance (see docs/performance.md). */
+#include "harness.h"
+#include "valo/valo.h"
+#include "image/image_io.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, lit_blocks; } cmp_result;
+
+/* Compares img to ref: per-channel mean error and worst relative error over lit blocks
+ * (block luminance above 5 % of the image's mean luminance). */
+static void compare(const float *img, const float *ref, int w, int h, int block, cmp_result *r) {
+  double s_img[3] = {0}, s_ref[3] = {0};
+  for (int i = 0; i < w * h; i++)
+    for (int c = 0; c < 3; c++) { s_img[c] += img[3 * i + c]; s_ref[c] += ref[3 * i + c]; }
+  double mean_lum = (s_ref[0] + s_ref[1] + s_ref[2]) / (3.0 * w * h);
+  for (int c = 0; c < 3; c++) r->mean_err[c] = fabs(s_img[c] - s_ref[c]) / s_ref[c];
+  r->worst_block = 0; r->lit_blocks = 0; r->worst_bx = r->worst_by = -1;
+  for (int by = 0; by < h / block; by++)
+    for (int bx = 0; bx < w / block; bx++) {
+      double a = 0, b = 0;
+      for (int y = by * block; y < (by + 1) * block; y++)
+        for (int x = bx * block; x < (bx + 1) * block; x++)
+          for (int c = 0; c < 3; c++) { a += img[3 * (y * w + x) + c]; b += ref[3 * (y * w + x) + c]; }
+      double n = 3.0 * block * block;
+      if (b / n < 0.05 * mean_lum) continue;
+      r->lit_blocks++;
+      double e = fabs(a - b) / b;
+      if (e > r->worst_block) { r->worst_block = e; r->worst_bx = bx; r->worst_by = by; }
+    }
+}
+
+static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int block) {
+  const char *obj = shared_file(obj_rel), *refp = shared_file(ref_rel);
+  if (!obj || !refp) return TEST_SKIP;
+  char json[4096];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"film\": {\"width\": 256, \"height\": 256},\n"
+           "  \"render\": {\"spp\": %d, \"seed\": 7},\n"
+           "  \"shapes\": [ {\"file\": \"%s\"} ] }\n", spp, obj);
+  const char *scene_path = scratch_file("ref.json", json);
+  valo_error err;
+  valo_scene *sc;
+  CHECK(valo_scene_load(scene_path, &sc, &err) == VALO_OK, "%s", err.message);
+  valo_render *r;
+  CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  float *img = malloc(256 * 256 * 3 * sizeof(float));
+  valo_render_pixels(r, img);
+  image ref;
+  CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
+  CHECK(ref.w == 256 && ref.h == 256, "reference is %dx%d", ref.w, ref.h);
+  for (int i = 0; i < 256 * 256 * 3; i++) CHECK(isfinite(img[i]) && img[i] >= 0, "pixel value %g at %d", img[i], i);
+  cmp_result cr;
+  compare(img, ref.rgb, 256, 256, block, &cr);
+  valo_stats st;
+  valo_render_stats(r, &st);
+  fprintf(stderr, "%s at %d spp (%.1f s): mean error R %.3f%% G %.3f%% B %.3f%%; worst of %d lit %dx%d blocks %.2f%% at (%d,%d)\n",
+          obj_rel, spp, st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2], cr.lit_blocks, block,
+          block, 100 * cr.worst_block, cr.worst_bx, cr.worst_by);
+  if (getenv("VALO_TEST_KEEP")) {
+    valo_render_write(r, "reference-test-valo.exr", NULL, &err);
+  }
+  free(img);
+  image_free(&ref);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  for (int c = 0; c < 3; c++) CHECK(cr.mean_err[c] < 0.01, "channel %d mean differs by %.3f%%", c, 100 * cr.mean_err[c]);
+  CHECK(cr.lit_blocks > 50, "only %d lit blocks", cr.lit_blocks);
+  CHECK(cr.worst_block < 0.03, "block (%d,%d) differs by %.2f%%", cr.worst_bx, cr.worst_by, 100 * cr.worst_block);
+  return 0;
+}
+
+static int cornell_original(void) { return run_reference("scenes/cornell/CornellBox-Original.obj", "references/cornell-original.exr", 512, 16); }
+static int cornell_mirror(void) { return run_reference("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", 2048, 32); }
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"cornell_original", cornell_original}, {"cornell_mirror", cornell_mirror}, {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
