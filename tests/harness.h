@@ -28,4 +28,8 @@ int test_full(void);
  * per call slot 0..7). */
 const char *scratch_file(const char *name, const char *text);
 const char *scratch_dir(void);
+/* Renders a JSON scene given as text (through the public API) with optional option
+ * overrides; returns malloc'd RGB pixels and the size, or NULL (message printed). */
+#include "valo/valo.h"
+float *render_json_text(const char *json, const valo_options *opt, int *w, int *h);
 #endif

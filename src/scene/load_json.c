@@ -262,7 +262,7 @@ static void resolve_path(const jctx *c, const char *rel, char *out, size_t n) {
 static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfirst, uint32_t mend) {
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
-  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", NULL};
+  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth", NULL};
   TRY(check_keys(c, o, where, keys));
   const char *type = "mesh", *file = NULL, *mname = NULL;
   TRY(get_str(c, o, "type", where, &type));
@@ -293,7 +293,8 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   if (!strcmp(type, "sphere")) {
     vec3 center = v3(0, 0, 0);
     double r = 1;
-    int sub = 4, flip = 0;
+    int sub = 4, flip = 0, smooth = 1;
+    TRY(get_bool(c, o, "smooth", where, &smooth));
     TRY(get_vec(c, o, "center", where, 0, &center));
     TRY(get_num(c, o, "radius", where, 1e-9, 1e9, &r));
     TRY(get_int(c, o, "subdivisions", where, 0, 7, &sub));
@@ -303,7 +304,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
       mat = scene_add_material(c->s, &d);
       if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     }
-    return scene_add_sphere(c->s, center, (float)r, sub, flip, mat, c->err);
+    return scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err);
   }
   return bad(c, where, "unknown shape type (mesh, sphere)");
 }

@@ -132,7 +132,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
 
 /* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
  * are not shared between faces (flat arrays stay simple); normals are exact. */
-valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, uint32_t mat, valo_error *err) {
+valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, int smooth, uint32_t mat, valo_error *err) {
   if (subdiv < 0 || subdiv > 7) return err_set(err, VALO_ERR_INVALID, "%s: sphere subdivisions must be 0..7", s->path);
   if (!(r > 0) || !isfinite(r)) return err_set(err, VALO_ERR_INVALID, "%s: sphere radius must be positive", s->path);
   const float t = (1.0f + sqrtf(5.0f)) / 2.0f;
@@ -172,7 +172,7 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, ui
     uint32_t ti = s->ntris++;
     s->idx[3 * ti] = base; s->idx[3 * ti + 1] = base + 1; s->idx[3 * ti + 2] = base + 2;
     s->tri_mat[ti] = mat;
-    s->tri_flags[ti] = TRI_HAS_NORMALS | TRI_HAS_UVS;
+    s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS);
   }
   free(tris); free(tmp);
   return VALO_OK;

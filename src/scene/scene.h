@@ -94,9 +94,10 @@ valo_status load_json(scene *s, const char *path, valo_error *err);
  * override_mat: material index for every triangle, or UINT32_MAX to keep the file's. */
 valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat,
                       int take_camera, valo_error *err);
-/* Adds a tessellated sphere (icosphere with `subdiv` subdivisions). */
+/* Adds a tessellated sphere (icosphere with `subdiv` subdivisions); flip: normals
+ * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,
-                             uint32_t mat, valo_error *err);
+                             int smooth, uint32_t mat, valo_error *err);
 /* Conductor presets: 0 on success. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
 #endif

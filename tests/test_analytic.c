@@ -1,0 +1,153 @@
+/* test_analytic.c — scenes with exact answers, as pbrt-v4 tests its integrators:
+ * white furnaces (a diffuse sphere of albedo 1 and 0.5 under a constant environment of
+ * radiance 1: the sphere shows 1 resp. 0.5, the background 1) and a camera inside a
+ * closed sphere of albedo 0.5 lit by a point light of intensity pi at its centre, or by
+ * its own emission of 0.5 (L = Le / (1 - albedo) = 1 everywhere). Flat facets are used so
+ * the answers are exact for the tessellated geometry. Tolerances: region means within
+ * 1 %, every pixel within 6 sigma-ish bounds stated per case; all pixels finite. */
+#include "harness.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *furnace_fmt =
+    "{ \"camera\": {\"position\": [0,0,4], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 40},\n"
+    "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": %d, \"seed\": 5},\n"
+    "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": %g}},\n"
+    "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 4, \"smooth\": false, \"material\": \"m\"}],\n"
+    "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n";
+
+/* Pixels whose centre ray hits well inside the sphere's silhouette, or misses it well
+ * outside: radius of the silhouette in pixels for the camera above. */
+static int classify(int x, int y) {
+  float t = tanf(20.0f * 3.14159265f / 180.0f);
+  float sx = (2.0f * (x + 0.5f) / 32 - 1) * t, sy = (1 - 2.0f * (y + 0.5f) / 32) * t;
+  float r = sqrtf(sx * sx + sy * sy);
+  float rs = 1.0f / sqrtf(16.0f - 1.0f); /* tan of the silhouette half-angle */
+  if (r < 0.85f * rs) return 1;
+  if (r > 1.15f * rs) return 0;
+  return -1;
+}
+
+static int furnace(float albedo) {
+  char json[2048];
+  snprintf(json, sizeof json, furnace_fmt, 256, albedo);
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  CHECK(px, "render failed");
+  double sum[2] = {0, 0};
+  int n[2] = {0, 0};
+  double worst = 0;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      for (int c = 0; c < 3; c++) CHECK(isfinite(px[3 * (y * w + x) + c]), "pixel %d,%d not finite", x, y);
+      int k = classify(x, y);
+      if (k < 0) continue;
+      float v = (px[3 * (y * w + x)] + px[3 * (y * w + x) + 1] + px[3 * (y * w + x) + 2]) / 3;
+      sum[k] += v; n[k]++;
+      float expect = k ? albedo : 1.0f;
+      double e = fabs(v - expect) / expect;
+      if (e > worst) worst = e;
+    }
+  free(px);
+  double m_sphere = sum[1] / n[1], m_bg = sum[0] / n[0];
+  fprintf(stderr, "albedo %.2f: sphere mean %.5f (expect %.5f, %d px), background mean %.5f (%d px), worst pixel %.2f%%\n", albedo,
+          m_sphere, albedo, n[1], m_bg, n[0], 100 * worst);
+  CHECK(fabs(m_sphere - albedo) < 0.01 * albedo, "sphere mean %g vs %g", m_sphere, albedo);
+  CHECK(fabs(m_bg - 1) < 1e-6, "background mean %g vs 1", m_bg);
+  /* With MIS each sample is exact only in expectation: pixels carry noise (256 spp). */
+  CHECK(worst < 0.08, "worst pixel off by %.2f%%", 100 * worst);
+  return 0;
+}
+static int furnace_albedo_1(void) { return furnace(1.0f); }
+static int furnace_albedo_half(void) { return furnace(0.5f); }
+
+static int inside_sphere(const char *extra_material, const char *lights, double expect, int spp) {
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,0,0.3], \"look_at\": [0.2,0.1,-1], \"up\": [0,1,0], \"fov\": 70},\n"
+           "  \"film\": {\"width\": 24, \"height\": 24}, \"render\": {\"spp\": %d, \"seed\": 9},\n"
+           "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5 %s}},\n"
+           "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 5, \"smooth\": false, \"flip_normals\": true, \"material\": \"m\"}],\n"
+           "  \"lights\": [%s] }\n",
+           spp, extra_material, lights);
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  CHECK(px, "render failed");
+  double sum = 0, worst = 0;
+  for (int i = 0; i < w * h * 3; i++) {
+    CHECK(isfinite(px[i]), "pixel value %d not finite", i);
+    sum += px[i];
+    double e = expect > 0 ? fabs(px[i] - expect) / expect : fabs(px[i]);
+    if (e > worst) worst = e;
+  }
+  free(px);
+  double mean = sum / (w * h * 3);
+  fprintf(stderr, "mean %.5f (expect %.5f), worst pixel %.2f%%\n", mean, expect, 100 * worst);
+  if (expect == 0) { CHECK(mean == 0, "mean %g, expected black", mean); return 0; }
+  CHECK(fabs(mean - expect) < 0.01 * expect, "mean %g vs %g", mean, expect);
+  CHECK(worst < 0.12, "worst pixel off by %.2f%%", 100 * worst);
+  return 0;
+}
+static int closed_sphere_point_light(void) {
+  return inside_sphere("", "{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 3.14159265358979}", 1.0, 256);
+}
+static int closed_sphere_emissive(void) { return inside_sphere(", \"emission\": 0.5", "", 1.0, 256); }
+/* Emission is front-sided: with the same sphere's normals facing out, the inside is black. */
+static int emission_front_side_only(void) {
+  const char *json =
+      "{ \"camera\": {\"position\": [0,0,0.3], \"look_at\": [0,0,-1], \"up\": [0,1,0], \"fov\": 70},\n"
+      "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
+      "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 0.5}},\n"
+      "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 3, \"material\": \"m\"}] }\n";
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  CHECK(px, "render failed");
+  double sum = 0;
+  for (int i = 0; i < w * h * 3; i++) sum += px[i];
+  free(px);
+  /* Light samples on the shading point's own facet meet it at cos ~ 0 and may round to
+   * the front side: a contribution of order 1e-9, nothing more. */
+  CHECK(sum / (w * h * 3) < 1e-6, "inside of an outward-emitting sphere should be black, got mean %g", sum / (w * h * 3));
+  /* ... and two_sided makes it emit inwards too. */
+  const char *json2 =
+      "{ \"camera\": {\"position\": [0,0,0.3], \"look_at\": [0,0,-1], \"up\": [0,1,0], \"fov\": 70},\n"
+      "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 64},\n"
+      "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 0.5, \"two_sided\": true}},\n"
+      "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 3, \"smooth\": false, \"material\": \"m\"}] }\n";
+  px = render_json_text(json2, NULL, &w, &h);
+  CHECK(px, "render failed");
+  sum = 0;
+  for (int i = 0; i < w * h * 3; i++) sum += px[i];
+  free(px);
+  double mean = sum / (w * h * 3);
+  CHECK(fabs(mean - 1) < 0.02, "two-sided emissive closed sphere: mean %g, expected 1", mean);
+  return 0;
+}
+/* max_depth 1 inside the point-lit sphere: direct light only, 0.5 exactly (up to the
+ * facets' distance from the centre). */
+static int max_depth_direct_only(void) {
+  const char *json =
+      "{ \"camera\": {\"position\": [0,0,0.3], \"look_at\": [0,0,-1], \"up\": [0,1,0], \"fov\": 70},\n"
+      "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 4, \"max_depth\": 1},\n"
+      "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+      "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 6, \"smooth\": false, \"material\": \"m\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0,0,0], \"intensity\": 3.14159265358979}] }\n";
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  CHECK(px, "render failed");
+  for (int i = 0; i < w * h * 3; i++) CHECK(fabs(px[i] - 0.5) < 0.002, "pixel value %g, expected 0.5", px[i]);
+  free(px);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
+                                    {"furnace_albedo_half", furnace_albedo_half},
+                                    {"closed_sphere_point_light", closed_sphere_point_light},
+                                    {"closed_sphere_emissive", closed_sphere_emissive},
+                                    {"emission_front_side_only", emission_front_side_only},
+                                    {"max_depth_direct_only", max_depth_direct_only},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}

@@ -1,0 +1,333 @@
+/* test_chi2.c — chi-square goodness-of-fit tests of every sampling routine against its
+ * own pdf, as Mitsuba and pbrt-v4 do: 10^6 samples (10^7 with VALO_TEST_FULL=1) binned
+ * over the sphere in (theta, phi); expected counts integrate the pdf over each cell
+ * (16x16 midpoint rule with the sin(theta) Jacobian); samples that produce no direction
+ * or a delta lobe form one extra cell whose expected count is N (1 - integral); cells
+ * with expected count < 5 are pooled; significance 0.01 with the Sidak correction over
+ * all CHI2_TESTS tests, so one run fails falsely with probability 1 %. Delta lobes get
+ * binomial / exact checks instead. */
+#include "harness.h"
+#include "material/bsdf.h"
+#include "material/fresnel.h"
+#include "light/light.h"
+#include "core/alias.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "geometry/triangle.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NT 20
+#define NP 40
+#define CHI2_TESTS 22
+
+/* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
+ * continued fraction). */
+static double gamma_q(double a, double x) {
+  if (x <= 0) return 1;
+  double gln = lgamma(a);
+  if (x < a + 1) {
+    double ap = a, sum = 1 / a, del = sum;
+    for (int n = 0; n < 100000; n++) { ap += 1; del *= x / ap; sum += del; if (fabs(del) < fabs(sum) * 1e-15) break; }
+    return 1 - sum * exp(-x + a * log(x) - gln);
+  }
+  double b = x + 1 - a, c = 1 / 1e-300, d = 1 / b, h = d;
+  for (int i = 1; i < 100000; i++) {
+    double an = -i * (i - a);
+    b += 2;
+    d = an * d + b; if (fabs(d) < 1e-300) d = 1e-300;
+    c = b + an / c; if (fabs(c) < 1e-300) c = 1e-300;
+    d = 1 / d;
+    double del = d * c;
+    h *= del;
+    if (fabs(del - 1) < 1e-15) break;
+  }
+  return exp(-x + a * log(x) - gln) * h;
+}
+
+static long nsamples(void) { return test_full() ? 10000000L : 1000000L; }
+
+/* Chi-square on observed/expected arrays of n cells; returns 0 if it passes. */
+static int chi2_check(const char *what, const double *obs, const double *exp_, int n) {
+  double chsq = 0, pooled_o = 0, pooled_e = 0;
+  int dof = 0;
+  for (int i = 0; i < n; i++) {
+    if (exp_[i] < 5) { pooled_o += obs[i]; pooled_e += exp_[i]; continue; }
+    chsq += (obs[i] - exp_[i]) * (obs[i] - exp_[i]) / exp_[i];
+    dof++;
+  }
+  if (pooled_e >= 5) { chsq += (pooled_o - pooled_e) * (pooled_o - pooled_e) / pooled_e; dof++; }
+  else if (pooled_o > 20) { fprintf(stderr, "%s: %g samples fell where the pdf expects %g\n", what, pooled_o, pooled_e); return 1; }
+  dof -= 1;
+  double p = gamma_q(dof / 2.0, chsq / 2.0);
+  double alpha = 1 - pow(1 - 0.01, 1.0 / CHI2_TESTS);
+  fprintf(stderr, "%s: chi2 = %.1f, dof = %d, p = %.4f (alpha %.2e)\n", what, chsq, dof, p, alpha);
+  return p < alpha;
+}
+
+static vec3 sph_dir(double theta, double phi) { return v3((float)(sin(theta) * cos(phi)), (float)(sin(theta) * sin(phi)), (float)cos(theta)); }
+
+typedef int (*sample_fn)(void *ctx, sampler *s, vec3 *dir);  /* 0: no direction / delta */
+typedef double (*pdf_fn)(void *ctx, vec3 dir);
+
+static int run_chi2(const char *what, void *ctx, sample_fn sf, pdf_fn pf) {
+  long n = nsamples();
+  int cells = NT * NP + 1;
+  double *obs = calloc(cells, sizeof(double)), *ex = calloc(cells, sizeof(double));
+  for (long i = 0; i < n; i++) {
+    sampler s = sampler_make(1234, (uint64_t)i, 0);
+    vec3 d;
+    if (!sf(ctx, &s, &d)) { obs[NT * NP] += 1; continue; }
+    double th = acos(fmin(1, fmax(-1, d.z))), ph = atan2(d.y, d.x);
+    if (ph < 0) ph += 2 * M_PI;
+    int it = (int)(th / M_PI * NT), ip = (int)(ph / (2 * M_PI) * NP);
+    if (it >= NT) it = NT - 1;
+    if (ip >= NP) ip = NP - 1;
+    obs[it * NP + ip] += 1;
+  }
+  /* Pass 1: 16x16 midpoint rule per cell. Pass 2: cells where the pdf is partly zero
+   * (edges of a light's solid angle, the horizon), and every neighbour of a non-zero
+   * cell (a sliver may fall between midpoints), are integrated again at 128x128. */
+  double total = 0;
+  char *mixed = calloc(NT * NP, 1), *nonzero = calloc(NT * NP, 1);
+  for (int pass = 0; pass < 2; pass++)
+    for (int it = 0; it < NT; it++)
+      for (int ip = 0; ip < NP; ip++) {
+        int refine = mixed[it * NP + ip];
+        for (int a = -1; a <= 1 && !refine; a++)
+          for (int b = -1; b <= 1; b++) {
+            int jt = it + a, jp = (ip + b + NP) % NP;
+            if (jt >= 0 && jt < NT && nonzero[jt * NP + jp]) refine = 1;
+          }
+        if (pass == 1 && !refine) continue;
+        int sub = pass == 0 ? 16 : 128, zeros = 0, nz = 0;
+        double acc = 0, dth = M_PI / NT / sub, dph = 2 * M_PI / NP / sub;
+        for (int a = 0; a < sub; a++)
+          for (int b = 0; b < sub; b++) {
+            double th = (it + (a + 0.5) / sub) * M_PI / NT, ph = (ip + (b + 0.5) / sub) * 2 * M_PI / NP;
+            double pv = pf(ctx, sph_dir(th, ph));
+            if (pv > 0) nz++; else zeros++;
+            acc += pv * sin(th) * dth * dph;
+          }
+        if (pass == 0) { mixed[it * NP + ip] = zeros && nz; nonzero[it * NP + ip] = nz > 0; }
+        ex[it * NP + ip] = acc * n;
+      }
+  for (int i = 0; i < NT * NP; i++) total += ex[i] / n;
+  free(mixed); free(nonzero);
+  ex[NT * NP] = fmax(0, 1 - total) * n;
+  fprintf(stderr, "%s: pdf integrates to %.5f, %.5f of samples gave no (or a delta) direction\n", what, total, obs[NT * NP] / n);
+  int rc = chi2_check(what, obs, ex, cells);
+  free(obs); free(ex);
+  if (total > 1.002) { fprintf(stderr, "%s: pdf integrates to more than 1\n", what); return 1; }
+  return rc;
+}
+
+/* ---- BSDFs */
+typedef struct bsdf_ctx { bsdf b; vec3 wo; } bsdf_ctx;
+static int bsdf_sf(void *c, sampler *s, vec3 *d) {
+  bsdf_ctx *x = c;
+  bsdf_sample bs;
+  float ul = sampler_1d(s), u1 = sampler_1d(s), u2 = sampler_1d(s);
+  if (!bsdf_sample_dir(&x->b, x->wo, ul, u1, u2, &bs) || bs.delta) return 0;
+  /* The sample's pdf and weight must agree with pdf() and eval(). */
+  float p = bsdf_pdf(&x->b, x->wo, bs.wi);
+  if (fabsf(p - bs.pdf) > 1e-3f * p) { fprintf(stderr, "pdf mismatch %g vs %g\n", p, bs.pdf); return 0; }
+  *d = bs.wi;
+  return 1;
+}
+static double bsdf_pf(void *c, vec3 d) { bsdf_ctx *x = c; return bsdf_pdf(&x->b, x->wo, d); }
+
+static int test_bsdf(const char *name, material m, float theta_o_deg) {
+  bsdf_ctx c;
+  c.b = bsdf_from_material(&m);
+  float th = theta_o_deg * (float)M_PI / 180;
+  c.wo = v3(sinf(th) * 0.8f, sinf(th) * 0.6f, cosf(th));
+  char what[128];
+  snprintf(what, sizeof what, "%s, theta_o %.0f deg", name, theta_o_deg);
+  return run_chi2(what, &c, bsdf_sf, bsdf_pf);
+}
+
+static int diffuse(void) {
+  material m = material_default();
+  int rc = 0;
+  rc |= test_bsdf("diffuse", m, 5);
+  rc |= test_bsdf("diffuse", m, 60);
+  rc |= test_bsdf("diffuse", m, 85);
+  return rc;
+}
+static int phong(void) {
+  material m = material_default();
+  m.type = MAT_PHONG;
+  int rc = 0;
+  float exps[3] = {1, 10, 100};
+  for (int i = 0; i < 3; i++) {
+    m.exponent = exps[i];
+    m.kd = c3(0.3f, 0.3f, 0.3f); m.ks = c3(0.5f, 0.5f, 0.5f);
+    char name[64];
+    snprintf(name, sizeof name, "phong n=%.0f kd=.3 ks=.5", exps[i]);
+    rc |= test_bsdf(name, m, 20);
+    rc |= test_bsdf(name, m, 70);
+  }
+  m.kd = c3(0, 0, 0); m.ks = c3(0.9f, 0.9f, 0.9f); m.exponent = 30;
+  rc |= test_bsdf("phong specular only n=30", m, 45);
+  return rc;
+}
+static int mirror_mixture(void) {
+  material m = material_default();
+  m.type = MAT_MIRROR;
+  m.kd = c3(0.4f, 0.4f, 0.4f); m.ks = c3(0.5f, 0.5f, 0.5f);
+  return test_bsdf("diffuse + mirror (illum 5), diffuse part", m, 30);
+}
+
+/* Energy: the albedo of diffuse and Phong estimated from their own samples never
+ * exceeds 1 (energy conservation, digest 000). */
+static int energy_conservation(void) {
+  material m = material_default();
+  m.type = MAT_PHONG;
+  m.kd = c3(0.5f, 0.5f, 0.5f); m.ks = c3(0.5f, 0.5f, 0.5f);
+  float exps[4] = {1, 5, 50, 500};
+  for (int e = 0; e < 4; e++)
+    for (int a = 0; a < 3; a++) {
+      m.exponent = exps[e];
+      bsdf b = bsdf_from_material(&m);
+      float th = (float)(a * 40 + 5) * (float)M_PI / 180;
+      vec3 wo = v3(sinf(th), 0, cosf(th));
+      double sum = 0;
+      long n = 200000;
+      for (long i = 0; i < n; i++) {
+        sampler s = sampler_make(99, (uint64_t)i, 0);
+        bsdf_sample bs;
+        float ul = sampler_1d(&s), u1 = sampler_1d(&s), u2 = sampler_1d(&s);
+        if (bsdf_sample_dir(&b, wo, ul, u1, u2, &bs)) sum += bs.weight.g;
+      }
+      double albedo = sum / n;
+      CHECK(albedo < 1.0 + 3e-3, "phong n=%g theta_o=%d: albedo %.4f > 1", exps[e], a * 40 + 5, albedo);
+    }
+  return 0;
+}
+
+/* Dielectric: reflection chosen with probability F (binomial, 6 sigma), refraction
+ * obeys Snell's law; conductor weight equals the complex Fresnel term. */
+static int delta_lobes(void) {
+  material m = material_default();
+  m.type = MAT_DIELECTRIC;
+  m.ior = 1.5f;
+  bsdf b = bsdf_from_material(&m);
+  float angles[4] = {0, 30, 60, 85};
+  for (int side = 0; side < 2; side++)
+    for (int a = 0; a < 4; a++) {
+      float th = angles[a] * (float)M_PI / 180;
+      vec3 wo = v3(sinf(th), 0, side ? -cosf(th) : cosf(th));
+      float F = fresnel_dielectric(wo.z, b.eta);
+      long n = 200000, refl = 0;
+      for (long i = 0; i < n; i++) {
+        sampler s = sampler_make(7, (uint64_t)i, 0);
+        bsdf_sample bs;
+        float ul = sampler_1d(&s);
+        CHECK(bsdf_sample_dir(&b, wo, ul, 0.5f, 0.5f, &bs), "dielectric sample failed");
+        if (bs.wi.z * wo.z > 0) refl++;
+        else {
+          float eta_i = side ? 1.5f : 1.0f, eta_t = side ? 1.0f : 1.5f;
+          float sin_i = sqrtf(fmaxf(0, 1 - wo.z * wo.z)), sin_t = sqrtf(fmaxf(0, 1 - bs.wi.z * bs.wi.z));
+          CHECK(fabsf(eta_i * sin_i - eta_t * sin_t) < 1e-4f, "Snell's law violated");
+        }
+      }
+      double sigma = sqrt(n * F * (1 - F)) + 1e-9;
+      CHECK(fabs(refl - n * F) <= 6 * sigma + 1e-9, "side %d angle %g: %ld reflections, expected %.1f", side, angles[a], refl, n * F);
+    }
+  /* Normal incidence, n = 1.5: F = 0.04. Beyond the critical angle: F = 1. */
+  CHECK(fabsf(fresnel_dielectric(1, 1.5f) - 0.04f) < 1e-6f, "F(0) = %g", fresnel_dielectric(1, 1.5f));
+  CHECK(fresnel_dielectric(-0.3f, 1.5f) == 1.0f, "no total internal reflection");
+  /* Conductor at normal incidence: ((n-1)^2 + k^2) / ((n+1)^2 + k^2). */
+  rgb eta, k;
+  CHECK(conductor_preset("Au", &eta, &k) == 0, "no Au preset");
+  float expect = ((eta.r - 1) * (eta.r - 1) + k.r * k.r) / ((eta.r + 1) * (eta.r + 1) + k.r * k.r);
+  CHECK(fabsf(fresnel_conductor(1, eta, k).r - expect) < 1e-5f, "conductor F(0) %g vs %g", fresnel_conductor(1, eta, k).r, expect);
+  CHECK(fabsf(fresnel_conductor1(0, 1.5f, 2.0f) - 1) < 1e-5f, "conductor F(90 deg) should be 1");
+  return 0;
+}
+
+/* ---- lights */
+typedef struct light_ctx { scene *s; light l; vec3 p; } light_ctx;
+static int light_sf(void *c, sampler *s, vec3 *d) {
+  light_ctx *x = c;
+  light_li li;
+  float u1 = sampler_1d(s), u2 = sampler_1d(s);
+  if (!light_sample(x->s, &x->l, x->p, u1, u2, &li)) return 0;
+  *d = li.wi;
+  return 1;
+}
+static double light_pf(void *c, vec3 d) {
+  light_ctx *x = c;
+  if (x->l.type == LIGHT_ENV) return light_pdf_env(&x->l, d);
+  const uint32_t *ix = &x->s->idx[3 * x->l.tri];
+  float v[9];
+  for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &x->s->pos[ix[k]], sizeof(vec3));
+  ray_shear sh = ray_shear_make(x->p, d);
+  float t, b1, b2;
+  if (!tri_intersect(&sh, v, INFINITY, &t, &b1, &b2)) return 0;
+  vec3 pl = v3_add(x->p, v3_scale(d, t));
+  return light_pdf_area(x->s, &x->l, x->p, pl, v3_norm(scene_tri_ng(x->s, x->l.tri)));
+}
+static int light_sampling(void) {
+  scene *s = scene_new("chi2");
+  scene_reserve(s, 3, 1);
+  s->pos[0] = v3(-1, 2, -1); s->pos[1] = v3(1.5f, 2, -0.5f); s->pos[2] = v3(0, 2.5f, 1.5f);
+  s->nverts = 3;
+  s->idx[0] = 0; s->idx[1] = 1; s->idx[2] = 2;
+  s->tri_mat[0] = 0; s->tri_flags[0] = 0; s->ntris = 1;
+  light_ctx c = {s, {0}, v3(0.2f, 0.1f, 0.3f)};
+  c.l.type = LIGHT_AREA; c.l.tri = 0; c.l.area = 0.5f * v3_len(scene_tri_ng(s, 0)); c.l.L = c3(1, 1, 1); c.l.two_sided = 1;
+  int rc = run_chi2("area light (triangle) from a point", &c, light_sf, light_pf);
+  c.p = v3(0.1f, 1.9f, 0.0f); /* close: strongly varying density */
+  rc |= run_chi2("area light (triangle) from a close point", &c, light_sf, light_pf);
+  c.l.type = LIGHT_ENV;
+  rc |= run_chi2("constant environment", &c, light_sf, light_pf);
+  scene_free(s);
+  return rc;
+}
+
+static int alias_table_chi2(void) {
+  float w[7] = {1, 0, 3.5f, 0.01f, 7, 2, 0.5f};
+  alias_table t;
+  CHECK(alias_build(&t, w, 7) == 0, "build failed");
+  double obs[7] = {0}, ex[7], sum = 0;
+  for (int i = 0; i < 7; i++) sum += w[i];
+  long n = nsamples();
+  for (long i = 0; i < n; i++) {
+    sampler s = sampler_make(5, (uint64_t)i, 0);
+    float pmf;
+    uint32_t k = alias_sample(&t, sampler_1d(&s), &pmf);
+    CHECK(fabsf(pmf - w[k] / (float)sum) < 1e-6f, "pmf %g for %u", pmf, k);
+    obs[k] += 1;
+  }
+  for (int i = 0; i < 7; i++) ex[i] = n * w[i] / sum;
+  CHECK(obs[1] == 0, "a zero-weight entry was sampled");
+  alias_free(&t);
+  return chi2_check("alias table", obs, ex, 7);
+}
+
+/* The chi-square machinery itself must reject a wrong pdf (a test that cannot fail is a
+ * defect): cosine samples checked against a uniform-hemisphere pdf. */
+static double wrong_pf(void *c, vec3 d) { (void)c; return d.z > 0 ? 1 / (2 * M_PI) : 0; }
+static int chi2_rejects_wrong_pdf(void) {
+  material m = material_default();
+  bsdf_ctx c = {bsdf_from_material(&m), v3(0, 0, 1)};
+  int rc = run_chi2("cosine samples vs uniform pdf (must fail)", &c, bsdf_sf, wrong_pf);
+  CHECK(rc != 0, "chi-square accepted a wrong pdf");
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"diffuse", diffuse},
+                                    {"phong", phong},
+                                    {"mirror_mixture", mirror_mixture},
+                                    {"energy_conservation", energy_conservation},
+                                    {"delta_lobes", delta_lobes},
+                                    {"light_sampling", light_sampling},
+                                    {"alias_table", alias_table_chi2},
+                                    {"chi2_rejects_wrong_pdf", chi2_rejects_wrong_pdf},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
