@@ -109,8 +109,12 @@ static int check_scene(const char *path, int nrays, const char *kind) {
   free(rays); free(stmax); free(bh); free(bf); free(bo);
   scene_free(s);
   CHECK(nhit > nrays / 10, "too few hits (%d) for the test to mean anything", nhit);
-  CHECK(bad_hit == 0, "%d closest-hit mismatches", bad_hit);
-  CHECK(bad_occl == 0, "%d shadow-query mismatches", bad_occl);
+  /* The kd-tree uses the very same triangle test as brute force: exact agreement.
+   * Embree's robust mode rounds differently, so a ray grazing an open boundary edge
+   * (a Cornell box has many) may be classified differently: at most 1 in 10 000. */
+  int allowed = strict ? 0 : nrays / 10000;
+  CHECK(bad_hit <= allowed, "%d closest-hit mismatches (allowed %d)", bad_hit, allowed);
+  CHECK(bad_occl <= allowed, "%d shadow-query mismatches (allowed %d)", bad_occl, allowed);
   return 0;
 }
 

@@ -103,7 +103,8 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *out);
 /* Output settings for display-referred formats (PNG). EXR/PFM are always linear. */
 typedef struct valo_output_options {
   float exposure;         /* stops; 0 by default */
-  char tonemap[16];       /* "clamp" (default) — more come with the display work */
+  char tonemap[16];       /* "clamp" (default), "log" (natural logarithm, as the thesis),
+                             "reinhard" or "aces" (filmic) */
 } valo_output_options;
 VALO_API void valo_output_options_init(valo_output_options *o);
 

@@ -58,6 +58,7 @@ static void usage_render(FILE *f) {
           "  --accel NAME           kdtree (default) or embree\n"
           "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
           "  --exposure STOPS       PNG exposure (default 0)\n"
+          "  --tonemap NAME         PNG tone curve: clamp (default), log, reinhard, aces\n"
           "  -q, --quiet            no progress or summary\n"
           "  -h, --help             this text\n");
 }
@@ -185,6 +186,10 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_double(val, -100, 100, &dv)) BAD_VALUE("stops, -100..100");
       oo.exposure = (float)dv;
+    } else if (!strcmp(a, "--tonemap")) {
+      NEED_VALUE();
+      if (strcmp(val, "clamp") && strcmp(val, "log") && strcmp(val, "reinhard") && strcmp(val, "aces")) BAD_VALUE("clamp, log, reinhard or aces");
+      snprintf(oo.tonemap, sizeof oo.tonemap, "%s", val);
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "valo: unknown option \"%s\" (see valo render --help)\n", a);
       return EXIT_USAGE;

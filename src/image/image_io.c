@@ -1,7 +1,9 @@
 /* image_io.c — see image_io.h. */
 #include "image/image_io.h"
 #include "core/error.h"
+#include "image/tonemap.h"
 #include <OpenEXR/openexr.h>
+#include <OpenEXR/ImfCRgbaFile.h>
 #include <stb_image_write.h>
 #include <errno.h>
 #include <math.h>
@@ -11,6 +13,8 @@
 #include <strings.h>
 #include <unistd.h>
 #include <stdatomic.h>
+
+static void exr_quiet(exr_const_context_t ctxt, exr_result_t code, const char *msg);
 
 static const char *ext_of(const char *path) {
   const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
@@ -35,19 +39,20 @@ static valo_status commit_temp(const char *tmp, const char *path, valo_error *er
   return VALO_OK;
 }
 
-static valo_status write_pfm(const char *tmp, int w, int h, const float *rgb) {
+static valo_status write_pfm(const char *tmp, int w, int h, const float *px) {
   FILE *f = fopen(tmp, "wb");
   if (!f) return VALO_ERR_IO;
   fprintf(f, "PF\n%d %d\n-1.0\n", w, h);
   int ok = 1;
-  for (int y = h - 1; y >= 0 && ok; y--) ok = fwrite(&rgb[(size_t)y * w * 3], sizeof(float), (size_t)w * 3, f) == (size_t)w * 3;
+  for (int y = h - 1; y >= 0 && ok; y--) ok = fwrite(&px[(size_t)y * w * 3], sizeof(float), (size_t)w * 3, f) == (size_t)w * 3;
   if (fclose(f) != 0) ok = 0;
   return ok ? VALO_OK : VALO_ERR_IO;
 }
 
-static valo_status write_exr(const char *tmp, int w, int h, const float *rgb, char *msg, size_t msglen) {
+static valo_status write_exr(const char *tmp, int w, int h, const float *px, char *msg, size_t msglen) {
   exr_context_t ctx = NULL;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.error_handler_fn = exr_quiet;
   exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
   int part = 0;
   if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, "rgb", EXR_STORAGE_SCANLINE, &part);
@@ -78,7 +83,7 @@ static valo_status write_exr(const char *tmp, int w, int h, const float *rgb, ch
       enc.channels[c].user_line_stride = w * 3 * (int32_t)sizeof(float);
       enc.channels[c].user_bytes_per_element = sizeof(float);
       enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
-      enc.channels[c].encode_from_ptr = (const uint8_t *)&rgb[(size_t)y * w * 3 + off];
+      enc.channels[c].encode_from_ptr = (const uint8_t *)&px[(size_t)y * w * 3 + off];
     }
     if (have_enc && y == 0) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
     if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
@@ -90,21 +95,19 @@ static valo_status write_exr(const char *tmp, int w, int h, const float *rgb, ch
   return rv == EXR_ERR_SUCCESS ? VALO_OK : VALO_ERR_IO;
 }
 
-static inline float srgb_encode(float v) {
-  if (!(v > 0)) return 0;
-  if (v >= 1) return 1;
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1 / 2.4f) - 0.055f;
-}
-
-void image_to_srgb8(int w, int h, const float *rgb, const valo_output_options *o, unsigned char *out) {
+void image_to_srgb8(int w, int h, const float *px, const valo_output_options *o, unsigned char *out) {
   float scale = exp2f(o ? o->exposure : 0);
-  for (size_t i = 0; i < (size_t)w * h * 3; i++) {
-    float v = srgb_encode(rgb[i] * scale);
-    out[i] = (unsigned char)lrintf(v * 255.0f);
+  tonemap_kind k = TONEMAP_CLAMP;
+  if (o && tonemap_parse(o->tonemap, &k)) k = TONEMAP_CLAMP;
+  for (size_t i = 0; i < (size_t)w * h; i++) {
+    rgb c = tonemap_apply(k, c3(px[3 * i] * scale, px[3 * i + 1] * scale, px[3 * i + 2] * scale));
+    out[3 * i] = (unsigned char)lrintf(srgb_encode(c.r) * 255.0f);
+    out[3 * i + 1] = (unsigned char)lrintf(srgb_encode(c.g) * 255.0f);
+    out[3 * i + 2] = (unsigned char)lrintf(srgb_encode(c.b) * 255.0f);
   }
 }
 
-valo_status image_write(const char *path, int w, int h, const float *rgb, const valo_output_options *o, valo_error *err) {
+valo_status image_write(const char *path, int w, int h, const float *px, const valo_output_options *o, valo_error *err) {
   const char *ext = ext_of(path);
   int kind = !strcasecmp(ext, "exr") ? 0 : !strcasecmp(ext, "pfm") ? 1 : !strcasecmp(ext, "png") ? 2 : -1;
   if (kind < 0) return err_set(err, VALO_ERR_UNSUPPORTED, "%s: unknown output format \".%s\" (use .exr, .pfm or .png)", path, ext);
@@ -112,14 +115,14 @@ valo_status image_write(const char *path, int w, int h, const float *rgb, const 
   temp_name(path, tmp, sizeof tmp);
   valo_status st = VALO_OK;
   char msg[256] = "";
-  if (kind == 0) st = write_exr(tmp, w, h, rgb, msg, sizeof msg);
-  else if (kind == 1) st = write_pfm(tmp, w, h, rgb);
+  if (kind == 0) st = write_exr(tmp, w, h, px, msg, sizeof msg);
+  else if (kind == 1) st = write_pfm(tmp, w, h, px);
   else {
-    unsigned char *px = malloc((size_t)w * h * 3);
-    if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-    image_to_srgb8(w, h, rgb, o, px);
-    st = stbi_write_png(tmp, w, h, 3, px, w * 3) ? VALO_OK : VALO_ERR_IO;
-    free(px);
+    unsigned char *bytes = malloc((size_t)w * h * 3);
+    if (!bytes) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    image_to_srgb8(w, h, px, o, bytes);
+    st = stbi_write_png(tmp, w, h, 3, bytes, w * 3) ? VALO_OK : VALO_ERR_IO;
+    free(bytes);
   }
   if (st) {
     int e = errno;
@@ -154,11 +157,41 @@ static valo_status read_pfm(const char *path, image *out, valo_error *err) {
   return VALO_OK;
 }
 
+/* OpenEXRCore reports errors through its context; valo reports them through valo_error. */
+static void exr_quiet(exr_const_context_t ctxt, exr_result_t code, const char *msg) { (void)ctxt; (void)code; (void)msg; }
+
+/* Debian 12's OpenEXRCore 3.1 cannot decompress DWAA/DWAB; OpenEXR's own C interface
+ * (ImfCRgbaFile.h, same package) can. Used only when the core decoder says so. */
+static valo_status read_exr_rgba(const char *path, image *out, valo_error *err) {
+  ImfInputFile *in = ImfOpenInputFile(path);
+  if (!in) return err_set(err, VALO_ERR_PARSE, "%s: cannot read EXR: %s", path, ImfErrorMessage());
+  int xmin, ymin, xmax, ymax;
+  ImfHeaderDataWindow(ImfInputHeader(in), &xmin, &ymin, &xmax, &ymax);
+  int w = xmax - xmin + 1, h = ymax - ymin + 1;
+  if (w <= 0 || h <= 0 || w > 65536 || h > 65536) { ImfCloseInputFile(in); return err_set(err, VALO_ERR_PARSE, "%s: bad data window", path); }
+  ImfRgba *buf = malloc((size_t)w * h * sizeof *buf);
+  float *rgbf = malloc((size_t)w * h * 3 * sizeof(float));
+  if (!buf || !rgbf) { free(buf); free(rgbf); ImfCloseInputFile(in); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  /* The frame buffer base is addressed by absolute pixel coordinates. */
+  ImfRgba *base = buf - xmin - (ptrdiff_t)ymin * w;
+  int ok = ImfInputSetFrameBuffer(in, base, 1, (size_t)w) && ImfInputReadPixels(in, ymin, ymax);
+  ImfCloseInputFile(in);
+  if (!ok) { free(buf); free(rgbf); return err_set(err, VALO_ERR_PARSE, "%s: cannot decode EXR: %s", path, ImfErrorMessage()); }
+  for (size_t i = 0; i < (size_t)w * h; i++) {
+    rgbf[3 * i] = ImfHalfToFloat(buf[i].r);
+    rgbf[3 * i + 1] = ImfHalfToFloat(buf[i].g);
+    rgbf[3 * i + 2] = ImfHalfToFloat(buf[i].b);
+  }
+  free(buf);
+  out->w = w; out->h = h; out->rgb = rgbf;
+  return VALO_OK;
+}
+
 static valo_status read_exr(const char *path, image *out, valo_error *err) {
   exr_context_t ctx = NULL;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.flags |= EXR_CONTEXT_FLAG_SILENT_HEADER_PARSE;
-  init.error_handler_fn = NULL;
+  init.error_handler_fn = exr_quiet;
   exr_result_t rv = exr_start_read(&ctx, path, &init);
   if (rv != EXR_ERR_SUCCESS) return err_set(err, VALO_ERR_PARSE, "%s: cannot read EXR: %s", path, exr_get_default_error_message(rv));
   valo_status st = VALO_OK;
@@ -205,6 +238,7 @@ static valo_status read_exr(const char *path, image *out, valo_error *err) {
     if (rv == EXR_ERR_SUCCESS) rv = exr_decoding_run(ctx, 0, &dec);
     if (rv != EXR_ERR_SUCCESS) break;
   }
+  if (rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED) { st = VALO_ERR_UNSUPPORTED; goto done; }
   if (rv != EXR_ERR_SUCCESS) { st = err_set(err, VALO_ERR_PARSE, "%s: cannot decode EXR: %s", path, exr_get_default_error_message(rv)); goto done; }
   {
     const exr_attr_chlist_t *cl = NULL;
@@ -219,6 +253,7 @@ done:
   if (have_dec) exr_decoding_destroy(ctx, &dec);
   free(buf);
   exr_finish(&ctx);
+  if (st == VALO_ERR_UNSUPPORTED) return read_exr_rgba(path, out, err);
   return st;
 }
 

@@ -8,10 +8,10 @@
 
 typedef struct image { int w, h; float *rgb; } image;
 
-valo_status image_write(const char *path, int w, int h, const float *rgb, const valo_output_options *o, valo_error *err);
+valo_status image_write(const char *path, int w, int h, const float *px, const valo_output_options *o, valo_error *err);
 /* Reads an EXR (any compression OpenEXR supports; half/float/uint; R,G,B or Y) or PFM. */
 valo_status image_read(const char *path, image *out, valo_error *err);
 void image_free(image *im);
 /* Display transform used for PNG: exposure, tone map, sRGB encode, 8-bit. */
-void image_to_srgb8(int w, int h, const float *rgb, const valo_output_options *o, unsigned char *out);
+void image_to_srgb8(int w, int h, const float *px, const valo_output_options *o, unsigned char *out);
 #endif

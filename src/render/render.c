@@ -9,6 +9,7 @@
 #include "geometry/accel.h"
 #include "integrator/integrator.h"
 #include "image/image_io.h"
+#include "image/tonemap.h"
 #include "core/threadpool.h"
 #include "core/error.h"
 #include "core/sampling.h"
@@ -290,7 +291,8 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
   valo_output_options def;
   valo_output_options_init(&def);
   if (!o) o = &def;
-  if (strcmp(o->tonemap, "clamp")) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp)", o->tonemap);
+  tonemap_kind tk;
+  if (tonemap_parse(o->tonemap, &tk)) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp, log, reinhard, aces)", o->tonemap);
   float *px = malloc((size_t)r->opt.width * r->opt.height * 3 * sizeof(float));
   if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   valo_render_pixels(r, px);

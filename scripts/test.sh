@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The whole test suite, as the README and CI run it:
+#   1. install the Debian packages valo needs (only those missing);
+#   2. a Release build with -Werror in build/, then every ctest test;
+#   3. with CI=true (or --sanitize): an ASan+UBSan build in build-asan/ running every
+#      test except the long `reference` and `slow` ones.
+# VALO_TEST_FULL=1 runs the statistical tests in their full (10x larger) form.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+sanitize=0
+[ "${CI:-}" = "true" ] && sanitize=1
+for a in "$@"; do [ "$a" = "--sanitize" ] && sanitize=1; done
+scripts/install-deps.sh
+jobs=$(nproc)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DVALO_WERROR=ON
+cmake --build build -j"$jobs"
+(cd build && ctest --output-on-failure -j"$jobs" --timeout 1500)
+if [ "$sanitize" = 1 ]; then
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVALO_WERROR=ON -DVALO_SANITIZE=ON
+  cmake --build build-asan -j"$jobs"
+  (cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+     ctest --output-on-failure -j"$jobs" -LE "reference|slow" --timeout 1500)
+fi

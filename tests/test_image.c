@@ -1,0 +1,127 @@
+/* test_image.c — image files and display transforms: EXR and PFM round-trips are exact;
+ * PNG encodes sRGB (0 -> 0, 1 -> 255, 0.5 -> 188); the tone curves (log, Reinhard, ACES)
+ * take known values and are monotone; writes are atomic (no temporary file left, an
+ * existing file replaced whole); real EXRs (half-float DWAB, PIZ) decode. */
+#include "harness.h"
+#include "image/image_io.h"
+#include "image/tonemap.h"
+#include <dirent.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static float *test_pattern(int w, int h) {
+  float *p = malloc((size_t)w * h * 3 * sizeof(float));
+  for (int i = 0; i < w * h * 3; i++) p[i] = (float)((i * 7919) % 1000) * 0.013f + (i % 3) * 1e-3f;
+  return p;
+}
+
+static int roundtrip(const char *ext) {
+  int w = 37, h = 19;
+  float *p = test_pattern(w, h);
+  char path[1200];
+  snprintf(path, sizeof path, "%s/rt.%s", scratch_dir(), ext);
+  valo_error err;
+  CHECK(image_write(path, w, h, p, NULL, &err) == VALO_OK, "%s", err.message);
+  image im;
+  CHECK(image_read(path, &im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im.w == w && im.h == h, "size %dx%d", im.w, im.h);
+  CHECK(memcmp(im.rgb, p, (size_t)w * h * 3 * sizeof(float)) == 0, "%s round trip is not exact", ext);
+  image_free(&im);
+  free(p);
+  return 0;
+}
+static int exr_roundtrip(void) { return roundtrip("exr"); }
+static int pfm_roundtrip(void) { return roundtrip("pfm"); }
+
+static int srgb_png(void) {
+  float px[9] = {0, 0, 0, 1, 1, 1, 0.5f, 0.5f, 0.5f};
+  unsigned char out[9];
+  valo_output_options o;
+  valo_output_options_init(&o);
+  image_to_srgb8(3, 1, px, &o, out);
+  CHECK(out[0] == 0 && out[3] == 255 && out[6] == 188, "sRGB bytes %d %d %d", out[0], out[3], out[6]);
+  o.exposure = 1; /* 0.5 * 2 = 1 */
+  image_to_srgb8(3, 1, px, &o, out);
+  CHECK(out[6] == 255, "exposure +1 of 0.5 gives %d", out[6]);
+  char path[1200];
+  snprintf(path, sizeof path, "%s/x.png", scratch_dir());
+  valo_error err;
+  CHECK(image_write(path, 3, 1, px, NULL, &err) == VALO_OK, "%s", err.message);
+  FILE *f = fopen(path, "rb");
+  unsigned char sig[8] = {0};
+  CHECK(f && fread(sig, 1, 8, f) == 8, "cannot read png");
+  fclose(f);
+  CHECK(sig[1] == 'P' && sig[2] == 'N' && sig[3] == 'G', "not a PNG");
+  return 0;
+}
+
+static int tone_curves(void) {
+  tonemap_kind k;
+  CHECK(tonemap_parse("reinhard", &k) == 0, "reinhard");
+  rgb g = tonemap_apply(k, c3(1, 1, 1));
+  CHECK(fabsf(g.g - 0.5f) < 1e-6f, "reinhard(1) = %g", g.g);
+  CHECK(tonemap_parse("log", &k) == 0, "log");
+  g = tonemap_apply(k, c3(expf(1) - 1, 0, 0));
+  CHECK(fabsf(g.r - 1) < 1e-6f, "log(e - 1) -> %g", g.r);
+  CHECK(tonemap_parse("aces", &k) == 0, "aces");
+  CHECK(tonemap_parse("nope", &k) != 0, "unknown name accepted");
+  const char *names[3] = {"log", "reinhard", "aces"};
+  for (int n = 0; n < 3; n++) {
+    tonemap_parse(names[n], &k);
+    float prev = -1;
+    for (float v = 0; v < 100; v = v * 1.3f + 0.01f) {
+      float y = tonemap_apply(k, c3(v, v, v)).g;
+      CHECK(y >= prev && isfinite(y), "%s not monotone at %g", names[n], v);
+      prev = y;
+    }
+  }
+  return 0;
+}
+
+static int atomic_write(void) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/atomic.exr", scratch_dir());
+  float *a = test_pattern(64, 64), b[3] = {1, 2, 3};
+  valo_error err;
+  CHECK(image_write(path, 64, 64, a, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(image_write(path, 1, 1, b, NULL, &err) == VALO_OK, "%s", err.message);
+  image im;
+  CHECK(image_read(path, &im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im.w == 1 && im.rgb[2] == 3, "the second write did not replace the first whole");
+  image_free(&im);
+  free(a);
+  DIR *d = opendir(scratch_dir());
+  struct dirent *e;
+  while ((e = readdir(d))) CHECK(!strstr(e->d_name, ".tmp"), "temporary file %s left behind", e->d_name);
+  closedir(d);
+  /* A failed write leaves nothing and says why. */
+  CHECK(image_write("/no/such/dir/x.exr", 1, 1, b, NULL, &err) != VALO_OK, "write to a missing folder succeeded");
+  CHECK(strstr(err.message, "/no/such/dir/x.exr") != NULL, "message: %s", err.message);
+  return 0;
+}
+
+static int real_exr_files(void) {
+  const char *dwab = shared_file("scenes/envmaps/venice.exr"), *piz = shared_file("scenes/envmaps/piz_compressed.exr");
+  if (!dwab || !piz) return TEST_SKIP;
+  const char *files[2] = {dwab, piz};
+  for (int i = 0; i < 2; i++) {
+    image im;
+    valo_error err;
+    CHECK(image_read(files[i], &im, &err) == VALO_OK, "%s", err.message);
+    double sum = 0;
+    for (int k = 0; k < im.w * im.h * 3; k++) { CHECK(isfinite(im.rgb[k]), "non-finite texel"); sum += im.rgb[k]; }
+    fprintf(stderr, "%s: %dx%d, mean %.4f\n", files[i], im.w, im.h, sum / (im.w * im.h * 3));
+    CHECK(im.w == 2 * im.h, "an equirectangular map is 2:1, got %dx%d", im.w, im.h);
+    CHECK(sum > 0, "all black");
+    image_free(&im);
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"exr_roundtrip", exr_roundtrip}, {"pfm_roundtrip", pfm_roundtrip}, {"srgb_png", srgb_png},
+                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}

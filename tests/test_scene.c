@@ -1,0 +1,131 @@
+/* test_scene.c — scene loading: non-unit normals normalised (head.obj), the JSON
+ * transform order (scale, rotate x/y/z, translate), MTL meanings of McGuire's Cornell
+ * boxes (Kd, Ke front-sided emitters, illum 5 mirror, illum 7 glass), automatic framing
+ * of a mesh without a camera, and polygon triangulation. */
+#include "harness.h"
+#include "scene/scene.h"
+#include "light/light.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int head_normals_unit(void) {
+  const char *p = shared_file("scenes/models/head.obj");
+  if (!p) return TEST_SKIP;
+  scene *s = scene_new(p);
+  valo_error err;
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  uint32_t with = 0;
+  for (uint32_t t = 0; t < s->ntris; t++) {
+    if (!(s->tri_flags[t] & TRI_HAS_NORMALS)) continue;
+    with++;
+    for (int k = 0; k < 3; k++) {
+      float l = v3_len(s->nrm[s->idx[3 * t + k]]);
+      CHECK(fabsf(l - 1) < 1e-5f, "normal of length %g", l);
+    }
+  }
+  CHECK(with > s->ntris / 2, "only %u of %u triangles kept normals", with, s->ntris);
+  scene_free(s);
+  return 0;
+}
+
+static int transform_order(void) {
+  const char *obj = scratch_file("tri.obj", "v 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n");
+  CHECK(obj, "cannot write");
+  char json[1024];
+  /* scale 2, then rotate_y 90 (x -> -z), then translate (10,0,0). */
+  snprintf(json, sizeof json,
+           "{ \"shapes\": [{\"file\": \"tri.obj\", \"transform\": {\"scale\": 2, \"rotate_y\": 90, \"translate\": [10,0,0]}}] }");
+  const char *jp = scratch_file("tri.json", json);
+  scene *s = scene_new(jp);
+  valo_error err;
+  CHECK(load_json(s, jp, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->ntris == 1, "%u triangles", s->ntris);
+  vec3 a = s->pos[s->idx[0]], b = s->pos[s->idx[1]], c = s->pos[s->idx[2]];
+  CHECK(fabsf(a.x - 10) < 1e-5f && fabsf(a.y) < 1e-5f && fabsf(a.z + 2) < 1e-5f, "v1 -> (%g %g %g), expected (10 0 -2)", a.x, a.y, a.z);
+  CHECK(fabsf(b.x - 10) < 1e-5f && fabsf(b.y - 2) < 1e-5f && fabsf(b.z) < 1e-5f, "v2 -> (%g %g %g)", b.x, b.y, b.z);
+  CHECK(fabsf(c.x - 12) < 1e-5f && fabsf(c.y) < 1e-5f && fabsf(c.z) < 1e-5f, "v3 -> (%g %g %g), expected (12 0 0)", c.x, c.y, c.z);
+  scene_free(s);
+  /* A mirroring scale keeps the winding's front side facing the same way. */
+  snprintf(json, sizeof json, "{ \"shapes\": [{\"file\": \"tri.obj\", \"transform\": {\"scale\": [-1,1,1]}}] }");
+  jp = scratch_file("tri2.json", json);
+  s = scene_new(jp);
+  CHECK(load_json(s, jp, &err) == VALO_OK, "%s", err.message);
+  vec3 n = scene_tri_ng(s, 0);
+  CHECK(n.x < 0 && n.y > 0 && n.z > 0, "mirrored normal (%g %g %g), expected (-,+,+)", n.x, n.y, n.z);
+  scene_free(s);
+  return 0;
+}
+
+static int load_committed(const char *rel, scene **out) {
+  const char *p = shared_file(rel);
+  if (!p) return TEST_SKIP;
+  scene *s = scene_new(p);
+  valo_error err;
+  if (load_mesh(s, p, NULL, UINT32_MAX, 1, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return 1; }
+  *out = s;
+  return 0;
+}
+
+static int mtl_meanings(void) {
+  scene *s;
+  int rc = load_committed("scenes/cornell/CornellBox-Original.obj", &s);
+  if (rc) return rc;
+  int lights = 0;
+  for (uint32_t i = 0; i < s->nlights; i++) {
+    const light *l = &s->lights[i];
+    if (l->type != LIGHT_AREA) continue;
+    lights++;
+    CHECK(fabsf(l->L.r - 17) < 1e-6f && fabsf(l->L.g - 12) < 1e-6f && fabsf(l->L.b - 4) < 1e-6f, "Ke (%g %g %g)", l->L.r, l->L.g, l->L.b);
+    CHECK(!l->two_sided, "MTL emitters are front-sided");
+    vec3 n = scene_tri_ng(s, l->tri);
+    CHECK(n.y < 0, "the light faces down into the room");
+  }
+  CHECK(lights == 2, "%d emissive triangles, expected 2 (one quad)", lights);
+  CHECK(s->ntris == 36, "%u triangles: quads were not triangulated as expected", s->ntris);
+  int red = 0;
+  for (uint32_t m = 0; m < s->nmats; m++)
+    if (!strcmp(s->mats[m].name, "leftWall")) { red = 1; CHECK(s->mats[m].type == MAT_DIFFUSE && fabsf(s->mats[m].kd.r - 0.63f) < 1e-6f, "leftWall"); }
+  CHECK(red, "no leftWall material");
+  CHECK(s->has_camera, "a camera was framed automatically");
+  vec3 c = s->cam.look_at;
+  CHECK(fabsf(c.x - s->center.x) < 1e-5f && fabsf(c.y - s->center.y) < 1e-5f, "auto camera looks at the centre");
+  scene_free(s);
+
+  rc = load_committed("scenes/cornell/CornellBox-Mirror.obj", &s);
+  if (rc) return rc;
+  int mirror = 0;
+  for (uint32_t m = 0; m < s->nmats; m++)
+    if (s->mats[m].type == MAT_MIRROR) { mirror = 1; CHECK(fabsf(s->mats[m].ks.r - 0.95f) < 1e-6f, "mirror Ks %g", s->mats[m].ks.r); }
+  CHECK(mirror, "illum 5 did not become a mirror");
+  scene_free(s);
+
+  rc = load_committed("scenes/cornell/CornellBox-Sphere.obj", &s); /* rightSphere: illum 7, Ni 2.5 */
+  if (rc) return rc;
+  int glass = 0;
+  for (uint32_t m = 0; m < s->nmats; m++)
+    if (s->mats[m].type == MAT_DIELECTRIC) { glass = 1; CHECK(fabsf(s->mats[m].ior - 2.5f) < 1e-6f, "glass ior %g", s->mats[m].ior); }
+  CHECK(glass, "illum 7 did not become a dielectric");
+  scene_free(s);
+  return 0;
+}
+
+static int gltf_and_ply_load(void) {
+  scene *s;
+  int rc = load_committed("scenes/damaged-helmet/glTF-Binary/DamagedHelmet.glb", &s);
+  if (rc) return rc;
+  /* 46 356 indices (the count ../shared/scenes/README.md gives) = 15 452 triangles. */
+  CHECK(s->ntris == 15452, "helmet has %u triangles, expected 15452", s->ntris);
+  scene_free(s);
+  rc = load_committed("scenes/dragon/dragon_vrip_res4.ply", &s);
+  if (rc) return rc;
+  CHECK(s->ntris > 11000 && s->ntris <= 11102, "dragon res4 has %u triangles", s->ntris);
+  scene_free(s);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
+                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
