@@ -27,8 +27,11 @@ static inline float v3_len2(vec3 a) { return v3_dot(a, a); }
 static inline float v3_len(vec3 a) { return sqrtf(v3_dot(a, a)); }
 static inline vec3 v3_norm(vec3 a) { float l = v3_len(a); return l > 0 ? v3_scale(a, 1.0f / l) : a; }
 static inline vec3 v3_abs(vec3 a) { return v3(fabsf(a.x), fabsf(a.y), fabsf(a.z)); }
-static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z)); }
-static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z)); }
+/* Plain compares rather than fminf/fmaxf, which gcc leaves as libm calls. */
+static inline float minf_fast(float a, float b) { return a < b ? a : b; }
+static inline float maxf_fast(float a, float b) { return a > b ? a : b; }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(minf_fast(a.x, b.x), minf_fast(a.y, b.y), minf_fast(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(maxf_fast(a.x, b.x), maxf_fast(a.y, b.y), maxf_fast(a.z, b.z)); }
 static inline float v3_get(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
 static inline void v3_set(vec3 *a, int i, float f) { if (i == 0) a->x = f; else if (i == 1) a->y = f; else a->z = f; }
 static inline int v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }

@@ -22,6 +22,13 @@ static inline ray_shear ray_shear_make(vec3 o, vec3 d) {
   return s;
 }
 
+/* fmaxf is a libm call (NaN rules); these inputs are finite, so plain compares do. */
+static inline float max3_abs(float a, float b, float c) {
+  a = fabsf(a); b = fabsf(b); c = fabsf(c);
+  float m = a > b ? a : b;
+  return m > c ? m : c;
+}
+
 /* Returns 1 if the ray hits (v0,v1,v2) at 0 < t < tmax; fills t and weights of v1, v2. */
 static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, float *t_out, float *b1_out, float *b2_out) {
   const float *p0 = v, *p1 = v + 3, *p2 = v + 6;
@@ -49,12 +56,10 @@ static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, 
   if (!(t < tmax) || !(t > 0)) return 0;
   /* Conservative t > 0 (pbrt-v3 §3.9.6): reject hits whose t is within the rounding
    * error of the computation, which would otherwise re-hit a surface a ray leaves. */
-  float max_z = fmaxf(fabsf(az), fmaxf(fabsf(bz), fabsf(cz)));
-  float max_x = fmaxf(fabsf(ax), fmaxf(fabsf(bx), fabsf(cx)));
-  float max_y = fmaxf(fabsf(ay), fmaxf(fabsf(by), fabsf(cy)));
+  float max_z = max3_abs(az, bz, cz), max_x = max3_abs(ax, bx, cx), max_y = max3_abs(ay, by, cy);
   float dz = fp_gamma(3) * max_z, dx = fp_gamma(5) * (max_x + max_z), dy = fp_gamma(5) * (max_y + max_z);
   float de = 2 * (fp_gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
-  float max_e = fmaxf(fabsf(u), fmaxf(fabsf(w1), fabsf(w)));
+  float max_e = max3_abs(u, w1, w);
   float dt = 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
   if (t <= dt) return 0;
   *t_out = t;
