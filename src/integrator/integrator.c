@@ -52,7 +52,8 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
 
 rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                     thread_stats *ts) {
-  float ul = sampler_1d(smp), u1 = sampler_1d(smp), u2 = sampler_1d(smp);
+  float ul = sampler_1d(smp), u1, u2;
+  sampler_2d(smp, &u1, &u2);
   if (c->ls.table.n == 0) return c3(0, 0, 0);
   float pmf;
   uint32_t li = alias_sample(&c->ls.table, ul, &pmf);

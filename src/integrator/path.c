@@ -51,7 +51,8 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
     if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, estimate_direct(c, &it, &b, &fr, wo, smp, ts)));
 
     bsdf_sample bs;
-    float ul = sampler_1d(smp), u1 = sampler_1d(smp), u2 = sampler_1d(smp);
+    float ul = sampler_1d(smp), u1, u2;
+    sampler_2d(smp, &u1, &u2);
     vec3 wo_l = frame_to_local(&fr, wo);
     if (!bsdf_sample_dir(&b, wo_l, ul, u1, u2, &bs)) break;
     vec3 wi = v3_norm(frame_to_world(&fr, bs.wi));

@@ -171,7 +171,8 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
 }
 
 static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
-  float jx = sampler_1d(smp), jy = sampler_1d(smp);
+  float jx, jy;
+  sampler_2d(smp, &jx, &jy);
   float sx = (2.0f * ((float)px + jx) / (float)r->opt.width - 1.0f) * r->tan_half * r->aspect;
   float sy = (1.0f - 2.0f * ((float)py + jy) / (float)r->opt.height) * r->tan_half;
   vec3 d = v3_norm(v3_add(r->cam_fwd, v3_add(v3_scale(r->cam_right, sx), v3_scale(r->cam_up, sy))));
@@ -179,7 +180,8 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   ry.o = r->cam_o;
   ry.tmax = INFINITY;
   const camera *c = &r->s->cam;
-  float lu = sampler_1d(smp), lv = sampler_1d(smp);
+  float lu, lv;
+  sampler_2d(smp, &lu, &lv);
   if (c->aperture_radius > 0) {
     /* Thin lens: every ray through the lens meets at the plane of focus. */
     float ft = c->focus_distance / v3_dot(d, r->cam_fwd);
