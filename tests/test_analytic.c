@@ -6,6 +6,7 @@
  * the answers are exact for the tessellated geometry. Tolerances: region means within
  * 1 %, every pixel within 6 sigma-ish bounds stated per case; all pixels finite. */
 #include "harness.h"
+#include "image/image_io.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -141,6 +142,75 @@ static int max_depth_direct_only(void) {
   return 0;
 }
 
+/* A map of constant radiance 1 is the white furnace again: albedo 0.5 shows 0.5. */
+static int furnace_constant_map(void) {
+  float *px = malloc(sizeof(float) * 32 * 16 * 3);
+  for (int i = 0; i < 32 * 16 * 3; i++) px[i] = 1;
+  char path[1200];
+  snprintf(path, sizeof path, "%s/white.pfm", scratch_dir());
+  valo_error err;
+  CHECK(image_write(path, 32, 16, px, NULL, &err) == VALO_OK, "%s", err.message);
+  free(px);
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,0,4], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 256, \"seed\": 5},\n"
+           "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+           "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 4, \"smooth\": false, \"material\": \"m\"}],\n"
+           "  \"environment\": {\"type\": \"map\", \"file\": \"white.pfm\", \"rotation\": 17} }\n");
+  int w, h;
+  float *img = render_json_text(json, NULL, &w, &h);
+  CHECK(img, "render failed");
+  double sum[2] = {0, 0};
+  int n[2] = {0, 0};
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      int k = classify(x, y);
+      if (k < 0) continue;
+      sum[k] += (img[3 * (y * w + x)] + img[3 * (y * w + x) + 1] + img[3 * (y * w + x) + 2]) / 3;
+      n[k]++;
+    }
+  free(img);
+  fprintf(stderr, "constant map: sphere %.5f, background %.5f\n", sum[1] / n[1], sum[0] / n[0]);
+  CHECK(fabs(sum[1] / n[1] - 0.5) < 0.005, "sphere mean %g, expected 0.5", sum[1] / n[1]);
+  CHECK(fabs(sum[0] / n[0] - 1) < 1e-5, "background %g, expected 1", sum[0] / n[0]);
+  return 0;
+}
+
+/* Orientation: a map red for u < 0.5, green for u >= 0.5; looking down -z (the map's
+ * centre) shows red on the left, green on the right; turned 180 degrees, the reverse. */
+static int envmap_orientation(void) {
+  float *px = malloc(sizeof(float) * 64 * 32 * 3);
+  for (int y = 0; y < 32; y++)
+    for (int x = 0; x < 64; x++) {
+      px[3 * (y * 64 + x)] = x < 32 ? 1.0f : 0.0f;
+      px[3 * (y * 64 + x) + 1] = x < 32 ? 0.0f : 1.0f;
+      px[3 * (y * 64 + x) + 2] = y < 16 ? 0.5f : 0.0f; /* blue only in the upper half */
+    }
+  char path[1200];
+  snprintf(path, sizeof path, "%s/halves.pfm", scratch_dir());
+  valo_error err;
+  CHECK(image_write(path, 64, 32, px, NULL, &err) == VALO_OK, "%s", err.message);
+  free(px);
+  for (int rot = 0; rot < 2; rot++) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [0,0,-1], \"up\": [0,1,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 4},\n"
+             "  \"environment\": {\"type\": \"map\", \"file\": \"halves.pfm\", \"rotation\": %d} }\n", rot ? 180 : 0);
+    int w, h;
+    float *img = render_json_text(json, NULL, &w, &h);
+    CHECK(img, "render failed");
+    const float *left = &img[3 * (8 * w + 2)], *right = &img[3 * (8 * w + 13)];
+    const float *top = &img[3 * (1 * w + 8)], *bottom = &img[3 * (14 * w + 8)];
+    if (!rot) CHECK(left[0] > 0.9f && left[1] < 0.1f && right[1] > 0.9f && right[0] < 0.1f, "left (%g %g) right (%g %g)", left[0], left[1], right[0], right[1]);
+    else CHECK(left[1] > 0.9f && left[0] < 0.1f && right[0] > 0.9f && right[1] < 0.1f, "rotated: left (%g %g) right (%g %g)", left[0], left[1], right[0], right[1]);
+    CHECK(top[2] > 0.4f && bottom[2] < 0.1f, "up is not up: top blue %g, bottom blue %g", top[2], bottom[2]);
+    free(img);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
                                     {"furnace_albedo_half", furnace_albedo_half},
@@ -148,6 +218,8 @@ int main(int argc, char **argv) {
                                     {"closed_sphere_emissive", closed_sphere_emissive},
                                     {"emission_front_side_only", emission_front_side_only},
                                     {"max_depth_direct_only", max_depth_direct_only},
+                                    {"furnace_constant_map", furnace_constant_map},
+                                    {"envmap_orientation", envmap_orientation},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

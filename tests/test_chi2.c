@@ -10,6 +10,7 @@
 #include "material/bsdf.h"
 #include "material/fresnel.h"
 #include "light/light.h"
+#include "light/envmap.h"
 #include "core/alias.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -20,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 22
+#define CHI2_TESTS 24
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -260,7 +261,7 @@ static int light_sf(void *c, sampler *s, vec3 *d) {
 }
 static double light_pf(void *c, vec3 d) {
   light_ctx *x = c;
-  if (x->l.type == LIGHT_ENV) return light_pdf_env(&x->l, d);
+  if (x->l.type == LIGHT_ENV) return light_pdf_env(x->s, &x->l, d);
   const uint32_t *ix = &x->s->idx[3 * x->l.tri];
   float v[9];
   for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &x->s->pos[ix[k]], sizeof(vec3));
@@ -284,6 +285,26 @@ static int light_sampling(void) {
   rc |= run_chi2("area light (triangle) from a close point", &c, light_sf, light_pf);
   c.l.type = LIGHT_ENV;
   rc |= run_chi2("constant environment", &c, light_sf, light_pf);
+  /* An equirectangular map with a bright spot, a dark hole and a gradient, upright and
+   * turned by 30 degrees. */
+  for (int rot = 0; rot < 2; rot++) {
+    int w = 64, h = 32;
+    float *px = malloc(sizeof(float) * w * h * 3);
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++)
+        for (int k = 0; k < 3; k++) {
+          float v = 0.2f + (float)x / w + (y < h / 2 ? 0.5f : 0.0f);
+          if (x >= 40 && x < 43 && y >= 10 && y < 12) v = 200;
+          if (x >= 8 && x < 20 && y >= 20 && y < 26) v = 0;
+          px[3 * (y * w + x) + k] = v * (k + 1) / 3.0f;
+        }
+    s->env_map = calloc(1, sizeof(envmap));
+    CHECK(envmap_init(s->env_map, w, h, px, 1.0f, rot ? 30.0f : 0.0f) == 0, "envmap init");
+    rc |= run_chi2(rot ? "environment map, rotated 30 deg" : "environment map", &c, light_sf, light_pf);
+    envmap_free(s->env_map);
+    free(s->env_map);
+    s->env_map = NULL;
+  }
   scene_free(s);
   return rc;
 }

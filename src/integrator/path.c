@@ -20,8 +20,8 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
       if (c->ls.env_index >= 0) {
         const light *env = &s->lights[c->ls.env_index];
         float w = 1;
-        if (!specular) w = power_heuristic(prev_pdf, light_select_pmf(c, (uint32_t)c->ls.env_index) * light_pdf_env(env, r.d));
-        L = c3_add(L, c3_scale(c3_mul(beta, env->L), w));
+        if (!specular) w = power_heuristic(prev_pdf, light_select_pmf(c, (uint32_t)c->ls.env_index) * light_pdf_env(s, env, r.d));
+        L = c3_add(L, c3_scale(c3_mul(beta, light_env_radiance(s, env, r.d)), w));
       }
       break;
     }

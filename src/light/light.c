@@ -2,6 +2,7 @@
  * power-proportional light selector (see light.h). */
 #include "light/light.h"
 #include "core/sampling.h"
+#include "light/envmap.h"
 #include <stdlib.h>
 
 float light_power(const scene *s, const light *l) {
@@ -81,7 +82,13 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     o->n_light = v3(0, 0, 0);
     return 1;
   case LIGHT_ENV:
-    o->wi = sample_uniform_sphere(u1, u2); o->dist = INFINITY; o->L = l->L; o->pdf = uniform_sphere_pdf();
+    if (s->env_map) {
+      if (!envmap_sample(s->env_map, u1, u2, &o->wi, &o->pdf)) return 0;
+      o->L = envmap_eval(s->env_map, o->wi);
+    } else {
+      o->wi = sample_uniform_sphere(u1, u2); o->L = l->L; o->pdf = uniform_sphere_pdf();
+    }
+    o->dist = INFINITY;
     o->p_light = v3_add(p, v3_scale(o->wi, 2 * s->radius));
     o->n_light = v3(0, 0, 0);
     return 1;
@@ -97,4 +104,8 @@ float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 pl, vec3 nl) {
   if (!(cos_l > 0) || !(d2 > 0)) return 0;
   return d2 / (cos_l * l->area);
 }
-float light_pdf_env(const light *l, vec3 wi) { (void)l; (void)wi; return uniform_sphere_pdf(); }
+float light_pdf_env(const scene *s, const light *l, vec3 wi) {
+  (void)l;
+  return s->env_map ? envmap_pdf(s->env_map, wi) : uniform_sphere_pdf();
+}
+rgb light_env_radiance(const scene *s, const light *l, vec3 wi) { return s->env_map ? envmap_eval(s->env_map, wi) : l->L; }

@@ -28,7 +28,9 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
 /* Solid-angle density with which light_sample picks direction wi from p to point
  * p_light with normal n_light on area light l (env: the direction alone). */
 float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 p_light, vec3 n_light);
-float light_pdf_env(const light *l, vec3 wi);
+float light_pdf_env(const scene *s, const light *l, vec3 wi);
+/* Radiance the environment sends along -wi (i.e. arriving from direction wi). */
+rgb light_env_radiance(const scene *s, const light *l, vec3 wi);
 /* Radiance an area light emits from its surface with normal ng towards direction w. */
 static inline rgb light_area_emitted(const light *l, vec3 ng, vec3 w) {
   float c = v3_dot(ng, w);

@@ -4,6 +4,7 @@
  * file and the JSON path; syntax errors give line:column. */
 #include "scene/scene.h"
 #include "core/error.h"
+#include "light/envmap.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <limits.h>
@@ -441,13 +442,31 @@ valo_status load_json(scene *s, const char *path, valo_error *err) {
   }
   const cJSON *env = cJSON_GetObjectItemCaseSensitive(root, "environment");
   if (env) {
-    static const char *const ek[] = {"type", "radiance", NULL};
-    TRY(check_keys(&c, env, "environment", ek));
     const char *type = "constant";
     TRY(get_str(&c, env, "type", "environment", &type));
-    if (strcmp(type, "constant")) { st = bad(&c, "environment.type", "unknown environment type (constant)"); goto done; }
-    s->env_radiance = c3(1, 1, 1);
-    TRY(get_rgb(&c, env, "radiance", "environment", &s->env_radiance));
+    if (!strcmp(type, "constant")) {
+      static const char *const ek[] = {"type", "radiance", NULL};
+      TRY(check_keys(&c, env, "environment", ek));
+      s->env_radiance = c3(1, 1, 1);
+      TRY(get_rgb(&c, env, "radiance", "environment", &s->env_radiance));
+    } else if (!strcmp(type, "map")) {
+      static const char *const ek[] = {"type", "file", "scale", "rotation", NULL};
+      TRY(check_keys(&c, env, "environment", ek));
+      const char *file = NULL;
+      double scale = 1, rot = 0;
+      TRY(get_str(&c, env, "file", "environment", &file));
+      if (!file) { st = bad(&c, "environment", "a map needs \"file\" (an equirectangular .exr, .hdr or .pfm)"); goto done; }
+      TRY(get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
+      TRY(get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
+      char full[2048];
+      resolve_path(&c, file, full, sizeof full);
+      s->env_map = calloc(1, sizeof *s->env_map);
+      if (!s->env_map) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      TRY(envmap_load(s->env_map, full, (float)scale, (float)rot, err));
+    } else {
+      st = bad(&c, "environment.type", "unknown environment type (constant, map)");
+      goto done;
+    }
     s->has_env = 1;
   }
 done:

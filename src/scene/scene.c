@@ -2,6 +2,7 @@
  * automatic camera framing), tessellated spheres and conductor presets. */
 #include "scene/scene.h"
 #include "core/error.h"
+#include "light/envmap.h"
 #include <stdlib.h>
 #include <string.h>
 #include <stdio.h>
@@ -18,6 +19,7 @@ void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light);
+  if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
   free(s);
 }
 
@@ -113,7 +115,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
     light l;
     memset(&l, 0, sizeof l);
     l.type = LIGHT_ENV;
-    l.L = s->env_radiance;
+    l.L = s->env_map ? s->env_map->average : s->env_radiance;
     if (!c3_black(l.L) && scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   }
   if (!s->has_camera) {

@@ -65,6 +65,7 @@ typedef struct scene {
   int32_t *tri_light;      /* per triangle: its area light or -1 (after commit) */
   rgb env_radiance;        /* constant environment */
   int has_env;
+  struct envmap *env_map;  /* equirectangular map (owned), or NULL for constant */
   camera cam;
   int has_camera;
   valo_options file_opts;

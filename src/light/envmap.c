@@ -1,0 +1,113 @@
+/* envmap.c — see envmap.h. */
+#include "light/envmap.h"
+#include "image/image_io.h"
+#include "core/error.h"
+#include <stdlib.h>
+#include <string.h>
+
+static vec3 to_map(const envmap *e, vec3 d) { /* world -> map frame: rotate by -rotation about y */
+  return v3(e->rot_cos * d.x - e->rot_sin * d.z, d.y, e->rot_sin * d.x + e->rot_cos * d.z);
+}
+static vec3 from_map(const envmap *e, vec3 d) {
+  return v3(e->rot_cos * d.x + e->rot_sin * d.z, d.y, -e->rot_sin * d.x + e->rot_cos * d.z);
+}
+static void dir_to_uv(vec3 d, float *u, float *v) {
+  float phi = atan2f(d.x, -d.z);
+  *u = 0.5f + phi * (0.5f * INV_PI_F);
+  *v = acosf(clampf(d.y, -1, 1)) * INV_PI_F;
+  if (*u >= 1) *u -= 1;
+  if (*u < 0) *u += 1;
+}
+static vec3 uv_to_dir(float u, float v) {
+  float phi = (u - 0.5f) * 2 * PI_F, th = v * PI_F;
+  float st = sinf(th);
+  return v3(st * sinf(phi), cosf(th), -st * cosf(phi));
+}
+
+static rgb texel(const envmap *e, int x, int y) {
+  x %= e->w;
+  if (x < 0) x += e->w;
+  y = y < 0 ? 0 : (y >= e->h ? e->h - 1 : y);
+  const float *p = &e->rgb[3 * ((size_t)y * e->w + x)];
+  return c3(p[0], p[1], p[2]);
+}
+
+static rgb lookup(const envmap *e, float u, float v) {
+  float x = u * e->w - 0.5f, y = v * e->h - 0.5f;
+  int x0 = (int)floorf(x), y0 = (int)floorf(y);
+  float fx = x - x0, fy = y - y0;
+  rgb a = texel(e, x0, y0), b = texel(e, x0 + 1, y0), c = texel(e, x0, y0 + 1), d = texel(e, x0 + 1, y0 + 1);
+  rgb top = c3_add(c3_scale(a, 1 - fx), c3_scale(b, fx)), bot = c3_add(c3_scale(c, 1 - fx), c3_scale(d, fx));
+  return c3_add(c3_scale(top, 1 - fy), c3_scale(bot, fy));
+}
+
+int envmap_init(envmap *e, int w, int h, float *px, float scale, float rotation_deg) {
+  memset(e, 0, sizeof *e);
+  e->w = w; e->h = h; e->rgb = px; e->scale = scale;
+  float r = rotation_deg * PI_F / 180;
+  e->rot_cos = cosf(r); e->rot_sin = sinf(r);
+  for (size_t i = 0; i < (size_t)w * h * 3; i++)
+    if (!(px[i] >= 0) || !isfinite(px[i])) px[i] = 0; /* negative/NaN texels carry no light */
+  float *wgt = malloc((size_t)w * h * sizeof(float));
+  if (!wgt) return -1;
+  double sum_w = 0, avg[3] = {0, 0, 0}, solid = 0;
+  for (int y = 0; y < h; y++) {
+    float st = sinf(PI_F * (y + 0.5f) / h);
+    for (int x = 0; x < w; x++) {
+      float m = 0;
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) { float l = c3_max(texel(e, x + dx, y + dy)); if (l > m) m = l; }
+      wgt[(size_t)y * w + x] = m * st;
+      sum_w += m * st;
+      rgb t = texel(e, x, y);
+      avg[0] += t.r * st; avg[1] += t.g * st; avg[2] += t.b * st;
+      solid += st;
+    }
+  }
+  /* A small floor keeps every direction reachable (robust to tiny bilinear tails). */
+  float floor_w = (float)(sum_w / ((double)w * h) * 1e-3 + 1e-12);
+  for (size_t i = 0; i < (size_t)w * h; i++) wgt[i] += floor_w * sinf(PI_F * ((float)(i / (size_t)w) + 0.5f) / h);
+  int rc = distrib2d_init(&e->dist, wgt, (uint32_t)w, (uint32_t)h);
+  free(wgt);
+  e->average = solid > 0 ? c3((float)(avg[0] / solid) * scale, (float)(avg[1] / solid) * scale, (float)(avg[2] / solid) * scale) : c3(0, 0, 0);
+  return rc;
+}
+
+valo_status envmap_load(envmap *e, const char *path, float scale, float rotation_deg, valo_error *err) {
+  image im;
+  valo_status st = image_read(path, &im, err);
+  if (st) return st;
+  if (im.w < 2 || im.h < 1) { image_free(&im); return err_set(err, VALO_ERR_INVALID, "%s: environment map too small", path); }
+  if (envmap_init(e, im.w, im.h, im.rgb, scale, rotation_deg)) { envmap_free(e); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  return VALO_OK;
+}
+
+void envmap_free(envmap *e) {
+  free(e->rgb);
+  e->rgb = NULL;
+  distrib2d_free(&e->dist);
+}
+
+rgb envmap_eval(const envmap *e, vec3 dir) {
+  float u, v;
+  dir_to_uv(to_map(e, dir), &u, &v);
+  return c3_scale(lookup(e, u, v), e->scale);
+}
+
+int envmap_sample(const envmap *e, float u1, float u2, vec3 *dir, float *pdf) {
+  float u, v, puv;
+  distrib2d_sample(&e->dist, u1, u2, &u, &v, &puv);
+  float st = sinf(v * PI_F);
+  if (!(st > 0) || !(puv > 0)) return 0;
+  *dir = from_map(e, uv_to_dir(u, v));
+  *pdf = puv / (2 * PI_F * PI_F * st);
+  return 1;
+}
+
+float envmap_pdf(const envmap *e, vec3 dir) {
+  float u, v;
+  dir_to_uv(to_map(e, dir), &u, &v);
+  float st = sinf(v * PI_F);
+  if (!(st > 0)) return 0;
+  return distrib2d_pdf(&e->dist, u, v) / (2 * PI_F * PI_F * st);
+}

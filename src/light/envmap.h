@@ -1,0 +1,31 @@
+/* envmap.h — owns equirectangular environment maps as lights: bilinear radiance lookup,
+ * importance sampling by a 2D piecewise-constant distribution over the image (weights:
+ * the largest luminance in each texel's bilinear footprint times sin(theta), so the
+ * density is non-zero wherever the looked-up radiance is), and the matching solid-angle
+ * density pdf(w) = pdf(u,v) / (2 pi^2 sin theta) (pbrt-v3 §14.2.4).
+ * Convention: y is up; direction -z maps to the image centre (u = 0.5); the top row is
+ * straight up. `rotation` turns the map about +y (degrees). */
+#ifndef VALO_ENVMAP_H
+#define VALO_ENVMAP_H
+#include "core/vec.h"
+#include "core/distrib.h"
+#include "valo/valo.h"
+
+typedef struct envmap {
+  int w, h;
+  float *rgb;        /* w*h*3, linear */
+  float scale;
+  float rot_cos, rot_sin;
+  distrib2d dist;
+  rgb average;       /* mean radiance over the sphere (for light selection) */
+} envmap;
+
+/* Takes ownership of rgb (w*h*3 floats). */
+int envmap_init(envmap *e, int w, int h, float *rgb, float scale, float rotation_deg);
+valo_status envmap_load(envmap *e, const char *path, float scale, float rotation_deg, valo_error *err);
+void envmap_free(envmap *e);
+rgb envmap_eval(const envmap *e, vec3 dir);
+/* Samples a unit direction; returns 0 if the density there is zero. */
+int envmap_sample(const envmap *e, float u1, float u2, vec3 *dir, float *pdf);
+float envmap_pdf(const envmap *e, vec3 dir);
+#endif
