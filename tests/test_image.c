@@ -119,9 +119,28 @@ static int real_exr_files(void) {
   return 0;
 }
 
+/* Bloom spreads only what exceeds the threshold, by a normalised Gaussian: a single
+ * pixel of 101 on black adds 100 x strength in total, symmetrically, and leaves pixels
+ * below the threshold alone when nothing bright is near. */
+static int bloom(void) {
+  int w = 41, h = 41;
+  float *px = calloc((size_t)w * h * 3, sizeof(float));
+  for (int c = 0; c < 3; c++) px[3 * (20 * w + 20) + c] = 101;
+  px[3 * (0 * w + 0)] = 0.5f; /* far corner, below threshold */
+  CHECK(bloom_apply(w, h, px, 1.0f, 0.1f, 2.0f) == 0, "bloom failed");
+  double added = 0;
+  for (int i = 0; i < w * h; i++) added += px[3 * i + 1];
+  added -= 101;
+  CHECK(fabs(added - 10.0) < 1e-3, "bloom added %g, expected 10", added);
+  CHECK(px[3 * (20 * w + 22) + 1] > 0 && fabsf(px[3 * (20 * w + 22) + 1] - px[3 * (22 * w + 20) + 1]) < 1e-6f, "not symmetric");
+  CHECK(px[0] == 0.5f, "a pixel far from bright ones changed: %g", px[0]);
+  free(px);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"exr_roundtrip", exr_roundtrip}, {"pfm_roundtrip", pfm_roundtrip}, {"srgb_png", srgb_png},
-                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files},
+                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files}, {"bloom", bloom},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

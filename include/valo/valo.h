@@ -105,6 +105,9 @@ typedef struct valo_output_options {
   float exposure;         /* stops; 0 by default */
   char tonemap[16];       /* "clamp" (default), "log" (natural logarithm, as the thesis),
                              "reinhard" or "aces" (filmic) */
+  float bloom;            /* bloom strength; 0 (default) = off */
+  float bloom_radius;     /* Gaussian std. dev. in pixels (default 1/100 of the width) */
+  float bloom_threshold;  /* radiance above which pixels bloom (default 1, after exposure) */
 } valo_output_options;
 VALO_API void valo_output_options_init(valo_output_options *o);
 

@@ -59,6 +59,8 @@ static void usage_render(FILE *f) {
           "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
           "  --exposure STOPS       PNG exposure (default 0)\n"
           "  --tonemap NAME         PNG tone curve: clamp (default), log, reinhard, aces\n"
+          "  --bloom STRENGTH       PNG bloom: add STRENGTH x a Gaussian blur of what exceeds 1\n"
+          "  --bloom-radius PIXELS  bloom blur standard deviation (default 1/100 of the width)\n"
           "  -q, --quiet            no progress or summary\n"
           "  -h, --help             this text\n");
 }
@@ -186,6 +188,14 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_double(val, -100, 100, &dv)) BAD_VALUE("stops, -100..100");
       oo.exposure = (float)dv;
+    } else if (!strcmp(a, "--bloom")) {
+      NEED_VALUE();
+      if (parse_double(val, 0, 100, &dv)) BAD_VALUE("0..100");
+      oo.bloom = (float)dv;
+    } else if (!strcmp(a, "--bloom-radius")) {
+      NEED_VALUE();
+      if (parse_double(val, 0.1, 500, &dv)) BAD_VALUE("pixels, 0.1..500");
+      oo.bloom_radius = (float)dv;
     } else if (!strcmp(a, "--tonemap")) {
       NEED_VALUE();
       if (strcmp(val, "clamp") && strcmp(val, "log") && strcmp(val, "reinhard") && strcmp(val, "aces")) BAD_VALUE("clamp, log, reinhard or aces");

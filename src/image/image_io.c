@@ -120,8 +120,26 @@ valo_status image_write(const char *path, int w, int h, const float *px, const v
   else if (kind == 1) st = write_pfm(tmp, w, h, px);
   else {
     unsigned char *bytes = malloc((size_t)w * h * 3);
-    if (!bytes) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-    image_to_srgb8(w, h, px, o, bytes);
+    float *disp = NULL;
+    if (o && o->bloom > 0) { /* bloom works on the display copy; linear files stay untouched */
+      disp = malloc((size_t)w * h * 3 * sizeof(float));
+      if (disp) {
+        float ex = exp2f(o->exposure);
+        for (size_t i = 0; i < (size_t)w * h * 3; i++) disp[i] = px[i] * ex;
+        float radius = o->bloom_radius > 0 ? o->bloom_radius : 0.01f * (float)w;
+        if (bloom_apply(w, h, disp, o->bloom_threshold, o->bloom, radius)) { free(disp); disp = NULL; }
+      }
+      if (!disp) { free(bytes); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+    }
+    if (!bytes) { free(disp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+    if (disp) {
+      valo_output_options o2 = *o;
+      o2.exposure = 0; /* already applied */
+      image_to_srgb8(w, h, disp, &o2, bytes);
+      free(disp);
+    } else {
+      image_to_srgb8(w, h, px, o, bytes);
+    }
     st = stbi_write_png(tmp, w, h, 3, bytes, w * 3) ? VALO_OK : VALO_ERR_IO;
     free(bytes);
   }

@@ -62,6 +62,7 @@ VALO_API void valo_options_init(valo_options *o) {
 VALO_API void valo_output_options_init(valo_output_options *o) {
   memset(o, 0, sizeof *o);
   snprintf(o->tonemap, sizeof o->tonemap, "clamp");
+  o->bloom_threshold = 1;
 }
 
 static int ends_with(const char *s, const char *suf) {
