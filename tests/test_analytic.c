@@ -211,6 +211,52 @@ static int envmap_orientation(void) {
   return 0;
 }
 
+/* AOVs of a plane facing the camera: albedo = its reflectance, normal = +z (towards the
+ * camera, though the plane's winding faces away), depth = distance along each ray. */
+static int aovs(void) {
+  CHECK(scratch_file("plane.obj", "v -5 -5 0\nv -5 5 0\nv 5 5 0\nv 5 -5 0\nf 1 2 3 4\n"), "write");
+  const char *path = scratch_file("aov.json",
+      "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 30},\n"
+      "  \"film\": {\"width\": 9, \"height\": 9}, \"render\": {\"spp\": 8},\n"
+      "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": [0.2,0.4,0.6]}},\n"
+      "  \"shapes\": [{\"file\": \"plane.obj\", \"material\": \"m\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0,0,2], \"intensity\": 1}] }\n");
+  valo_options o;
+  valo_options_init(&o);
+  o.aovs = 1;
+  valo_error err;
+  valo_scene *sc;
+  valo_render *r;
+  CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  const char *names[3] = {"albedo", "normal", "depth"};
+  image im[3];
+  for (int k = 0; k < 3; k++) {
+    char out[1200], file[1200];
+    snprintf(file, sizeof file, "%s/%s.pfm", scratch_dir(), names[k]);
+    snprintf(out, sizeof out, "%s:%s", names[k], file);
+    CHECK(valo_render_write(r, out, NULL, &err) == VALO_OK, "%s", err.message);
+    CHECK(image_read(file, &im[k], &err) == VALO_OK, "%s", err.message);
+  }
+  const float *a = &im[0].rgb[3 * (4 * 9 + 4)], *n = &im[1].rgb[3 * (4 * 9 + 4)], *d = &im[2].rgb[3 * (4 * 9 + 4)];
+  CHECK(fabsf(a[0] - 0.2f) < 1e-5f && fabsf(a[1] - 0.4f) < 1e-5f && fabsf(a[2] - 0.6f) < 1e-5f, "albedo (%g %g %g)", a[0], a[1], a[2]);
+  CHECK(fabsf(n[2] - 1) < 1e-5f, "normal (%g %g %g)", n[0], n[1], n[2]);
+  CHECK(fabsf(d[0] - 3) < 0.01f, "centre depth %g, expected 3 (within the pixel's jitter)", d[0]);
+  const float *dc = &im[2].rgb[0];
+  float tanh = tanf(15.0f * 3.14159265f / 180) * (1 - 1.0f / 9); /* corner pixel centre */
+  float expect = 3 * sqrtf(1 + 2 * tanh * tanh);
+  CHECK(fabsf(dc[0] - expect) < 0.05f, "corner depth %g, expected about %g", dc[0], expect);
+  for (int k = 0; k < 3; k++) image_free(&im[k]);
+  /* Without aovs set, asking for one is a clear error. */
+  valo_render_destroy(r);
+  CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_write(r, "albedo:x.exr", NULL, &err) == VALO_ERR_INVALID, "AOV without aovs accepted");
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
                                     {"furnace_albedo_half", furnace_albedo_half},
@@ -220,6 +266,7 @@ int main(int argc, char **argv) {
                                     {"max_depth_direct_only", max_depth_direct_only},
                                     {"furnace_constant_map", furnace_constant_map},
                                     {"envmap_orientation", envmap_orientation},
+                                    {"aovs", aovs},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -55,6 +55,8 @@ typedef struct valo_options {
                              VALO_DEPTH_UNSET when not given */
   char integrator[32];    /* "path" (default) */
   char accel[16];         /* "kdtree" (default) or "embree" */
+  int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
+                             valo_render_write can then write; VALO_UNSET = no */
 } valo_options;
 
 /* Sets every field of `o` to "unset". */
@@ -113,7 +115,10 @@ VALO_API void valo_output_options_init(valo_output_options *o);
 
 /* Writes the film; the format follows the extension: .exr (linear float, OpenEXRCore),
  * .pfm (linear float), .png (8-bit sRGB). Written to a temporary file in the same folder
- * and renamed, so a reader never sees a partial file. */
+ * and renamed, so a reader never sees a partial file. A prefix "albedo:", "normal:" or
+ * "depth:" writes that AOV instead (the render must have been created with aovs set):
+ * the first camera hit's albedo, its shading normal (world space, facing the camera)
+ * and its distance from the camera (0 where the ray escaped), averaged over samples. */
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
                                        const valo_output_options *o, valo_error *err);
 /* Copies the linear RGB film (width*height*3 floats, row-major, top row first). */

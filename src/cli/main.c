@@ -44,7 +44,8 @@ static void usage_render(FILE *f) {
           "(OBJ/MTL, glTF 2.0, PLY, ...; its camera is used, or the view is framed automatically).\n"
           "Options override the scene file:\n"
           "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
-          "                         repeat for several outputs (default: SCENE-NAME.png)\n"
+          "                         repeat for several outputs (default: SCENE-NAME.png);\n"
+          "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs\n"
           "  --spp N                samples per pixel (default 16)\n"
           "  --time SECONDS         time budget: stop after the pass that reaches it\n"
           "                         (with --spp, whichever comes first)\n"
@@ -217,6 +218,7 @@ static int cmd_render(int argc, char **argv) {
     outputs[nout++] = default_out;
   }
   for (int i = 0; i < nout; i++) {
+    if (!strncmp(outputs[i], "albedo:", 7) || !strncmp(outputs[i], "normal:", 7) || !strncmp(outputs[i], "depth:", 6)) opt.aovs = 1;
     const char *dot = strrchr(outputs[i], '.');
     if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
       fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);

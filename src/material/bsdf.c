@@ -127,3 +127,13 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   }
   return 0;
 }
+
+rgb material_albedo(const material *m, float cos_o) {
+  switch (m->type) {
+  case MAT_DIFFUSE: return m->kd;
+  case MAT_PHONG: case MAT_MIRROR: return c3_add(m->kd, m->ks);
+  case MAT_DIELECTRIC: return c3(1, 1, 1);
+  case MAT_CONDUCTOR: return fresnel_conductor(fabsf(cos_o), m->eta, m->k);
+  }
+  return c3(0, 0, 0);
+}

@@ -36,6 +36,9 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi);
 int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s);
 /* 1 if the BSDF has any non-delta lobe (so light sampling can help). */
 int bsdf_has_smooth(const bsdf *b);
+/* The colour a denoiser calls albedo: kd + ks for opaque models, the Fresnel
+ * reflectance at cos_o for conductors, white for glass. */
+rgb material_albedo(const material *m, float cos_o);
 /* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
 static inline int bsdf_transmits(const bsdf *b) { return b->type == BSDF_DIELECTRIC; }
 #endif

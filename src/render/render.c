@@ -34,6 +34,7 @@ struct valo_render {
   const integrator_ops *integ;
   accel *acc;
   double *sum;            /* 3 doubles per pixel */
+  float *aov;             /* 7 floats per pixel (albedo rgb, normal xyz, depth) summed, or NULL */
   int spp_done;
   double build_seconds, render_seconds;
   uint64_t rays, bad_samples;
@@ -56,6 +57,7 @@ VALO_API void valo_options_init(valo_options *o) {
   o->width = o->height = o->spp = o->threads = o->max_depth = VALO_UNSET;
   o->time_budget = VALO_UNSET;
   o->seed = VALO_UNSET;
+  o->aovs = VALO_UNSET;
   o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
 }
 
@@ -108,12 +110,14 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->max_depth != VALO_DEPTH_UNSET) dst->max_depth = o->max_depth;
     if (o->integrator[0]) memcpy(dst->integrator, o->integrator, sizeof dst->integrator);
     if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
+    if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
   }
   if (dst->width == VALO_UNSET) dst->width = 256;
   if (dst->height == VALO_UNSET) dst->height = 256;
   if (dst->spp == VALO_UNSET) dst->spp = 16;
   if (dst->threads == VALO_UNSET || dst->threads == 0) dst->threads = threads_available();
   if (dst->seed == VALO_UNSET) dst->seed = 1;
+  if (dst->aovs == VALO_UNSET) dst->aovs = 0;
   if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
@@ -146,10 +150,11 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->integ = integ;
   atomic_init(&r->cancel, 0);
   r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
-  if (!r->sum) { free(r); return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height); }
+  if (o.aovs) r->aov = calloc((size_t)o.width * o.height * 7, sizeof(float));
+  if (!r->sum || (o.aovs && !r->aov)) { free(r->sum); free(r->aov); free(r); return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height); }
   double t0 = now_seconds();
   valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, &r->acc, err);
-  if (st) { free(r->sum); free(r); return st; }
+  if (st) { free(r->sum); free(r->aov); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
   if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   r->ctx.s = s;
@@ -196,6 +201,19 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   return ry;
 }
 
+/* AOVs of one camera ray: albedo, shading normal facing the ray, hit distance. */
+static void record_aovs(const valo_render *r, ray ry, float *acc, thread_stats *ts) {
+  hit h;
+  if (!ctx_intersect(&r->ctx, &ry, &h, ts)) return;
+  isect it;
+  isect_from_hit(r->s, &ry, &h, &it);
+  rgb a = material_albedo(it.m, v3_dot(it.ns, v3_neg(ry.d)));
+  vec3 n = v3_faceforward(it.ns, v3_neg(ry.d));
+  acc[0] += a.r; acc[1] += a.g; acc[2] += a.b;
+  acc[3] += n.x; acc[4] += n.y; acc[5] += n.z;
+  acc[6] += h.t * v3_len(ry.d);
+}
+
 typedef struct pass_job {
   valo_render *r;
   int s0, s1;          /* sample indices [s0, s1) */
@@ -220,6 +238,7 @@ static void render_tile(void *user, int64_t item, int thread) {
         sampler smp = sampler_make((uint64_t)r->opt.seed, pix, (uint64_t)si);
         ray ry = camera_ray(r, x, y, &smp);
         ts->rays++;
+        if (r->aov) record_aovs(r, ry, &r->aov[7 * pix], ts);
         rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
         if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
         acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
@@ -248,6 +267,7 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     if (atomic_load(&r->cancel)) {
       /* A cancelled pass is partial: the film keeps whole passes only. */
       memset(r->sum, 0, (size_t)r->opt.width * r->opt.height * 3 * sizeof(double));
+      if (r->aov) memset(r->aov, 0, (size_t)r->opt.width * r->opt.height * 7 * sizeof(float));
       r->spp_done = 0;
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled");
       break;
@@ -294,6 +314,23 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
   valo_output_options def;
   valo_output_options_init(&def);
   if (!o) o = &def;
+  static const char *const aov_names[3] = {"albedo:", "normal:", "depth:"};
+  for (int k = 0; k < 3; k++) {
+    size_t n = strlen(aov_names[k]);
+    if (strncmp(path, aov_names[k], n)) continue;
+    if (!r->aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", path);
+    size_t np = (size_t)r->opt.width * r->opt.height;
+    float *px = malloc(np * 3 * sizeof(float));
+    if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    float inv = r->spp_done > 0 ? 1.0f / (float)r->spp_done : 0;
+    for (size_t i = 0; i < np; i++)
+      for (int c = 0; c < 3; c++) px[3 * i + c] = (k == 2 ? r->aov[7 * i + 6] : r->aov[7 * i + 3 * k + c]) * inv;
+    valo_output_options raw = *o;
+    raw.bloom = 0;
+    valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, &raw, err);
+    free(px);
+    return st;
+  }
   tonemap_kind tk;
   if (tonemap_parse(o->tonemap, &tk)) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp, log, reinhard, aces)", o->tonemap);
   float *px = malloc((size_t)r->opt.width * r->opt.height * 3 * sizeof(float));
@@ -309,5 +346,6 @@ VALO_API void valo_render_destroy(valo_render *r) {
   accel_destroy(r->acc);
   light_sampler_free(&r->ctx.ls);
   free(r->sum);
+  free(r->aov);
   free(r);
 }
