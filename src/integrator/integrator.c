@@ -4,9 +4,9 @@
 #include "core/sampling.h"
 #include <string.h>
 
-extern const integrator_ops integrator_path;
-static const integrator_ops *const registry[] = {&integrator_path, NULL};
-static const char *const names[] = {"path", NULL};
+extern const integrator_ops integrator_path, integrator_whitted, integrator_distribution;
+static const integrator_ops *const registry[] = {&integrator_path, &integrator_whitted, &integrator_distribution, NULL};
+static const char *const names[] = {"path", "whitted", "distribution", NULL};
 
 const integrator_ops *integrator_find(const char *name) {
   for (int i = 0; registry[i]; i++)
@@ -50,8 +50,8 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return accel_occluded(c->acc, &r);
 }
 
-rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                    thread_stats *ts) {
+static rgb direct_impl(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                       thread_stats *ts, int mis) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
   if (c->ls.table.n == 0) return c3(0, 0, 0);
@@ -69,6 +69,35 @@ rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const f
   f = c3_scale(f, fabsf(wi_l.z));
   if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return c3(0, 0, 0);
   float light_pdf = pmf * ls.pdf;
-  float w = ls.delta ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
+  float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
   return c3_scale(c3_mul(f, ls.L), w / light_pdf);
+}
+
+rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                    thread_stats *ts) {
+  return direct_impl(c, it, b, fr, wo, smp, ts, 1);
+}
+rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                          thread_stats *ts) {
+  return direct_impl(c, it, b, fr, wo, smp, ts, 0);
+}
+
+rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, const isect *it) {
+  const scene *s = c->s;
+  if (!found) {
+    if (c->ls.env_index < 0) return c3(0, 0, 0);
+    return light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
+  }
+  int32_t lid = s->tri_light[h->tri];
+  if (lid < 0) return c3(0, 0, 0);
+  return light_area_emitted(&s->lights[lid], it->ng, v3_neg(r->d));
+}
+
+frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
+  vec3 ns = it->ns;
+  if (!bsdf_transmits(b)) {
+    if (v3_dot(it->ng, wo) < 0) it->ng = v3_neg(it->ng);
+    if (v3_dot(ns, wo) < 0) ns = v3_neg(ns);
+  }
+  return frame_from_n(ns);
 }

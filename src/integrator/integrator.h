@@ -63,6 +63,16 @@ static inline ray spawn_ray(const isect *it, vec3 d) {
  * (already faced for opaque BSDFs). */
 rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                     thread_stats *ts);
+/* The same estimate with weight 1 (light sampling alone): for integrators that never
+ * count emission found by BSDF-sampled rays at non-specular vertices. */
+rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                          thread_stats *ts);
+/* Emission arriving along r when it hits (or escapes to) a light: the area light's
+ * radiance for hit h (if found), else the environment's. */
+rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, const isect *it);
+/* Shading frame at it for viewer direction wo, faced for opaque BSDFs (geometric normal
+ * too); returns the frame and updates it->ng. */
+frame shading_frame(isect *it, const bsdf *b, vec3 wo);
 /* Probability that estimate_direct picks light index li. */
 static inline float light_select_pmf(const render_ctx *c, uint32_t li) {
   return c->ls.table.n ? alias_pmf(&c->ls.table, li) : 0;

@@ -1,0 +1,93 @@
+/* test_integrators.c — where the classic integrators agree with `path` and where they
+ * are documented to differ (docs/integrators.md):
+ *  - whitted == path on a scene whose only light paths are point light -> one diffuse
+ *    surface -> an ideal mirror -> camera;
+ *  - whitted is darker than path in a closed box (no interreflection);
+ *  - distribution == path at the same fixed max_depth (both unbiased for the truncated
+ *    transport), and darker than unlimited path. */
+#include "harness.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef VALO_SOURCE_DIR
+#define VALO_SOURCE_DIR "."
+#endif
+
+static double mean_of(const char *json, const char *integrator, int spp, int max_depth) {
+  valo_options o;
+  valo_options_init(&o);
+  snprintf(o.integrator, sizeof o.integrator, "%s", integrator);
+  o.spp = spp;
+  if (max_depth != VALO_DEPTH_UNSET) o.max_depth = max_depth;
+  int w, h;
+  float *px = render_json_text(json, &o, &w, &h);
+  if (!px) return -1;
+  double s = 0;
+  for (int i = 0; i < w * h * 3; i++) {
+    if (!isfinite(px[i]) || px[i] < 0) { free(px); return -1; }
+    s += px[i];
+  }
+  free(px);
+  return s / (w * h * 3);
+}
+
+static int whitted_equals_path_mirror(void) {
+  /* Camera looks straight down at a mirror tilted 45 degrees; the mirror shows a
+   * diffuse wall lit by a point light; everything else is black. Light leaving the wall
+   * towards the mirror goes up into the void, so no other paths exist. */
+  CHECK(scratch_file("mirror.obj", "v -1 -0.7071 0.7071\nv 1 -0.7071 0.7071\nv 1 0.7071 -0.7071\nv -1 0.7071 -0.7071\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("wall.obj", "v -3 -1 5\nv -3 0.5 5\nv 3 0.5 5\nv 3 -1 5\nf 1 2 3 4\n"), "write");
+  const char *json =
+      "{ \"camera\": {\"position\": [0,3,0], \"look_at\": [0,0,0], \"up\": [0,0,-1], \"fov\": 25},\n"
+      "  \"film\": {\"width\": 24, \"height\": 24}, \"render\": {\"seed\": 3},\n"
+      "  \"materials\": {\"mirror\": {\"type\": \"mirror\", \"reflectance\": 0.9},\n"
+      "                \"wall\": {\"type\": \"diffuse\", \"reflectance\": [0.8,0.5,0.3]}},\n"
+      "  \"shapes\": [{\"file\": \"mirror.obj\", \"material\": \"mirror\"}, {\"file\": \"wall.obj\", \"material\": \"wall\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0,0.2,3], \"intensity\": 10}] }\n";
+  double w = mean_of(json, "whitted", 64, VALO_DEPTH_UNSET), p = mean_of(json, "path", 512, VALO_DEPTH_UNSET);
+  double d = mean_of(json, "distribution", 32, VALO_DEPTH_UNSET);
+  fprintf(stderr, "mirror scene mean: whitted %.5f, path %.5f, distribution %.5f\n", w, p, d);
+  CHECK(w > 0.01, "the wall is not visible in the mirror (mean %g)", w);
+  CHECK(fabs(w - p) < 0.01 * p, "whitted %g vs path %g", w, p);
+  CHECK(fabs(d - p) < 0.01 * p, "distribution %g vs path %g", d, p);
+  return 0;
+}
+
+static char box_json[4096];
+static const char *box_scene(void) {
+  snprintf(box_json, sizeof box_json,
+           "{ \"camera\": {\"position\": [0,1,3.6], \"look_at\": [0,0.95,0], \"fov\": 40},\n"
+           "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"seed\": 4},\n"
+           "  \"materials\": {\"plastic\": {\"type\": \"phong\", \"diffuse\": [0.3,0.3,0.5], \"specular\": 0.2, \"exponent\": 20}},\n"
+           "  \"shapes\": [{\"file\": \"%s/scenes/cornell-box.obj\"},\n"
+           "             {\"type\": \"sphere\", \"center\": [0.2,0.35,0], \"radius\": 0.35, \"subdivisions\": 3, \"material\": \"plastic\"}] }\n",
+           VALO_SOURCE_DIR);
+  return box_json;
+}
+
+static int whitted_darker_in_box(void) {
+  double w = mean_of(box_scene(), "whitted", 16, VALO_DEPTH_UNSET), p = mean_of(box_scene(), "path", 64, VALO_DEPTH_UNSET);
+  fprintf(stderr, "box mean: whitted %.5f, path %.5f\n", w, p);
+  CHECK(w > 0 && p > 0, "render failed");
+  /* Interreflection carries about a fifth of this box's light: whitted must miss it. */
+  CHECK(w < 0.9 * p, "whitted (%g) should miss the interreflected light of path (%g)", w, p);
+  return 0;
+}
+
+static int distribution_equals_path_at_depth(void) {
+  double d = mean_of(box_scene(), "distribution", 32, 2), p = mean_of(box_scene(), "path", 1024, 2);
+  double pu = mean_of(box_scene(), "path", 256, -1);
+  fprintf(stderr, "box mean at max_depth 2: distribution %.5f, path %.5f; unlimited path %.5f\n", d, p, pu);
+  CHECK(fabs(d - p) < 0.01 * p, "distribution %g vs path %g at max_depth 2", d, p);
+  CHECK(d < 0.95 * pu, "depth-2 distribution (%g) should be darker than unlimited path (%g)", d, pu);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"whitted_equals_path_mirror", whitted_equals_path_mirror},
+                                    {"whitted_darker_in_box", whitted_darker_in_box},
+                                    {"distribution_equals_path_at_depth", distribution_equals_path_at_depth},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
