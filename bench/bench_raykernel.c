@@ -117,7 +117,7 @@ static void bench_scene(const char *name, scene *s) {
   const char *kinds[2] = {"kdtree", "embree"};
   for (int k = 0; k < 2; k++) {
     double t0 = now();
-    if (accel_create(kinds[k], s->pos, s->idx, s->ntris, 2, &acc[k], &err)) { fprintf(stderr, "%s\n", err.message); acc[k] = NULL; }
+    if (accel_create(kinds[k], s->pos, s->idx, s->ntris, 2, NULL, &acc[k], &err)) { fprintf(stderr, "%s\n", err.message); acc[k] = NULL; }
     build[k] = now() - t0;
   }
   if (!acc[0] || !acc[1]) { accel_destroy(acc[0]); accel_destroy(acc[1]); return; }
@@ -174,7 +174,7 @@ int main(int argc, char **argv) {
     if (load(s, res[i], NULL) == 0 && scene_commit(s, &err) == 0) {
       accel *a;
       double t0 = now();
-      if (kdtree_create(s->pos, s->idx, s->ntris, &a, &err) == 0) {
+      if (kdtree_create(s->pos, s->idx, s->ntris, NULL, &a, &err) == 0) {
         double dt = now() - t0;
         kd_stats st;
         kdtree_stats(a, &st);

@@ -278,6 +278,9 @@ static int light_sampling(void) {
   s->nverts = 3;
   s->idx[0] = 0; s->idx[1] = 1; s->idx[2] = 2;
   s->tri_mat[0] = 0; s->tri_flags[0] = 0; s->ntris = 1;
+  material m = material_default();
+  m.emission = c3(1, 1, 1);
+  CHECK(scene_add_material(s, &m) == 0, "material");
   light_ctx c = {s, {0}, v3(0.2f, 0.1f, 0.3f)};
   c.l.type = LIGHT_AREA; c.l.tri = 0; c.l.area = 0.5f * v3_len(scene_tri_ng(s, 0)); c.l.L = c3(1, 1, 1); c.l.two_sided = 1;
   int rc = run_chi2("area light (triangle) from a point", &c, light_sf, light_pf);

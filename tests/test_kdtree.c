@@ -72,7 +72,7 @@ static int check_scene(const char *path, int nrays, const char *kind) {
   CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   accel *a;
-  CHECK(accel_create(kind, s->pos, s->idx, s->ntris, 1, &a, &err) == VALO_OK, "%s", err.message);
+  CHECK(accel_create(kind, s->pos, s->idx, s->ntris, 1, NULL, &a, &err) == VALO_OK, "%s", err.message);
   ray *rays = malloc(nrays * sizeof *rays);
   float *stmax = malloc(nrays * sizeof *stmax);
   hit *bh = malloc(nrays * sizeof *bh);

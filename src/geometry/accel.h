@@ -22,16 +22,29 @@ typedef struct accel_ops {
 } accel_ops;
 struct accel { const accel_ops *ops; };
 
+/* An optional hit filter (alpha cutout): for triangles whose tri_flags[t] has flag_bit
+ * set, a hit counts only if pass(user, t, b1, b2) returns non-zero — for closest-hit and
+ * any-hit queries alike. */
+typedef struct accel_filter {
+  int (*pass)(const void *user, uint32_t tri, float b1, float b2);
+  const void *user;
+  const uint8_t *tri_flags;
+  uint8_t flag_bit;
+} accel_filter;
+
 /* kind: "kdtree" or "embree". Triangles are given as indexed vertices; the structure
- * keeps its own copy. threads: used by builders that can use them. */
+ * keeps its own copy. threads: used by builders that can use them. filter: NULL or
+ * one that outlives the structure. */
 valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
-                         accel **out, valo_error *err);
+                         const accel_filter *filter, accel **out, valo_error *err);
 static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return a->ops->intersect(a, r, h); }
 static inline int accel_occluded(const accel *a, const ray *r) { return a->ops->occluded(a, r); }
 static inline void accel_destroy(accel *a) { if (a) a->ops->destroy(a); }
 
-valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err);
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err);
+valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+                          valo_error *err);
+valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+                          valo_error *err);
 int embree_available(void);
 
 /* Statistics of a built kd-tree (for benchmarks and tests). */

@@ -8,7 +8,22 @@
 #ifdef VALO_HAVE_EMBREE
 #include <embree3/rtcore.h>
 
-typedef struct embree_accel { accel base; RTCDevice dev; RTCScene scn; } embree_accel;
+typedef struct embree_accel { accel base; RTCDevice dev; RTCScene scn; accel_filter filter; } embree_accel;
+
+/* Intersection and occlusion filter: rejects hits the alpha test discards. */
+static void em_filter(const struct RTCFilterFunctionNArguments *args) {
+  const embree_accel *e = args->geometryUserPtr;
+  for (unsigned i = 0; i < args->N; i++) {
+    if (args->valid[i] != -1) continue;
+    /* RTCHitN is SoA: Ng_x[N] Ng_y[N] Ng_z[N] u[N] v[N] primID[N] ... (rtcore_ray.h; its
+     * accessors are C++ only). */
+    const float *hf = (const float *)args->hit;
+    const unsigned *hu = (const unsigned *)args->hit;
+    unsigned prim = hu[5 * args->N + i];
+    if (!(e->filter.tri_flags[prim] & e->filter.flag_bit)) continue;
+    if (!e->filter.pass(e->filter.user, prim, hf[3 * args->N + i], hf[4 * args->N + i])) args->valid[i] = 0;
+  }
+}
 
 static int em_intersect(const accel *a, const ray *r, hit *h) {
   const embree_accel *e = (const embree_accel *)a;
@@ -46,7 +61,8 @@ static const accel_ops em_ops = {"embree", em_intersect, em_occluded, em_destroy
 
 int embree_available(void) { return 1; }
 
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err) {
+valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+                          valo_error *err) {
   *out = NULL;
   embree_accel *e = calloc(1, sizeof *e);
   if (!e) return err_set(err, VALO_ERR_NOMEM, "embree: out of memory");
@@ -65,6 +81,12 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
     if (!vb || !ib) { rtcReleaseGeometry(g); em_destroy(&e->base); return err_set(err, VALO_ERR_NOMEM, "embree: out of memory"); }
     for (uint32_t i = 0; i < maxv; i++) { vb[3 * i] = pos[i].x; vb[3 * i + 1] = pos[i].y; vb[3 * i + 2] = pos[i].z; }
     memcpy(ib, idx, (size_t)ntris * 3 * sizeof(unsigned));
+    if (filter && filter->pass && filter->tri_flags) {
+      e->filter = *filter;
+      rtcSetGeometryUserData(g, e);
+      rtcSetGeometryIntersectFilterFunction(g, em_filter);
+      rtcSetGeometryOccludedFilterFunction(g, em_filter);
+    }
     rtcCommitGeometry(g);
     rtcAttachGeometry(e->scn, g);
     rtcReleaseGeometry(g);
@@ -76,7 +98,8 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
 }
 #else
 int embree_available(void) { return 0; }
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err) {
+valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+                          valo_error *err) {
   (void)pos; (void)idx; (void)ntris;
   *out = NULL;
   return err_set(err, VALO_ERR_UNSUPPORTED, "this valo was built without Embree (install libembree-dev and rebuild)");

@@ -28,7 +28,7 @@ typedef struct kd_node {
 /* A leaf's triangles are stored in leaf order, vertices inline, in groups of four laid
  * out for SSE (v[vertex][axis][lane]), so a leaf is read sequentially and tested four
  * triangles at a time (tri4_intersect). Unused lanes have id UINT32_MAX. */
-typedef struct kd_tri4 { float v[3][3][4]; uint32_t id[4]; } kd_tri4;
+typedef struct kd_tri4 { float v[3][3][4]; uint32_t id[4]; uint32_t filt; } kd_tri4; /* filt: lanes needing the hit filter */
 
 typedef struct kdtree {
   accel base;
@@ -37,6 +37,8 @@ typedef struct kdtree {
   kd_node *nodes;
   uint32_t nnodes, cap_nodes;
   kd_tri4 *prims;     /* leaf-ordered triangle groups */
+  accel_filter filter;
+  int has_filter;
   uint64_t nprims, cap_prims;
   bbox bounds;
   uint32_t max_depth_seen;
@@ -102,6 +104,7 @@ static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {
     for (int vtx = 0; vtx < 3; vtx++)
       for (int ax = 0; ax < 3; ax++) g->v[vtx][ax][lane] = kd->tv[9 * (size_t)t + 3 * vtx + ax];
     g->id[lane] = t;
+    if (kd->has_filter && (kd->filter.tri_flags[t] & kd->filter.flag_bit)) g->filt |= 1u << lane;
     count++;
   }
   kd->nprims += (count + 3) / 4;
@@ -423,6 +426,22 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
     for (uint32_t i = 0; i < cnt; i += 4, g++) {
       float t, b1, b2;
       int lane;
+      if (g->filt) {
+        /* Alpha-tested triangles: lane by lane, each hit through the filter. */
+        for (int k = 0; k < 4; k++) {
+          if (g->id[k] == UINT32_MAX) continue;
+          float tv[9];
+          for (int vtx = 0; vtx < 3; vtx++)
+            for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
+          if (!tri_intersect(&sh, tv, best, &t, &b1, &b2)) continue;
+          if (((g->filt >> k) & 1) && !kd->filter.pass(kd->filter.user, g->id[k], b1, b2)) continue;
+          if (any) return 1;
+          best = t;
+          found = 1;
+          h->t = t; h->b1 = b1; h->b2 = b2; h->tri = g->id[k];
+        }
+        continue;
+      }
       if (tri4_intersect(&sh, g, best, &t, &b1, &b2, &lane)) {
         if (any) return 1;
         best = t;
@@ -459,13 +478,15 @@ void kdtree_stats(const accel *a, kd_stats *st) {
   st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * sizeof(kd_tri4);
 }
 
-valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, accel **out, valo_error *err) {
+valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+                          valo_error *err) {
   *out = NULL;
   if (ntris >= (1u << 30)) return err_set(err, VALO_ERR_INVALID, "kd-tree: too many triangles (%u)", ntris);
   kdtree *kd = calloc(1, sizeof *kd);
   if (!kd) return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory");
   kd->base.ops = &kd_ops;
   kd->ntris = ntris;
+  if (filter && filter->pass && filter->tri_flags) { kd->filter = *filter; kd->has_filter = 1; }
   kd->bounds = bbox_empty();
   kd_builder b = {kd, NULL, NULL, 0};
   evlist l = {{0}, {0}, ntris};

@@ -2,6 +2,7 @@
  * integrator.h (surface interactions, shadow segments, next-event estimation + MIS). */
 #include "integrator/integrator.h"
 #include "core/sampling.h"
+#include "scene/texture.h"
 #include <string.h>
 
 extern const integrator_ops integrator_path, integrator_whitted, integrator_distribution;
@@ -32,6 +33,16 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   }
   it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
   it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+}
+
+bsdf bsdf_at(const scene *s, const isect *it) {
+  const material *m = it->m;
+  if (m->tex_kd < 0 && m->tex_ks < 0) return bsdf_from_material(m);
+  material mm = *m;
+  float px[4];
+  if (m->tex_kd >= 0) { texture_lookup(&s->tex[m->tex_kd], it->u, it->v, px); mm.kd = c3_mul(mm.kd, c3(px[0], px[1], px[2])); }
+  if (m->tex_ks >= 0) { texture_lookup(&s->tex[m->tex_ks], it->u, it->v, px); mm.ks = c3_mul(mm.ks, c3(px[0], px[1], px[2])); }
+  return bsdf_from_material(&mm);
 }
 
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
@@ -90,7 +101,7 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
   }
   int32_t lid = s->tri_light[h->tri];
   if (lid < 0) return c3(0, 0, 0);
-  return light_area_emitted(&s->lights[lid], it->ng, v3_neg(r->d));
+  return light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
 }
 
 frame shading_frame(isect *it, const bsdf *b, vec3 wo) {

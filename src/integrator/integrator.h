@@ -41,6 +41,8 @@ typedef struct isect {
 } isect;
 
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
+/* The BSDF at it, with the material's texture maps applied at its UV. */
+bsdf bsdf_at(const scene *s, const isect *it);
 static inline vec3 offset_origin_isect(const isect *it, vec3 d) { return offset_origin(it->p, it->perr, it->ng, d); }
 static inline int ctx_intersect(const render_ctx *c, const ray *r, hit *h, thread_stats *ts) {
   ts->rays++;

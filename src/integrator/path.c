@@ -31,7 +31,7 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
     int32_t lid = s->tri_light[h.tri];
     if (lid >= 0) {
       const light *l = &s->lights[lid];
-      rgb Le = light_area_emitted(l, it.ng, wo);
+      rgb Le = light_area_radiance(s, l, it.ng, wo, it.u, it.v);
       if (!c3_black(Le)) {
         float w = 1;
         if (!specular) w = power_heuristic(prev_pdf, light_select_pmf(c, (uint32_t)lid) * light_pdf_area(s, l, prev_p, it.p, it.ng));
@@ -40,7 +40,7 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
     }
     if (depth >= max_depth) break;
 
-    bsdf b = bsdf_from_material(it.m);
+    bsdf b = bsdf_at(s, &it);
     vec3 ns = it.ns;
     if (!bsdf_transmits(&b)) {
       /* Opaque surfaces are two-sided: face both normals towards the viewer. */

@@ -18,7 +18,7 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
   rgb L = emitted_along(c, &r, &h, found, &it);
   int max_depth = c->max_depth >= 0 ? c->max_depth : WHITTED_DEFAULT_DEPTH;
   if (!found || depth >= max_depth) return L;
-  bsdf b = bsdf_from_material(it.m);
+  bsdf b = bsdf_at(c->s, &it);
   vec3 wo = v3_neg(r.d);
   frame fr = shading_frame(&it, &b, wo);
   if (bsdf_has_smooth(&b)) L = c3_add(L, estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts));

@@ -3,7 +3,17 @@
 #include "light/light.h"
 #include "core/sampling.h"
 #include "light/envmap.h"
+#include "scene/texture.h"
 #include <stdlib.h>
+
+rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v) {
+  rgb L = light_area_emitted(l, ng, w);
+  const material *m = &s->mats[s->tri_mat[l->tri]];
+  if (m->tex_ke < 0 || c3_black(L)) return L;
+  float px[4];
+  texture_lookup(&s->tex[m->tex_ke], u, v, px);
+  return c3_mul(L, c3(px[0], px[1], px[2]));
+}
 
 float light_power(const scene *s, const light *l) {
   switch (l->type) {
@@ -57,7 +67,9 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     vec3 wi = v3_scale(d, 1 / dist);
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
-    o->L = light_area_emitted(l, n, v3_neg(wi));
+    float tu, tv;
+    scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+    o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
     if (c3_black(o->L)) return 0;
     o->wi = wi; o->dist = dist; o->p_light = pl; o->n_light = n;
     o->pdf = d2 / (cos_l * l->area);

@@ -36,5 +36,7 @@ static inline rgb light_area_emitted(const light *l, vec3 ng, vec3 w) {
   float c = v3_dot(ng, w);
   return (c > 0 || (l->two_sided && c < 0)) ? l->L : c3(0, 0, 0);
 }
+/* The same with the emitter's emission map (if any) applied at surface UV (u, v). */
+rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v);
 float light_power(const scene *s, const light *l);
 #endif

@@ -33,6 +33,7 @@ struct valo_render {
   render_ctx ctx;
   const integrator_ops *integ;
   accel *acc;
+  accel_filter alpha_filter;
   double *sum;            /* 3 doubles per pixel */
   float *aov;             /* 7 floats per pixel (albedo rgb, normal xyz, depth) summed, or NULL */
   int spp_done;
@@ -49,6 +50,8 @@ static double now_seconds(void) {
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+
+static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2) { return scene_alpha_pass(user, tri, b1, b2); }
 
 VALO_API const char *valo_version(void) { return VALO_VERSION_STRING; }
 
@@ -153,7 +156,13 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   if (o.aovs) r->aov = calloc((size_t)o.width * o.height * 7, sizeof(float));
   if (!r->sum || (o.aovs && !r->aov)) { free(r->sum); free(r->aov); free(r); return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height); }
   double t0 = now_seconds();
-  valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, &r->acc, err);
+  int any_alpha = 0;
+  for (uint32_t t = 0; t < s->ntris && !any_alpha; t++) any_alpha = (s->tri_flags[t] & TRI_ALPHA) != 0;
+  r->alpha_filter.pass = alpha_filter_pass;
+  r->alpha_filter.user = s;
+  r->alpha_filter.tri_flags = s->tri_flags;
+  r->alpha_filter.flag_bit = TRI_ALPHA;
+  valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &r->alpha_filter : NULL, &r->acc, err);
   if (st) { free(r->sum); free(r->aov); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
   if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
@@ -207,7 +216,11 @@ static void record_aovs(const valo_render *r, ray ry, float *acc, thread_stats *
   if (!ctx_intersect(&r->ctx, &ry, &h, ts)) return;
   isect it;
   isect_from_hit(r->s, &ry, &h, &it);
-  rgb a = material_albedo(it.m, v3_dot(it.ns, v3_neg(ry.d)));
+  bsdf b = bsdf_at(r->s, &it);
+  material tm = *it.m;
+  tm.kd = b.kd;
+  tm.ks = b.ks;
+  rgb a = material_albedo(&tm, v3_dot(it.ns, v3_neg(ry.d)));
   vec3 n = v3_faceforward(it.ns, v3_neg(ry.d));
   acc[0] += a.r; acc[1] += a.g; acc[2] += a.b;
   acc[3] += n.x; acc[4] += n.y; acc[5] += n.z;

@@ -10,6 +10,9 @@
 #include <assimp/postprocess.h>
 #include <assimp/material.h>
 #include <assimp/ObjMaterial.h>
+#include "scene/texture.h"
+#include <assimp/GltfMaterial.h>
+#include <assimp/texture.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -81,6 +84,32 @@ static float ai_float(const struct aiMaterial *m, const char *key, unsigned type
   return def;
 }
 
+/* Loads texture slot `type` of am into the scene: a file beside the mesh, or an image
+ * embedded in the file ("*N"). Returns the texture index or -1. */
+static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type,
+                     const char *dir, int srgb, int *wrap_mode) {
+  if (aiGetMaterialTextureCount(am, type) == 0) return -1;
+  struct aiString path;
+  enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
+  if (aiGetMaterialTexture(am, type, 0, &path, NULL, NULL, NULL, NULL, mode, NULL) != aiReturn_SUCCESS) return -1;
+  if (wrap_mode) *wrap_mode = mode[0];
+  const char *p = path.data;
+  if (p[0] == '*') {
+    long k = strtol(p + 1, NULL, 10);
+    if (k < 0 || (unsigned long)k >= ai->mNumTextures) return -1;
+    const struct aiTexture *t = ai->mTextures[k];
+    if (t->mHeight != 0) return -1; /* raw texel arrays are not produced by the formats we read */
+    char key[1200];
+    snprintf(key, sizeof key, "%s%s", dir, p);
+    return scene_texture_memory(s, key, (const unsigned char *)t->pcData, t->mWidth, srgb);
+  }
+  char full[2048];
+  if (p[0] == '/') snprintf(full, sizeof full, "%s", p);
+  else snprintf(full, sizeof full, "%s%s", dir, p);
+  for (char *q = full; *q; q++) if (*q == '\\') *q = '/';
+  return scene_texture_file(s, full, srgb);
+}
+
 static material convert_material(const struct aiMaterial *am) {
   material m = material_default();
   struct aiString name;
@@ -104,7 +133,29 @@ static material convert_material(const struct aiMaterial *am) {
   else m.type = MAT_DIFFUSE;
   if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = -1;
+  m.alpha_cutoff = 0.5f;
   return m;
+}
+
+static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir) {
+  int wrap = 0;
+  m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
+  if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
+  if (m->tex_kd >= 0) s->tex[m->tex_kd].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
+  m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
+  m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
+  if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
+  /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */
+  int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
+  if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
+  struct aiString mode;
+  if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) == aiReturn_SUCCESS && strcmp(mode.data, "OPAQUE") &&
+      m->tex_kd >= 0 && s->tex[m->tex_kd].has_alpha) {
+    m->tex_alpha = m->tex_kd;
+    m->alpha_channel = 1;
+    m->alpha_cutoff = ai_float(am, AI_MATKEY_GLTF_ALPHACUTOFF, 0.5f);
+  }
 }
 
 typedef struct load_ctx {
@@ -240,7 +291,14 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
       if (scene_add_material(s, &(material){0}) == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
-    for (unsigned i = 0; i < ai->mNumMaterials; i++) s->mats[c.mat_base + i] = convert_material(ai->mMaterials[i]);
+    char dir[1024] = "";
+    const char *slash = strrchr(path, '/');
+    if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
+    for (unsigned i = 0; i < ai->mNumMaterials; i++) {
+      material m = convert_material(ai->mMaterials[i]);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir);
+      s->mats[c.mat_base + i] = m;
+    }
     if (ai->mNumMaterials == 0) {
       material d = material_default();
       c.override_mat = scene_add_material(s, &d);

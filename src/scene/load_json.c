@@ -14,6 +14,8 @@
 
 typedef struct jctx { scene *s; const char *path; char dir[1024]; valo_error *err; } jctx;
 
+static void resolve_path(const struct jctx *c, const char *rel, char *out, size_t n);
+
 static valo_status bad(jctx *c, const char *where, const char *what) {
   return err_set(c->err, VALO_ERR_INVALID, "%s: %s: %s", c->path, where, what);
 }
@@ -159,6 +161,34 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
   return VALO_OK;
 }
 
+/* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
+ * then multiplies 1. */
+static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (v && cJSON_IsString(v)) {
+    char full[2048];
+    resolve_path(c, v->valuestring, full, sizeof full);
+    FILE *f = fopen(full, "rb");
+    if (!f) {
+      char w[300];
+      snprintf(w, sizeof w, "%s.%s", where, key);
+      char msg[2200];
+      snprintf(msg, sizeof msg, "cannot open texture %s: %s", full, strerror(errno));
+      return bad(c, w, msg);
+    }
+    fclose(f);
+    *tex = scene_texture_file(c->s, full, 1);
+    if (*tex < 0) {
+      char w[300];
+      snprintf(w, sizeof w, "%s.%s", where, key);
+      return bad(c, w, "texture could not be decoded");
+    }
+    *out = c3(1, 1, 1);
+    return VALO_OK;
+  }
+  return get_rgb(c, o, key, where, out);
+}
+
 static valo_status parse_material(jctx *c, const cJSON *o, const char *name, material *m) {
   char where[256];
   snprintf(where, sizeof where, "materials.%s", name);
@@ -176,13 +206,13 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
-    TRY(get_rgb(c, o, "reflectance", where, &m->kd));
+    TRY(get_rgb_tex(c, o, "reflectance", where, &m->kd, &m->tex_kd));
   } else if (!strcmp(type, "phong")) {
     TRY(check_keys(c, o, where, k_phong));
     m->type = MAT_PHONG;
     m->kd = c3(0.5f, 0.5f, 0.5f); m->ks = c3(0.2f, 0.2f, 0.2f); m->exponent = 20;
-    TRY(get_rgb(c, o, "diffuse", where, &m->kd));
-    TRY(get_rgb(c, o, "specular", where, &m->ks));
+    TRY(get_rgb_tex(c, o, "diffuse", where, &m->kd, &m->tex_kd));
+    TRY(get_rgb_tex(c, o, "specular", where, &m->ks, &m->tex_ks));
     double e = m->exponent;
     TRY(get_num(c, o, "exponent", where, 0, 1e6, &e));
     m->exponent = (float)e;
@@ -214,7 +244,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   } else {
     return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor)");
   }
-  TRY(get_rgb(c, o, "emission", where, &m->emission));
+  TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   TRY(get_bool(c, o, "two_sided", where, &m->two_sided));
   return VALO_OK;
 }

@@ -3,6 +3,7 @@
 #include "scene/scene.h"
 #include "core/error.h"
 #include "light/envmap.h"
+#include "scene/texture.h"
 #include <stdlib.h>
 #include <string.h>
 #include <stdio.h>
@@ -20,6 +21,8 @@ void scene_free(scene *s) {
   free(s->pos); free(s->nrm); free(s->uv); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light);
   if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
+  for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
+  free(s->tex);
   free(s);
 }
 
@@ -63,6 +66,8 @@ material material_default(void) {
   m.kd = c3(0.8f, 0.8f, 0.8f);
   m.exponent = 1;
   m.ior = 1.5f;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = -1;
+  m.alpha_cutoff = 0.5f;
   snprintf(m.name, sizeof m.name, "default");
   return m;
 }
@@ -77,6 +82,56 @@ int scene_add_light(scene *s, const light *l) {
   if (grow((void **)&s->lights, &s->cap_lights, (uint64_t)s->nlights + 1, sizeof *l)) return -1;
   s->lights[s->nlights++] = *l;
   return 0;
+}
+
+static int add_texture(scene *s, texture *t, const char *key) {
+  snprintf(t->key, sizeof t->key, "%s", key);
+  if (grow((void **)&s->tex, &s->cap_tex, (uint64_t)s->ntex + 1, sizeof *t)) { texture_free(t); return -1; }
+  s->tex[s->ntex] = *t;
+  return (int)s->ntex++;
+}
+static int find_texture(const scene *s, const char *key) {
+  for (uint32_t i = 0; i < s->ntex; i++)
+    if (!strcmp(s->tex[i].key, key)) return (int)i;
+  return -1;
+}
+
+int scene_texture_file(scene *s, const char *path, int srgb) {
+  char key[600];
+  snprintf(key, sizeof key, "%s|%d", path, srgb);
+  int i = find_texture(s, key);
+  if (i >= 0) return i;
+  texture t;
+  valo_error err;
+  if (texture_load_file(&t, path, srgb, &err)) { log_warning("%s (the map is ignored)", err.message); return -1; }
+  return add_texture(s, &t, key);
+}
+
+int scene_texture_memory(scene *s, const char *name, const unsigned char *data, size_t len, int srgb) {
+  char key[600];
+  snprintf(key, sizeof key, "%s|%d", name, srgb);
+  int i = find_texture(s, key);
+  if (i >= 0) return i;
+  texture t;
+  valo_error err;
+  if (texture_load_memory(&t, data, len, name, srgb, &err)) { log_warning("%s (the map is ignored)", err.message); return -1; }
+  return add_texture(s, &t, key);
+}
+
+void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v) {
+  const uint32_t *ix = &s->idx[3 * t];
+  float b0 = 1 - b1 - b2;
+  *u = b0 * s->uv[2 * ix[0]] + b1 * s->uv[2 * ix[1]] + b2 * s->uv[2 * ix[2]];
+  *v = b0 * s->uv[2 * ix[0] + 1] + b1 * s->uv[2 * ix[1] + 1] + b2 * s->uv[2 * ix[2] + 1];
+}
+
+int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2) {
+  const material *m = &s->mats[s->tri_mat[t]];
+  if (m->tex_alpha < 0) return 1;
+  float u, v, px[4];
+  scene_tri_uv(s, t, b1, b2, &u, &v);
+  texture_lookup(&s->tex[m->tex_alpha], u, v, px);
+  return (m->alpha_channel ? px[3] : px[0]) >= m->alpha_cutoff;
 }
 
 valo_status scene_commit(scene *s, valo_error *err) {
@@ -99,6 +154,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
   for (uint32_t t = 0; t < s->ntris; t++) {
     s->tri_light[t] = -1;
     const material *m = &s->mats[s->tri_mat[t]];
+    if (m->tex_alpha >= 0 && (s->tri_flags[t] & TRI_HAS_UVS)) s->tri_flags[t] |= TRI_ALPHA;
     if (c3_black(m->emission)) continue;
     light l;
     memset(&l, 0, sizeof l);

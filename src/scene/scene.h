@@ -24,6 +24,10 @@ typedef struct material {
   rgb eta, k;
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
+  int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
+  int tex_alpha;     /* alpha-cutout texture, -1 = none */
+  int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
+  float alpha_cutoff;/* a hit counts where alpha >= cutoff */
   char name[64];
 } material;
 
@@ -46,7 +50,7 @@ typedef struct camera {
 } camera;
 
 /* Triangle flags. */
-enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2 };
+enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
 
 typedef struct scene {
   char path[1024];
@@ -60,6 +64,8 @@ typedef struct scene {
   uint32_t ntris, cap_tris;
   material *mats;
   uint32_t nmats, cap_mats;
+  struct texture *tex;
+  uint32_t ntex, cap_tex;
   light *lights;
   uint32_t nlights, cap_lights;
   int32_t *tri_light;      /* per triangle: its area light or -1 (after commit) */
@@ -81,6 +87,14 @@ int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris);
 uint32_t scene_add_material(scene *s, const material *m); /* UINT32_MAX on OOM */
 int scene_add_light(scene *s, const light *l);
 material material_default(void);
+/* Adds (or finds, by key) a texture from a file; returns its index, or -1 after a
+ * warning naming the file when it cannot be read (the map is then ignored). */
+int scene_texture_file(scene *s, const char *path, int srgb);
+int scene_texture_memory(scene *s, const char *key, const unsigned char *data, size_t len, int srgb);
+/* Surface UV of triangle t at barycentrics (b1, b2). */
+void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);
+/* Alpha-cutout test: 1 if the hit on triangle t at (b1, b2) counts. */
+int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
 valo_status scene_commit(scene *s, valo_error *err);
 /* Geometric (unnormalised cross product) normal of triangle t. */

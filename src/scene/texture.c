@@ -1,0 +1,97 @@
+/* texture.c — see texture.h. */
+#include "scene/texture.h"
+#include "image/image_io.h"
+#include "core/error.h"
+#include <stb_image.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+
+static valo_status from_8bit(texture *t, unsigned char *data, int w, int h, int n, int srgb, const char *name, valo_error *err) {
+  t->px = malloc((size_t)w * h * 4 * sizeof(float));
+  if (!t->px) { stbi_image_free(data); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", name); }
+  float lut[256];
+  for (int i = 0; i < 256; i++) lut[i] = srgb ? srgb_to_linear(i / 255.0f) : i / 255.0f;
+  for (size_t i = 0; i < (size_t)w * h; i++) {
+    const unsigned char *p = &data[(size_t)n * i];
+    float *o = &t->px[4 * i];
+    if (n >= 3) { o[0] = lut[p[0]]; o[1] = lut[p[1]]; o[2] = lut[p[2]]; }
+    else { o[0] = o[1] = o[2] = lut[p[0]]; }
+    o[3] = (n == 2 || n == 4) ? p[n - 1] / 255.0f : 1.0f; /* alpha is always linear */
+  }
+  t->w = w; t->h = h;
+  t->has_alpha = (n == 2 || n == 4);
+  stbi_image_free(data);
+  return VALO_OK;
+}
+
+valo_status texture_load_memory(texture *t, const unsigned char *data, size_t len, const char *name, int srgb, valo_error *err) {
+  memset(t, 0, sizeof *t);
+  if (len > (size_t)INT32_MAX) return err_set(err, VALO_ERR_INVALID, "%s: embedded image too large", name);
+  int w, h, n;
+  unsigned char *img = stbi_load_from_memory(data, (int)len, &w, &h, &n, 0);
+  if (!img) return err_set(err, VALO_ERR_PARSE, "%s: cannot decode image: %s", name, stbi_failure_reason());
+  return from_8bit(t, img, w, h, n, srgb, name, err);
+}
+
+valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error *err) {
+  memset(t, 0, sizeof *t);
+  const char *dot = strrchr(path, '.');
+  if (dot && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm"))) {
+    image im;
+    valo_status st = image_read(path, &im, err);
+    if (st) return st;
+    t->px = malloc((size_t)im.w * im.h * 4 * sizeof(float));
+    if (!t->px) { image_free(&im); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); }
+    for (size_t i = 0; i < (size_t)im.w * im.h; i++) {
+      for (int c = 0; c < 3; c++) t->px[4 * i + c] = im.rgb[3 * i + c];
+      t->px[4 * i + 3] = 1;
+    }
+    t->w = im.w; t->h = im.h;
+    image_free(&im);
+    return VALO_OK;
+  }
+  int w, h, n;
+  unsigned char *img = stbi_load(path, &w, &h, &n, 0);
+  if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());
+  return from_8bit(t, img, w, h, n, srgb, path, err);
+}
+
+void texture_free(texture *t) { free(t->px); t->px = NULL; }
+
+static int wrap_coord(int i, int n, tex_wrap m) {
+  switch (m) {
+  case TEX_CLAMP: return i < 0 ? 0 : (i >= n ? n - 1 : i);
+  case TEX_MIRROR: {
+    int p = 2 * n;
+    i %= p;
+    if (i < 0) i += p;
+    return i < n ? i : p - 1 - i;
+  }
+  case TEX_REPEAT: break;
+  }
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+void texture_texel(const texture *t, int x, int y, float out[4]) {
+  x = wrap_coord(x, t->w, t->wrap);
+  y = wrap_coord(y, t->h, t->wrap);
+  memcpy(out, &t->px[4 * ((size_t)y * t->w + x)], 4 * sizeof(float));
+}
+
+void texture_lookup(const texture *t, float u, float v, float out[4]) {
+  if (!isfinite(u) || !isfinite(v)) { u = 0; v = 0; }
+  /* Texel centres sit at (x + 0.5)/w; v = 0 is the bottom row. */
+  float x = u * t->w - 0.5f, y = (1 - v) * t->h - 0.5f;
+  float fx0 = floorf(x), fy0 = floorf(y);
+  if (fabsf(fx0) > 1e8f || fabsf(fy0) > 1e8f) { fx0 = 0; fy0 = 0; }
+  int x0 = (int)fx0, y0 = (int)fy0;
+  float fx = x - fx0, fy = y - fy0;
+  float a[4], b[4], c[4], d[4];
+  texture_texel(t, x0, y0, a); texture_texel(t, x0 + 1, y0, b);
+  texture_texel(t, x0, y0 + 1, c); texture_texel(t, x0 + 1, y0 + 1, d);
+  for (int k = 0; k < 4; k++) out[k] = (a[k] * (1 - fx) + b[k] * fx) * (1 - fy) + (c[k] * (1 - fx) + d[k] * fx) * fy;
+}

@@ -1,0 +1,124 @@
+/* test_texture.c — textures: texel-exact bilinear lookups at texel centres of the
+ * DamagedHelmet's base-colour map (embedded in the .glb and beside the .gltf), sRGB
+ * decoding against the raw 8-bit values, wrap modes, and alpha cutout honoured by camera
+ * and shadow rays alike on the kd-tree and on Embree. */
+#include "harness.h"
+#include "scene/scene.h"
+#include "scene/texture.h"
+#include <stb_image.h>
+#include <stb_image_write.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static float srgb_dec(int b) { float c = b / 255.0f; return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+
+static int helmet_texels(const char *rel) {
+  const char *p = shared_file(rel), *jpg = shared_file("scenes/damaged-helmet/glTF/Default_albedo.jpg");
+  if (!p || !jpg) return TEST_SKIP;
+  scene *s = scene_new(p);
+  valo_error err;
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  int kd = s->mats[s->tri_mat[0]].tex_kd;
+  CHECK(kd >= 0, "no base colour texture");
+  const texture *t = &s->tex[kd];
+  int w, h, n;
+  unsigned char *raw = stbi_load(jpg, &w, &h, &n, 3);
+  CHECK(raw && t->w == w && t->h == h, "texture %dx%d vs file %dx%d", t->w, t->h, w, h);
+  /* At texel centres the bilinear lookup returns the texel itself, v = 0 at the bottom. */
+  int xs[5] = {0, 17, 1024, 1500, 2047}, ys[5] = {0, 2047, 333, 1024, 5};
+  for (int i = 0; i < 5; i++) {
+    float u = (xs[i] + 0.5f) / w, v = 1 - (ys[i] + 0.5f) / h, px[4];
+    texture_lookup(t, u, v, px);
+    for (int c = 0; c < 3; c++) {
+      float expect = srgb_dec(raw[3 * (ys[i] * w + xs[i]) + c]);
+      CHECK(fabsf(px[c] - expect) < 1e-6f, "texel (%d,%d) channel %d: %g, expected %g", xs[i], ys[i], c, px[c], expect);
+    }
+  }
+  stbi_image_free(raw);
+  /* Emissive map present too. */
+  CHECK(s->mats[s->tri_mat[0]].tex_ke >= 0, "no emissive texture");
+  scene_free(s);
+  return 0;
+}
+static int helmet_glb_texels(void) { return helmet_texels("scenes/damaged-helmet/glTF-Binary/DamagedHelmet.glb"); }
+static int helmet_gltf_texels(void) { return helmet_texels("scenes/damaged-helmet/glTF/DamagedHelmet.gltf"); }
+
+static int wrap_modes(void) {
+  texture t;
+  memset(&t, 0, sizeof t);
+  t.w = 4; t.h = 1;
+  float px[16] = {0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 1, 3, 3, 3, 1};
+  t.px = px;
+  float o[4];
+  t.wrap = TEX_REPEAT;
+  texture_lookup(&t, 1.125f, 0.5f, o); /* texel 0 again */
+  CHECK(fabsf(o[0] - 0) < 1e-6f, "repeat: %g", o[0]);
+  t.wrap = TEX_CLAMP;
+  texture_lookup(&t, 1.125f, 0.5f, o);
+  CHECK(fabsf(o[0] - 3) < 1e-6f, "clamp: %g", o[0]);
+  t.wrap = TEX_MIRROR;
+  texture_lookup(&t, 1.125f, 0.5f, o); /* mirrored: texel 3 */
+  CHECK(fabsf(o[0] - 3) < 1e-6f, "mirror: %g", o[0]);
+  texture_lookup(&t, -0.125f, 0.5f, o);
+  CHECK(fabsf(o[0] - 0) < 1e-6f, "mirror below 0: %g", o[0]);
+  t.wrap = TEX_REPEAT;
+  texture_lookup(&t, 0.25f, 0.5f, o); /* halfway between texel 0 and 1 */
+  CHECK(fabsf(o[0] - 0.5f) < 1e-6f, "bilinear: %g", o[0]);
+  return 0;
+}
+
+/* A quad with a fully transparent alpha map hides nothing: camera rays pass through it,
+ * and a floor in its shadow is lit as if it were absent. A fully opaque map blocks. */
+static double cutout_mean(const char *accel, int alpha, int with_quad) {
+  unsigned char rgba[4 * 4 * 4];
+  for (int i = 0; i < 16; i++) { rgba[4 * i] = 200; rgba[4 * i + 1] = 20; rgba[4 * i + 2] = 20; rgba[4 * i + 3] = (unsigned char)alpha; }
+  char png[1200];
+  snprintf(png, sizeof png, "%s/alpha%d.png", scratch_dir(), alpha);
+  if (!stbi_write_png(png, 4, 4, 4, rgba, 16)) return -1;
+  char mtl[256];
+  snprintf(mtl, sizeof mtl, "newmtl leaf\nKd 0 0 0\nmap_Kd alpha%d.png\nmap_d alpha%d.png\n", alpha, alpha);
+  char name[64];
+  snprintf(name, sizeof name, "leaf%d.mtl", alpha);
+  scratch_file(name, mtl);
+  char obj[512];
+  snprintf(obj, sizeof obj,
+           "mtllib leaf%d.mtl\nv -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3 4/4\n", alpha);
+  snprintf(name, sizeof name, "leaf%d.obj", alpha);
+  scratch_file(name, obj);
+  scratch_file("floor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n");
+  char json[1024];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,4,0.01], \"look_at\": [0,0,0], \"fov\": 30},\n"
+           "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 4, \"max_depth\": 1, \"accel\": \"%s\"},\n"
+           "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+           "  \"shapes\": [{\"file\": \"floor.obj\", \"material\": \"floor\"}%s%s%s],\n"
+           "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+           accel, with_quad ? ", {\"file\": \"leaf" : "", with_quad ? (alpha ? "255" : "0") : "", with_quad ? ".obj\"}" : "");
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  if (!px) return -1;
+  double s = 0;
+  for (int i = 0; i < w * h * 3; i++) s += px[i];
+  free(px);
+  return s / (w * h * 3);
+}
+
+static int alpha_cutout(void) {
+  const char *kinds[2] = {"kdtree", "embree"};
+  for (int k = 0; k < 2; k++) {
+    double none = cutout_mean(kinds[k], 0, 0), clear = cutout_mean(kinds[k], 0, 1), opaque = cutout_mean(kinds[k], 255, 1);
+    fprintf(stderr, "%s: floor alone %.5f, behind a transparent quad %.5f, behind an opaque quad %.5f\n", kinds[k], none, clear, opaque);
+    CHECK(none > 0 && clear >= 0 && opaque >= 0, "render failed");
+    CHECK(fabs(clear - none) < 1e-6, "%s: a fully transparent quad changed the image (%g vs %g)", kinds[k], clear, none);
+    CHECK(opaque < 0.5 * none, "%s: an opaque quad should shadow and hide the floor (%g vs %g)", kinds[k], opaque, none);
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
+                                    {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout}, {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
