@@ -257,6 +257,43 @@ static int aovs(void) {
   return 0;
 }
 
+/* Thin lens: a tiny emitter at distance D, focus at F, aperture radius A spreads into a
+ * uniform disk of angular radius atan(A |1 - F/D| / F) (plus the emitter's own size);
+ * in focus it stays a dot. */
+static double spot_radius_px(double aperture, double focus) {
+  char json[1024];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [0,0,-1], \"fov\": 20, \"aperture_radius\": %g, \"focus_distance\": %g},\n"
+           "  \"film\": {\"width\": 96, \"height\": 96}, \"render\": {\"spp\": 256},\n"
+           "  \"materials\": {\"e\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1000}},\n"
+           "  \"shapes\": [{\"type\": \"sphere\", \"center\": [0,0,-4], \"radius\": 0.005, \"subdivisions\": 2, \"material\": \"e\"}] }\n",
+           aperture, focus);
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  if (!px) return -1;
+  /* Energy-weighted second moment of the spot: a uniform disk of radius R has
+   * E[r^2] = R^2 / 2. */
+  double sum = 0, m2 = 0;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      double v = px[3 * (y * w + x) + 1], dx = x + 0.5 - w / 2.0, dy = y + 0.5 - h / 2.0;
+      sum += v; m2 += v * (dx * dx + dy * dy);
+    }
+  free(px);
+  return sum > 0 ? sqrt(2 * m2 / sum) : -1;
+}
+static int thin_lens_circle_of_confusion(void) {
+  double A = 0.1, F = 2, D = 4;
+  double tan_half = tan(10.0 * M_PI / 180);
+  double predicted = A * fabs(1 - F / D) / F / tan_half * 48; /* pixels: half the film spans tan_half */
+  double r = spot_radius_px(A, F), r_focus = spot_radius_px(A, D), r_pin = spot_radius_px(0, F);
+  fprintf(stderr, "spot radius: defocused %.2f px (predicted %.2f), in focus %.2f px, pinhole %.2f px\n", r, predicted, r_focus, r_pin);
+  CHECK(r > 0 && r_focus >= 0 && r_pin >= 0, "render failed");
+  CHECK(fabs(r - predicted) < 0.05 * predicted + 0.5, "defocus radius %.2f px, predicted %.2f", r, predicted);
+  CHECK(r_focus < 1.5 && r_pin < 1.5, "in focus the spot should stay within a pixel or so (%.2f, %.2f)", r_focus, r_pin);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
                                     {"furnace_albedo_half", furnace_albedo_half},
@@ -267,6 +304,7 @@ int main(int argc, char **argv) {
                                     {"furnace_constant_map", furnace_constant_map},
                                     {"envmap_orientation", envmap_orientation},
                                     {"aovs", aovs},
+                                    {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

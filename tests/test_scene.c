@@ -124,8 +124,28 @@ static int gltf_and_ply_load(void) {
   return 0;
 }
 
+/* glTF KHR_lights_punctual: a point light at (0,2,0) of colour (1,.5,.25) x 5, a spot at
+ * (1,1,1) turned to point down with cones 0.2/0.5 rad, a directional light pointing down. */
+static const char *LIGHTS_GLTF = "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"color\": [1, 0.5, 0.25], \"intensity\": 5}, {\"type\": \"spot\", \"intensity\": 2, \"spot\": {\"innerConeAngle\": 0.2, \"outerConeAngle\": 0.5}}, {\"type\": \"directional\", \"intensity\": 3}]}}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1, 2, 3]}], \"nodes\": [{\"mesh\": 0}, {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}, {\"translation\": [1, 1, 1], \"rotation\": [-0.7071068, 0, 0, 0.7071068], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}}, {\"rotation\": [-0.7071068, 0, 0, 0.7071068], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 2}}}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1}]}], \"buffers\": [{\"byteLength\": 44, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}], \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}]}";
+static int gltf_lights(void) {
+  const char *p = scratch_file("lights.gltf", LIGHTS_GLTF);
+  scene *s = scene_new(p);
+  valo_error err;
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 1, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->nlights == 3, "%u lights", s->nlights);
+  const light *pt = &s->lights[0], *sp = &s->lights[1], *di = &s->lights[2];
+  CHECK(pt->type == LIGHT_POINT && fabsf(pt->p.y - 2) < 1e-5f && fabsf(pt->L.r - 5) < 1e-5f && fabsf(pt->L.b - 1.25f) < 1e-5f,
+        "point light: type %d at y %g, L (%g %g %g)", pt->type, pt->p.y, pt->L.r, pt->L.g, pt->L.b);
+  CHECK(sp->type == LIGHT_SPOT && fabsf(sp->p.x - 1) < 1e-5f && fabsf(sp->dir.y + 1) < 1e-4f, "spot: type %d at (%g %g %g) dir (%g %g %g)",
+        sp->type, sp->p.x, sp->p.y, sp->p.z, sp->dir.x, sp->dir.y, sp->dir.z);
+  CHECK(fabsf(sp->cos_outer - cosf(0.5f)) < 1e-5f && fabsf(sp->cos_inner - cosf(0.2f)) < 1e-5f, "spot cones");
+  CHECK(di->type == LIGHT_DIRECTIONAL && fabsf(di->dir.y + 1) < 1e-4f && fabsf(di->L.g - 3) < 1e-5f, "directional light");
+  scene_free(s);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
-                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {NULL, NULL}};
+                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -276,6 +276,42 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   }
 }
 
+/* KHR_lights_punctual (and other formats' lights) as Assimp gives them: colour x
+ * intensity, position and direction in the frame of the node that shares the light's
+ * name. Photometric glTF units are taken as radiometric (candela as W/sr, lux as W/m^2). */
+static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
+  for (unsigned i = 0; i < c->ai->mNumLights; i++) {
+    const struct aiLight *al = c->ai->mLights[i];
+    mat34 node_xf = m34_identity(), id = m34_identity();
+    if (!find_node(c->ai->mRootNode, al->mName.data, &node_xf, &id)) node_xf = m34_identity();
+    mat34 full = m34_mul(xf, &node_xf);
+    light l;
+    memset(&l, 0, sizeof l);
+    l.L = c3(al->mColorDiffuse.r, al->mColorDiffuse.g, al->mColorDiffuse.b);
+    l.p = m34_point(&full, v3(al->mPosition.x, al->mPosition.y, al->mPosition.z));
+    l.dir = v3_norm(m34_vector(&full, v3(al->mDirection.x, al->mDirection.y, al->mDirection.z)));
+    switch (al->mType) {
+    case aiLightSource_POINT: l.type = LIGHT_POINT; break;
+    case aiLightSource_SPOT:
+      l.type = LIGHT_SPOT;
+      l.cos_outer = cosf(clampf(al->mAngleOuterCone, 1e-4f, PI_F));
+      l.cos_inner = cosf(clampf(al->mAngleInnerCone, 0, al->mAngleOuterCone));
+      break;
+    case aiLightSource_DIRECTIONAL: l.type = LIGHT_DIRECTIONAL; break;
+    case aiLightSource_UNDEFINED: case aiLightSource_AMBIENT: case aiLightSource_AREA: case _aiLightSource_Force32Bit:
+    default:
+      log_warning("%s: light '%s' of an unsupported kind is ignored", c->path, al->mName.data);
+      continue;
+    }
+    if (!v3_finite(l.p) || !c3_finite(l.L) || ((l.type != LIGHT_POINT) && !(v3_len2(l.dir) > 0))) {
+      log_warning("%s: light '%s' has a bad position or direction and is ignored", c->path, al->mName.data);
+      continue;
+    }
+    if (scene_add_light(c->s, &l)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  }
+  return VALO_OK;
+}
+
 valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_error *err) {
   FILE *f = fopen(path, "rb");
   if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
@@ -318,6 +354,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   if (c.degenerate)
     log_warning("%s: skipped %llu degenerate (zero-area) triangles", path, (unsigned long long)c.degenerate);
   if (take_camera && ai->mNumCameras > 0) take_file_camera(&c, &x);
+  st = take_file_lights(&c, &x);
 done:
   aiReleaseImport(ai);
   return st;
