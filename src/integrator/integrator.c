@@ -74,9 +74,10 @@ static rgb direct_impl(const render_ctx *c, const isect *it, const bsdf *b, cons
   vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
   rgb f = bsdf_eval(b, wo_l, wi_l);
   if (c3_black(f)) return c3(0, 0, 0);
-  /* Reflection must stay on wo's side of the true surface too (no leaks through
-   * shading normals). */
-  if (v3_dot(ls.wi, it->ng) * v3_dot(wo, it->ng) <= 0) return c3(0, 0, 0);
+  /* Reflection vs transmission must agree between the shading frame and the true
+   * surface (no leaks through shading normals). */
+  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(ls.wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) return c3(0, 0, 0);
   f = c3_scale(f, fabsf(wi_l.z));
   if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return c3(0, 0, 0);
   float light_pdf = pmf * ls.pdf;

@@ -1,12 +1,14 @@
-/* bsdf.c — owns the five BSDF models of the core renderer (digest 000): Lambertian,
- * energy-conserving normalised Phong (Lafortune & Willems 1994: kd/pi + ks (n+2)/(2pi)
- * cos^n alpha) with mixture sampling of its lobes, diffuse + ideal mirror (MTL illum 5),
- * smooth dielectric (Fresnel reflection/refraction, total internal reflection, radiance
- * scaled by 1/eta^2 across the boundary as in pbrt-v4) and smooth conductor (complex
- * Fresnel). */
+/* bsdf.c — owns the BSDF models (digest 000): Lambertian, energy-conserving normalised
+ * Phong (Lafortune & Willems 1994: kd/pi + ks (n+2)/(2pi) cos^n alpha) with mixture
+ * sampling of its lobes, diffuse + ideal mirror (MTL illum 5), smooth dielectric (Fresnel
+ * reflection/refraction, total internal reflection, radiance scaled by 1/eta^2 across the
+ * boundary as in pbrt-v4), smooth conductor (complex Fresnel), and GGX rough conductor
+ * and rough dielectric (Walter et al. 2007) sampled by visible normals (microfacet.h),
+ * following pbrt-v4's formulation of the rough dielectric. */
 #include "material/bsdf.h"
 #include "material/fresnel.h"
 #include "core/sampling.h"
+#include "material/microfacet.h"
 
 static float lobe_prob(rgb a, rgb b) {
   float wa = c3_avg(a), wb = c3_avg(b);
@@ -26,6 +28,11 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
   case MAT_CONDUCTOR: b.type = BSDF_CONDUCTOR; break;
   }
+  b.alpha = m->roughness * m->roughness;
+  if (b.alpha >= 1e-3f) {
+    if (b.type == BSDF_CONDUCTOR) b.type = BSDF_ROUGH_CONDUCTOR;
+    else if (b.type == BSDF_DIELECTRIC) b.type = BSDF_ROUGH_DIELECTRIC;
+  }
   return b;
 }
 
@@ -34,8 +41,53 @@ int bsdf_has_smooth(const bsdf *b) {
   case BSDF_DIFFUSE: case BSDF_PHONG: return 1;
   case BSDF_MIRROR: return b->p_first > 0;
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return 0;
+  case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: return 1;
   }
   return 0;
+}
+
+/* ---- rough dielectric (pbrt-v4 DielectricBxDF): the half vector of a refraction is
+ * wm = normalize(wi * etap + wo), facing +z; reflection R = F, transmission T = 1 - F. */
+static int rd_half(const bsdf *b, vec3 wo, vec3 wi, vec3 *wm_out, float *etap_out) {
+  int reflect = wo.z * wi.z > 0;
+  float etap = 1;
+  if (!reflect) etap = wo.z > 0 ? b->eta : 1 / b->eta;
+  vec3 wm = v3_add(v3_scale(wi, etap), wo);
+  if (wi.z == 0 || wo.z == 0 || !(v3_len2(wm) > 0)) return 0;
+  wm = v3_norm(wm);
+  if (wm.z < 0) wm = v3_neg(wm);
+  /* Discard back-facing microfacets. */
+  if (v3_dot(wm, wi) * wi.z < 0 || v3_dot(wm, wo) * wo.z < 0) return 0;
+  *wm_out = wm;
+  *etap_out = etap;
+  return 1;
+}
+static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
+  vec3 wm;
+  float etap;
+  if (!rd_half(b, wo, wi, &wm, &etap)) return c3(0, 0, 0);
+  float F = fresnel_dielectric(v3_dot(wo, wm), b->eta);
+  float D = ggx_D(b->alpha, wm), G = ggx_G(b->alpha, wo, wi);
+  float v;
+  if (etap == 1) v = D * G * F / fabsf(4 * wi.z * wo.z);
+  else {
+    float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap) * wi.z * wo.z;
+    v = D * G * (1 - F) * fabsf(v3_dot(wi, wm) * v3_dot(wo, wm) / denom) / (etap * etap);
+  }
+  return isfinite(v) ? c3(v, v, v) : c3(0, 0, 0);
+}
+static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+  vec3 wm;
+  float etap;
+  if (!rd_half(b, wo, wi, &wm, &etap)) return 0;
+  float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;
+  float pdf;
+  if (etap == 1) pdf = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm))) * R / (R + T);
+  else {
+    float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap);
+    pdf = ggx_D_visible(b->alpha, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
+  }
+  return isfinite(pdf) ? pdf : 0;
 }
 
 static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
@@ -44,6 +96,7 @@ static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
 }
 
 rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+  if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_eval(b, wo, wi);
   if (wo.z <= 0 || wi.z <= 0) return c3(0, 0, 0);
   switch (b->type) {
   case BSDF_DIFFUSE: return c3_scale(b->kd, INV_PI_F);
@@ -53,19 +106,31 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
     float lobe = ca > 0 ? (b->exponent + 2) * (0.5f * INV_PI_F) * powf(ca, b->exponent) : 0;
     return c3_add(c3_scale(b->kd, INV_PI_F), c3_scale(b->ks, lobe));
   }
-  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return c3(0, 0, 0);
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: return c3(0, 0, 0);
+  case BSDF_ROUGH_CONDUCTOR: {
+    vec3 wm = v3_norm(v3_add(wo, wi));
+    float dg = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
+    rgb F = fresnel_conductor(fabsf(v3_dot(wo, wm)), b->cond_eta, b->cond_k);
+    return isfinite(dg) ? c3_scale(F, dg) : c3(0, 0, 0);
+  }
   }
   return c3(0, 0, 0);
 }
 
 float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+  if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_pdf(b, wo, wi);
   if (wo.z <= 0 || wi.z <= 0) return 0;
   switch (b->type) {
   case BSDF_DIFFUSE: return cosine_hemisphere_pdf(wi.z);
   case BSDF_MIRROR: return b->p_first * cosine_hemisphere_pdf(wi.z);
   case BSDF_PHONG:
     return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * phong_lobe_pdf(phong_cos_alpha(wo, wi), b->exponent);
-  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return 0;
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: return 0;
+  case BSDF_ROUGH_CONDUCTOR: {
+    vec3 wm = v3_norm(v3_add(wo, wi));
+    float p = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
+    return isfinite(p) ? p : 0;
+  }
   }
   return 0;
 }
@@ -123,6 +188,39 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     s->eta_scale = 1 / (etap * etap);
     s->weight = c3(s->eta_scale, s->eta_scale, s->eta_scale);
     return 1;
+  }
+  case BSDF_ROUGH_CONDUCTOR: {
+    if (wo.z <= 0) return 0;
+    vec3 wm = ggx_sample_visible(b->alpha, wo, u1, u2);
+    s->wi = v3_reflect(wo, wm);
+    if (s->wi.z <= 0) return 0;
+    s->pdf = bsdf_pdf(b, wo, s->wi);
+    if (!(s->pdf > 0)) return 0;
+    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
+    return c3_finite(s->weight);
+  }
+  case BSDF_ROUGH_DIELECTRIC: {
+    if (wo.z == 0) return 0;
+    vec3 wm = ggx_sample_visible(b->alpha, wo, u1, u2);
+    float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;
+    if (ulobe < R / (R + T)) {
+      s->wi = v3_reflect(wo, wm);
+      if (s->wi.z * wo.z <= 0) return 0;
+    } else {
+      /* Refract wo about the microfacet normal turned to wo's side; seen from inside,
+       * the relative index is 1/eta. */
+      int inside = v3_dot(wo, wm) < 0;
+      vec3 n = inside ? v3_neg(wm) : wm;
+      float etap = inside ? 1 / b->eta : b->eta;
+      if (!refract_dir(wo, n, etap, &s->wi)) return 0;
+      if (s->wi.z * wo.z >= 0) return 0;
+      s->eta_scale = 1 / (etap * etap);
+    }
+    s->pdf = bsdf_pdf(b, wo, s->wi);
+    if (!(s->pdf > 0)) return 0;
+    rgb f = bsdf_eval(b, wo, s->wi);
+    s->weight = c3_scale(f, fabsf(s->wi.z) / s->pdf);
+    return c3_finite(s->weight);
   }
   }
   return 0;

@@ -8,7 +8,10 @@
 #include "core/vec.h"
 #include "scene/scene.h"
 
-typedef enum bsdf_type { BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR } bsdf_type;
+typedef enum bsdf_type {
+  BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR,
+  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC
+} bsdf_type;
 
 typedef struct bsdf {
   bsdf_type type;
@@ -17,6 +20,7 @@ typedef struct bsdf {
   float eta;          /* dielectric: interior index / exterior index */
   rgb cond_eta, cond_k;
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
+  float alpha;        /* GGX roughness (rough types) */
 } bsdf;
 
 typedef struct bsdf_sample {
@@ -40,5 +44,5 @@ int bsdf_has_smooth(const bsdf *b);
  * reflectance at cos_o for conductors, white for glass. */
 rgb material_albedo(const material *m, float cos_o);
 /* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
-static inline int bsdf_transmits(const bsdf *b) { return b->type == BSDF_DIELECTRIC; }
+static inline int bsdf_transmits(const bsdf *b) { return b->type == BSDF_DIELECTRIC || b->type == BSDF_ROUGH_DIELECTRIC; }
 #endif

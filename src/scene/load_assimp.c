@@ -147,6 +147,24 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
   /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */
+  /* glTF metallic-roughness (docs/scene-format.md): a metal (metallic >= 0.5, no
+   * per-texel metallic map) becomes a GGX conductor whose Fresnel term has F0 = base
+   * colour (eta = (1 + sqrt F0) / (1 - sqrt F0), k = 0) and alpha = roughness^2;
+   * anything else stays Lambertian in its base colour. */
+  float metallic = ai_float(am, AI_MATKEY_METALLIC_FACTOR, -1);
+  if (metallic >= 0.5f && aiGetMaterialTextureCount(am, aiTextureType_METALNESS) == 0 &&
+      aiGetMaterialTextureCount(am, aiTextureType_UNKNOWN) == 0 && m->type == MAT_DIFFUSE) {
+    float f0[3] = {m->kd.r, m->kd.g, m->kd.b}, eta[3];
+    for (int c = 0; c < 3; c++) {
+      float r = sqrtf(clampf(f0[c], 0, 0.998f));
+      eta[c] = (1 + r) / (1 - r);
+    }
+    m->type = MAT_CONDUCTOR;
+    m->eta = c3(eta[0], eta[1], eta[2]);
+    m->k = c3(0, 0, 0);
+    m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
+    m->tex_kd = -1;
+  }
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
   struct aiString mode;

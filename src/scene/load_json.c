@@ -201,8 +201,8 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   static const char *const k_diffuse[] = {"type", "reflectance", "emission", "two_sided", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "emission", "two_sided", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "emission", "two_sided", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "emission", "two_sided", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "emission", "two_sided", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "roughness", "emission", "two_sided", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "emission", "two_sided", NULL};
   if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
@@ -244,6 +244,9 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   } else {
     return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor)");
   }
+  double rough = 0;
+  TRY(get_num(c, o, "roughness", where, 0, 1, &rough));
+  m->roughness = (float)rough;
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   TRY(get_bool(c, o, "two_sided", where, &m->two_sided));
   return VALO_OK;

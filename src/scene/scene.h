@@ -22,6 +22,7 @@ typedef struct material {
   float exponent;
   float ior;
   rgb eta, k;
+  float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
