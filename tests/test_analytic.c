@@ -294,6 +294,65 @@ static int thin_lens_circle_of_confusion(void) {
   return 0;
 }
 
+/* Adaptive sampling on the albedo-0.5 furnace: the budget is used exactly (to within a
+ * round), background pixels (zero variance) get no more than the first pass, sphere
+ * pixels get more, the image still shows 0.5 and 1, and a loose noise threshold stops
+ * after the first pass. */
+static int adaptive_sampling(void) {
+  char json[2048];
+  snprintf(json, sizeof json, furnace_fmt, 64, 0.5);
+  const char *path = scratch_file("adaptive.json", json);
+  for (int pass = 0; pass < 2; pass++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.adaptive = 1;
+    if (pass == 1) o.noise_threshold = 10;
+    valo_error err;
+    valo_scene *sc;
+    valo_render *r;
+    CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    char mp[1200], out[1300];
+    snprintf(mp, sizeof mp, "%s/spp%d.pfm", scratch_dir(), pass);
+    snprintf(out, sizeof out, "spp:%s", mp);
+    CHECK(valo_render_write(r, out, NULL, &err) == VALO_OK, "%s", err.message);
+    float px[32 * 32 * 3];
+    valo_render_pixels(r, px);
+    image cnt;
+    CHECK(image_read(mp, &cnt, &err) == VALO_OK, "%s", err.message);
+    double total = 0, sum[2] = {0, 0}, nsum[2] = {0, 0};
+    int n[2] = {0, 0};
+    float bg_max = 0;
+    for (int y = 0; y < 32; y++)
+      for (int x = 0; x < 32; x++) {
+        float c = cnt.rgb[3 * (y * 32 + x)];
+        total += c;
+        int k = classify(x, y);
+        if (k < 0) continue;
+        n[k]++;
+        nsum[k] += c;
+        sum[k] += (px[3 * (y * 32 + x)] + px[3 * (y * 32 + x) + 1] + px[3 * (y * 32 + x) + 2]) / 3;
+        if (k == 0 && c > bg_max) bg_max = c;
+      }
+    image_free(&cnt);
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+    fprintf(stderr, "%s: %.0f samples (budget %d), background max %.0f per pixel, sphere mean %.1f; sphere %.4f, background %.4f\n",
+            pass ? "threshold 10" : "budget", total, 64 * 32 * 32, bg_max, nsum[1] / n[1], sum[1] / n[1], sum[0] / n[0]);
+    if (pass == 0) {
+      CHECK(fabs(total - 64 * 32 * 32) < 8, "used %.0f samples of a budget of %d", total, 64 * 32 * 32);
+      CHECK(bg_max == 8, "zero-variance background pixels got %.0f samples, expected only the first pass's 8", bg_max);
+      CHECK(nsum[1] / n[1] > 64, "sphere pixels average %.1f samples, expected more than the mean 64", nsum[1] / n[1]);
+      CHECK(fabs(sum[1] / n[1] - 0.5) < 0.01, "sphere mean %g", sum[1] / n[1]);
+    } else {
+      CHECK(total == 8 * 32 * 32, "a threshold every pixel meets should stop after the first pass (%.0f samples)", total);
+    }
+    CHECK(fabs(sum[0] / n[0] - 1) < 1e-5, "background %g", sum[0] / n[0]);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
                                     {"furnace_albedo_half", furnace_albedo_half},
@@ -305,6 +364,7 @@ int main(int argc, char **argv) {
                                     {"envmap_orientation", envmap_orientation},
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
+                                    {"adaptive_sampling", adaptive_sampling},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -98,7 +98,26 @@ static int exr_bytes_identical(void) {
   return 0;
 }
 
+/* Adaptive sampling decides between rounds from deterministic sums: still identical. */
+static int adaptive_threads_identical(void) {
+  float *px[3];
+  int w, h, threads[3] = {1, 2, 7};
+  for (int i = 0; i < 3; i++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.threads = threads[i];
+    o.adaptive = 1;
+    px[i] = render_json_text(scene_json, &o, &w, &h);
+    CHECK(px[i], "render failed");
+  }
+  size_t n = (size_t)w * h * 3 * sizeof(float);
+  CHECK(memcmp(px[0], px[1], n) == 0 && memcmp(px[0], px[2], n) == 0, "adaptive renders differ between thread counts");
+  for (int i = 0; i < 3; i++) free(px[i]);
+  return 0;
+}
+
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"exr_bytes_identical", exr_bytes_identical}, {NULL, NULL}};
+  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"exr_bytes_identical", exr_bytes_identical},
+                                    {"adaptive_threads_identical", adaptive_threads_identical}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

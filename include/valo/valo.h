@@ -57,6 +57,10 @@ typedef struct valo_options {
   char accel[16];         /* "kdtree" (default) or "embree" */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
                              valo_render_write can then write; VALO_UNSET = no */
+  int adaptive;           /* non-zero: adaptive sampling (docs/integrators.md): spp is then
+                             the average budget per pixel; VALO_UNSET = no */
+  double noise_threshold; /* adaptive: stop when every pixel's relative standard error is
+                             below this (e.g. 0.01); VALO_UNSET or <= 0: use the budget */
 } valo_options;
 
 /* Sets every field of `o` to "unset". */
@@ -118,7 +122,8 @@ VALO_API void valo_output_options_init(valo_output_options *o);
  * and renamed, so a reader never sees a partial file. A prefix "albedo:", "normal:" or
  * "depth:" writes that AOV instead (the render must have been created with aovs set):
  * the first camera hit's albedo, its shading normal (world space, facing the camera)
- * and its distance from the camera (0 where the ray escaped), averaged over samples. */
+ * and its distance from the camera (0 where the ray escaped), averaged over samples.
+ * "spp:" writes the number of samples each pixel received (in all three channels). */
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
                                        const valo_output_options *o, valo_error *err);
 /* Copies the linear RGB film (width*height*3 floats, row-major, top row first). */

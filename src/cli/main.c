@@ -45,7 +45,8 @@ static void usage_render(FILE *f) {
           "Options override the scene file:\n"
           "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
           "                         repeat for several outputs (default: SCENE-NAME.png);\n"
-          "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs\n"
+          "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs,\n"
+          "                         spp:FILE the samples each pixel received\n"
           "  --spp N                samples per pixel (default 16)\n"
           "  --time SECONDS         time budget: stop after the pass that reaches it\n"
           "                         (with --spp, whichever comes first)\n"
@@ -58,6 +59,10 @@ static void usage_render(FILE *f) {
           " (default path)\n"
           "  --accel NAME           kdtree (default) or embree\n"
           "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
+          "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
+          "                         noisiest pixels get more (spp:FILE writes the count map)\n"
+          "  --noise-threshold X    with --adaptive: stop once every pixel's relative\n"
+          "                         standard error is below X (e.g. 0.01)\n"
           "  --exposure STOPS       PNG exposure (default 0)\n"
           "  --tonemap NAME         PNG tone curve: clamp (default), log, reinhard, aces\n"
           "  --bloom STRENGTH       PNG bloom: add STRENGTH x a Gaussian blur of what exceeds 1\n"
@@ -185,6 +190,12 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_int(val, -1, 100000, &lv)) BAD_VALUE("-1 or a whole number >= 0");
       opt.max_depth = (int)lv;
+    } else if (!strcmp(a, "--adaptive")) {
+      opt.adaptive = 1;
+    } else if (!strcmp(a, "--noise-threshold")) {
+      NEED_VALUE();
+      if (parse_double(val, 1e-6, 10, &dv)) BAD_VALUE("a relative error, 1e-6..10");
+      opt.noise_threshold = dv;
     } else if (!strcmp(a, "--exposure")) {
       NEED_VALUE();
       if (parse_double(val, -100, 100, &dv)) BAD_VALUE("stops, -100..100");

@@ -36,6 +36,8 @@ struct valo_render {
   accel_filter alpha_filter;
   double *sum;            /* 3 doubles per pixel */
   float *aov;             /* 7 floats per pixel (albedo rgb, normal xyz, depth) summed, or NULL */
+  uint32_t *count;        /* samples per pixel */
+  double *lum;            /* adaptive: per pixel sum of luminance and of its square */
   int spp_done;
   double build_seconds, render_seconds;
   uint64_t rays, bad_samples;
@@ -61,6 +63,8 @@ VALO_API void valo_options_init(valo_options *o) {
   o->time_budget = VALO_UNSET;
   o->seed = VALO_UNSET;
   o->aovs = VALO_UNSET;
+  o->adaptive = VALO_UNSET;
+  o->noise_threshold = VALO_UNSET;
   o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
 }
 
@@ -114,6 +118,8 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->integrator[0]) memcpy(dst->integrator, o->integrator, sizeof dst->integrator);
     if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
     if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
+    if (o->adaptive != VALO_UNSET) dst->adaptive = o->adaptive;
+    if (o->noise_threshold != VALO_UNSET) dst->noise_threshold = o->noise_threshold;
   }
   if (dst->width == VALO_UNSET) dst->width = 256;
   if (dst->height == VALO_UNSET) dst->height = 256;
@@ -121,6 +127,8 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
   if (dst->threads == VALO_UNSET || dst->threads == 0) dst->threads = threads_available();
   if (dst->seed == VALO_UNSET) dst->seed = 1;
   if (dst->aovs == VALO_UNSET) dst->aovs = 0;
+  if (dst->adaptive == VALO_UNSET) dst->adaptive = 0;
+  if (dst->noise_threshold == VALO_UNSET) dst->noise_threshold = 0;
   if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
@@ -154,7 +162,12 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   atomic_init(&r->cancel, 0);
   r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
   if (o.aovs) r->aov = calloc((size_t)o.width * o.height * 7, sizeof(float));
-  if (!r->sum || (o.aovs && !r->aov)) { free(r->sum); free(r->aov); free(r); return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height); }
+  r->count = calloc((size_t)o.width * o.height, sizeof(uint32_t));
+  if (o.adaptive) r->lum = calloc((size_t)o.width * o.height * 2, sizeof(double));
+  if (!r->sum || (o.aovs && !r->aov) || !r->count || (o.adaptive && !r->lum)) {
+    free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r);
+    return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
+  }
   double t0 = now_seconds();
   int any_alpha = 0;
   for (uint32_t t = 0; t < s->ntris && !any_alpha; t++) any_alpha = (s->tri_flags[t] & TRI_ALPHA) != 0;
@@ -163,7 +176,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->alpha_filter.tri_flags = s->tri_flags;
   r->alpha_filter.flag_bit = TRI_ALPHA;
   valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &r->alpha_filter : NULL, &r->acc, err);
-  if (st) { free(r->sum); free(r->aov); free(r); return st; }
+  if (st) { free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
   if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   r->ctx.s = s;
@@ -234,6 +247,27 @@ typedef struct pass_job {
   thread_stats *ts;    /* one per thread */
 } pass_job;
 
+/* Takes samples [s0, s1) of pixel (x, y) in order. */
+static void sample_pixel(valo_render *r, int x, int y, int s0, int s1, thread_stats *ts) {
+  uint64_t pix = (uint64_t)y * (uint64_t)r->opt.width + (uint64_t)x;
+  double *acc = &r->sum[3 * pix];
+  for (int si = s0; si < s1; si++) {
+    sampler smp = sampler_make((uint64_t)r->opt.seed, pix, (uint64_t)si);
+    ray ry = camera_ray(r, x, y, &smp);
+    ts->rays++;
+    if (r->aov) record_aovs(r, ry, &r->aov[7 * pix], ts);
+    rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
+    r->count[pix]++;
+    if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
+    acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
+    if (r->lum) {
+      double l = c3_lum(L);
+      r->lum[2 * pix] += l;
+      r->lum[2 * pix + 1] += l * l;
+    }
+  }
+}
+
 static void render_tile(void *user, int64_t item, int thread) {
   pass_job *j = user;
   valo_render *r = j->r;
@@ -244,19 +278,42 @@ static void render_tile(void *user, int64_t item, int thread) {
   int x1 = x0 + TILE < r->opt.width ? x0 + TILE : r->opt.width;
   int y1 = y0 + TILE < r->opt.height ? y0 + TILE : r->opt.height;
   for (int y = y0; y < y1; y++)
-    for (int x = x0; x < x1; x++) {
-      uint64_t pix = (uint64_t)y * (uint64_t)r->opt.width + (uint64_t)x;
-      double *acc = &r->sum[3 * pix];
-      for (int si = j->s0; si < j->s1; si++) {
-        sampler smp = sampler_make((uint64_t)r->opt.seed, pix, (uint64_t)si);
-        ray ry = camera_ray(r, x, y, &smp);
-        ts->rays++;
-        if (r->aov) record_aovs(r, ry, &r->aov[7 * pix], ts);
-        rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
-        if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
-        acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
-      }
-    }
+    for (int x = x0; x < x1; x++) sample_pixel(r, x, y, j->s0, j->s1, ts);
+}
+
+/* ---- adaptive sampling (digest 000): after a uniform first pass, rounds give
+ * ADAPT_BATCH more samples to the 1/ADAPT_FRACTION of pixels whose mean has the largest
+ * relative variance, (N sum s^2 / (sum s)^2 - 1) / N in luminance — the digest's
+ * priority N sum s^2/(sum s)^2, minus 1 and over N so that it falls as a pixel gets
+ * samples. Selection happens between rounds from deterministic sums, ties by index. */
+#define ADAPT_BATCH 8
+#define ADAPT_FRACTION 8
+
+static double pixel_priority(const valo_render *r, size_t i) {
+  double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
+  if (n < 2 || !(s > 0)) return 0;
+  double rel = (n * s2 / (s * s) - 1) / n;
+  return rel > 0 ? rel : 0;
+}
+
+typedef struct prio { double p; uint32_t i; } prio;
+static int prio_cmp(const void *a, const void *b) {
+  const prio *x = a, *y = b;
+  if (x->p != y->p) return x->p < y->p ? 1 : -1;
+  return x->i < y->i ? -1 : (x->i > y->i);
+}
+
+typedef struct adapt_job { valo_render *r; const prio *sel; int64_t n; thread_stats *ts; } adapt_job;
+static void adapt_chunk(void *user, int64_t item, int thread) {
+  adapt_job *j = user;
+  if (atomic_load_explicit(&j->r->cancel, memory_order_relaxed)) return;
+  int64_t lo = item * 64, hi = lo + 64 < j->n ? lo + 64 : j->n;
+  for (int64_t k = lo; k < hi; k++) {
+    uint32_t pix = j->sel[k].i;
+    int x = (int)(pix % (uint32_t)j->r->opt.width), y = (int)(pix / (uint32_t)j->r->opt.width);
+    int c = (int)j->r->count[pix];
+    sample_pixel(j->r, x, y, c, c + ADAPT_BATCH, &j->ts[thread]);
+  }
 }
 
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
@@ -269,10 +326,15 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
   double budget = r->opt.time_budget > 0 ? r->opt.time_budget : 0;
   int pass_spp = 1;
   valo_status st = VALO_OK;
+  int uniform_spp = r->opt.spp;
+  if (r->opt.adaptive) {
+    uniform_spp = r->opt.spp / 8;
+    if (uniform_spp < 4) uniform_spp = r->opt.spp < 4 ? r->opt.spp : 4;
+  }
   /* Passes grow until one takes about a second, so progress stays lively. */
-  while (r->spp_done < r->opt.spp) {
+  while (r->spp_done < uniform_spp) {
     int n = pass_spp;
-    if (r->spp_done + n > r->opt.spp) n = r->opt.spp - r->spp_done;
+    if (r->spp_done + n > uniform_spp) n = uniform_spp - r->spp_done;
     pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
     double p0 = now_seconds();
     parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
@@ -281,6 +343,8 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
       /* A cancelled pass is partial: the film keeps whole passes only. */
       memset(r->sum, 0, (size_t)r->opt.width * r->opt.height * 3 * sizeof(double));
       if (r->aov) memset(r->aov, 0, (size_t)r->opt.width * r->opt.height * 7 * sizeof(float));
+      memset(r->count, 0, (size_t)r->opt.width * r->opt.height * sizeof(uint32_t));
+      if (r->lum) memset(r->lum, 0, (size_t)r->opt.width * r->opt.height * 2 * sizeof(double));
       r->spp_done = 0;
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled");
       break;
@@ -288,10 +352,39 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     r->spp_done += n;
     double el = now_seconds() - t0;
     double frac = (double)r->spp_done / r->opt.spp;
+    if (r->opt.adaptive) frac *= (double)uniform_spp / r->opt.spp;
     if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
     if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
     if (budget > 0 && el >= budget) break;
     if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
+  }
+  if (r->opt.adaptive && st == VALO_OK && !(budget > 0 && now_seconds() - t0 >= budget)) {
+    size_t np = (size_t)r->opt.width * r->opt.height;
+    double total = (double)r->opt.spp * (double)np, taken = (double)uniform_spp * (double)np;
+    prio *pr = malloc(np * sizeof *pr);
+    if (!pr) { free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+    size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
+    double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
+    while (taken < total) {
+      for (size_t i = 0; i < np; i++) { pr[i].p = pixel_priority(r, i); pr[i].i = (uint32_t)i; }
+      qsort(pr, np, sizeof *pr, prio_cmp);
+      if (!(pr[0].p > thr2)) break; /* every pixel below the noise threshold */
+      size_t sel = k;
+      if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
+      if (sel == 0) break;
+      while (sel > 0 && !(pr[sel - 1].p > thr2)) sel--;
+      adapt_job aj = {r, pr, (int64_t)sel, ts};
+      parallel_for(threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
+      if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+      taken += (double)sel * ADAPT_BATCH;
+      double el = now_seconds() - t0;
+      double frac = taken / total;
+      if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+      if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+      if (budget > 0 && el >= budget) break;
+    }
+    r->spp_done = (int)(taken / (double)np);
+    free(pr);
   }
   r->render_seconds += now_seconds() - t0;
   for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
@@ -317,9 +410,11 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
 }
 
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) {
-  size_t n = (size_t)r->opt.width * r->opt.height * 3;
-  double inv = r->spp_done > 0 ? 1.0 / r->spp_done : 0;
-  for (size_t i = 0; i < n; i++) rgb_out[i] = (float)(r->sum[i] * inv);
+  size_t n = (size_t)r->opt.width * r->opt.height;
+  for (size_t i = 0; i < n; i++) {
+    double inv = r->count[i] > 0 ? 1.0 / r->count[i] : 0;
+    for (int c = 0; c < 3; c++) rgb_out[3 * i + c] = (float)(r->sum[3 * i + c] * inv);
+  }
 }
 
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {
@@ -327,6 +422,17 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
   valo_output_options def;
   valo_output_options_init(&def);
   if (!o) o = &def;
+  if (!strncmp(path, "spp:", 4)) {
+    size_t np = (size_t)r->opt.width * r->opt.height;
+    float *px = malloc(np * 3 * sizeof(float));
+    if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < np; i++) px[3 * i] = px[3 * i + 1] = px[3 * i + 2] = (float)r->count[i];
+    valo_output_options raw = *o;
+    raw.bloom = 0;
+    valo_status st = image_write(path + 4, r->opt.width, r->opt.height, px, &raw, err);
+    free(px);
+    return st;
+  }
   static const char *const aov_names[3] = {"albedo:", "normal:", "depth:"};
   for (int k = 0; k < 3; k++) {
     size_t n = strlen(aov_names[k]);
@@ -335,9 +441,10 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
     size_t np = (size_t)r->opt.width * r->opt.height;
     float *px = malloc(np * 3 * sizeof(float));
     if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-    float inv = r->spp_done > 0 ? 1.0f / (float)r->spp_done : 0;
-    for (size_t i = 0; i < np; i++)
+    for (size_t i = 0; i < np; i++) {
+      float inv = r->count[i] > 0 ? 1.0f / (float)r->count[i] : 0;
       for (int c = 0; c < 3; c++) px[3 * i + c] = (k == 2 ? r->aov[7 * i + 6] : r->aov[7 * i + 3 * k + c]) * inv;
+    }
     valo_output_options raw = *o;
     raw.bloom = 0;
     valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, &raw, err);
@@ -360,5 +467,7 @@ VALO_API void valo_render_destroy(valo_render *r) {
   light_sampler_free(&r->ctx.ls);
   free(r->sum);
   free(r->aov);
+  free(r->count);
+  free(r->lum);
   free(r);
 }
