@@ -33,6 +33,23 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   }
   it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
   it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+  if (it->m->tex_normal >= 0 && s->tan && (s->tri_flags[h->tri] & TRI_HAS_UVS)) {
+    /* Tangent-space normal map: n = 2 rgb - 1 in the (T, B, N) frame at the hit. */
+    const float *t0 = &s->tan[4 * ix[0]], *t1 = &s->tan[4 * ix[1]], *t2 = &s->tan[4 * ix[2]];
+    vec3 T = v3(b0 * t0[0] + h->b1 * t1[0] + h->b2 * t2[0], b0 * t0[1] + h->b1 * t1[1] + h->b2 * t2[1],
+                b0 * t0[2] + h->b1 * t1[2] + h->b2 * t2[2]);
+    vec3 N = it->ns;
+    T = v3_sub(T, v3_scale(N, v3_dot(N, T)));
+    if (v3_len2(T) > 1e-12f) {
+      T = v3_norm(T);
+      vec3 B = v3_scale(v3_cross(N, T), t0[3]);
+      float px[4];
+      texture_lookup(&s->tex[it->m->tex_normal], it->u, it->v, px);
+      vec3 nm = v3(2 * px[0] - 1, 2 * px[1] - 1, 2 * px[2] - 1);
+      vec3 n2 = v3_add(v3_add(v3_scale(T, nm.x), v3_scale(B, nm.y)), v3_scale(N, nm.z));
+      if (v3_len2(n2) > 1e-12f && v3_finite(n2)) it->ns = v3_norm(n2);
+    }
+  }
 }
 
 bsdf bsdf_at(const scene *s, const isect *it) {

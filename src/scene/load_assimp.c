@@ -133,7 +133,7 @@ static material convert_material(const struct aiMaterial *am) {
   else m.type = MAT_DIFFUSE;
   if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
-  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = -1;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = -1;
   m.alpha_cutoff = 0.5f;
   return m;
 }
@@ -144,6 +144,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
   if (m->tex_kd >= 0) s->tex[m->tex_kd].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
+  m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, dir, 0, NULL);
   m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
   /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */

@@ -198,11 +198,11 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   if (!type) return bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "emission", "two_sided", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "emission", "two_sided", NULL};
-  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "emission", "two_sided", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "roughness", "emission", "two_sided", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "emission", "two_sided", NULL};
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "roughness", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", NULL};
   if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
@@ -243,6 +243,18 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     TRY(get_rgb(c, o, "k", where, &m->k));
   } else {
     return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor)");
+  }
+  const char *nmap = NULL;
+  TRY(get_str(c, o, "normal_map", where, &nmap));
+  if (nmap) {
+    char full[2048];
+    resolve_path(c, nmap, full, sizeof full);
+    m->tex_normal = scene_texture_file(c->s, full, 0);
+    if (m->tex_normal < 0) {
+      char w[300];
+      snprintf(w, sizeof w, "%s.normal_map", where);
+      return bad(c, w, "cannot read the normal map");
+    }
   }
   double rough = 0;
   TRY(get_num(c, o, "roughness", where, 0, 1, &rough));

@@ -18,7 +18,7 @@ scene *scene_new(const char *path) {
 
 void scene_free(scene *s) {
   if (!s) return;
-  free(s->pos); free(s->nrm); free(s->uv); free(s->idx); free(s->tri_mat); free(s->tri_flags);
+  free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light);
   if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
@@ -66,7 +66,7 @@ material material_default(void) {
   m.kd = c3(0.8f, 0.8f, 0.8f);
   m.exponent = 1;
   m.ior = 1.5f;
-  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = -1;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = -1;
   m.alpha_cutoff = 0.5f;
   snprintf(m.name, sizeof m.name, "default");
   return m;
@@ -134,6 +134,47 @@ int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2) {
   return (m->alpha_channel ? px[3] : px[0]) >= m->alpha_cutoff;
 }
 
+/* Per-vertex tangents from UV derivatives (dp/du), accumulated area-weighted over the
+ * triangles that share a vertex and made orthogonal to the vertex normal (digest 000);
+ * the sign of the bitangent follows the UV handedness. */
+static int compute_tangents(scene *s) {
+  float *acc = calloc((size_t)s->nverts * 7, sizeof(float)); /* t xyz, b xyz, count */
+  s->tan = malloc((size_t)s->nverts * 4 * sizeof(float));
+  if (!acc || !s->tan) { free(acc); free(s->tan); s->tan = NULL; return -1; }
+  for (uint32_t t = 0; t < s->ntris; t++) {
+    if (!(s->tri_flags[t] & TRI_HAS_UVS) || s->mats[s->tri_mat[t]].tex_normal < 0) continue;
+    const uint32_t *ix = &s->idx[3 * t];
+    vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
+    float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
+    float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
+    float det = du1 * dv2 - du2 * dv1;
+    if (!(fabsf(det) > 1e-12f)) continue;
+    float r = 1 / det;
+    /* Unnormalised dp/du and dp/dv; their length carries the area weighting. */
+    vec3 tu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), r);
+    vec3 tv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), r);
+    float area = 0.5f * v3_len(v3_cross(e1, e2));
+    tu = v3_scale(v3_norm(tu), area);
+    tv = v3_scale(v3_norm(tv), area);
+    for (int k = 0; k < 3; k++) {
+      float *a = &acc[7 * ix[k]];
+      a[0] += tu.x; a[1] += tu.y; a[2] += tu.z; a[3] += tv.x; a[4] += tv.y; a[5] += tv.z; a[6] += 1;
+    }
+  }
+  for (uint32_t v = 0; v < s->nverts; v++) {
+    const float *a = &acc[7 * v];
+    vec3 n = s->nrm[v], t = v3(a[0], a[1], a[2]), b = v3(a[3], a[4], a[5]);
+    float *o = &s->tan[4 * v];
+    if (!(v3_len2(n) > 0) || !(v3_len2(t) > 0)) { o[0] = o[1] = o[2] = 0; o[3] = 1; continue; }
+    t = v3_sub(t, v3_scale(n, v3_dot(n, t)));
+    t = v3_norm(t);
+    o[0] = t.x; o[1] = t.y; o[2] = t.z;
+    o[3] = v3_dot(v3_cross(n, t), b) < 0 ? -1.0f : 1.0f;
+  }
+  free(acc);
+  return 0;
+}
+
 valo_status scene_commit(scene *s, valo_error *err) {
   if (s->ntris == 0 && s->nlights == 0 && !s->has_env)
     return err_set(err, VALO_ERR_INVALID, "%s: the scene has no geometry and no lights", s->path);
@@ -166,6 +207,20 @@ valo_status scene_commit(scene *s, valo_error *err) {
     if (!(l.area > 0)) continue;
     s->tri_light[t] = (int32_t)s->nlights;
     if (scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  }
+  int any_normal_map = 0;
+  for (uint32_t m = 0; m < s->nmats; m++) any_normal_map |= s->mats[m].tex_normal >= 0;
+  if (any_normal_map) {
+    /* Triangles without vertex normals get their geometric normal at their vertices. */
+    for (uint32_t t = 0; t < s->ntris; t++) {
+      if (s->tri_flags[t] & TRI_HAS_NORMALS) continue;
+      if (s->mats[s->tri_mat[t]].tex_normal < 0) continue;
+      vec3 n = v3_norm(scene_tri_ng(s, t));
+      for (int k = 0; k < 3; k++) if (!(v3_len2(s->nrm[s->idx[3 * t + k]]) > 0)) s->nrm[s->idx[3 * t + k]] = n;
+    }
+    free(s->tan);
+    s->tan = NULL;
+    if (compute_tangents(s)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   }
   if (s->has_env) {
     light l;

@@ -27,6 +27,7 @@ typedef struct material {
   int two_sided;     /* emission on both sides */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
   int tex_alpha;     /* alpha-cutout texture, -1 = none */
+  int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
   char name[64];
@@ -57,6 +58,8 @@ typedef struct scene {
   char path[1024];
   /* geometry */
   vec3 *pos, *nrm;         /* per vertex; nrm may hold zeros where the file had none */
+  float *tan;              /* 4 per vertex (tangent xyz, bitangent sign), after commit when
+                              a material has a normal map; else NULL */
   float *uv;               /* 2 per vertex */
   uint32_t nverts, cap_verts;
   uint32_t *idx;           /* 3 per triangle */
