@@ -137,6 +137,20 @@ static int index_out_of_range(void) {
   return 0;
 }
 
+/* PLY: an out-of-range face index, and triangle strips (which Assimp would misread as one
+ * polygon without complaint). */
+static int bad_ply(void) {
+  const char *p = write_file("badidx.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  EXPECT_FAIL(1, "render", p, "-o", "x.png");
+  SAID("badidx.ply"); SAID("out of range"); NO_SANITIZER();
+  p = write_file("strip.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                              "element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n");
+  EXPECT_FAIL(1, "render", p, "-o", "x.png");
+  SAID("strip.ply"); SAID("strips"); NO_SANITIZER();
+  return 0;
+}
+
 static int nan_vertices(void) {
   const char *p = write_file("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
   EXPECT_FAIL(1, "render", p, "-o", "x.png");
@@ -245,6 +259,7 @@ int main(int argc, char **argv) {
                                     {"unsupported_format", unsupported_format},
                                     {"index_out_of_range", index_out_of_range},
                                     {"nan_vertices", nan_vertices},
+                                    {"bad_ply", bad_ply},
                                     {"degenerate_triangles", degenerate_triangles},
                                     {"absurd_resolution", absurd_resolution},
                                     {"absurd_sample_count", absurd_sample_count},

@@ -331,10 +331,26 @@ static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
   return VALO_OK;
 }
 
+/* Assimp reads a PLY made of triangle strips (as some Stanford scans are stored) as one
+ * bogus polygon without an error: look at the header ourselves. */
+static int ply_has_tristrips(FILE *f) {
+  char line[512];
+  int n = 0;
+  if (!fgets(line, sizeof line, f) || strncmp(line, "ply", 3)) return 0;
+  while (n++ < 200 && fgets(line, sizeof line, f)) {
+    if (!strncmp(line, "end_header", 10)) break;
+    if (!strncmp(line, "element tristrips", 17)) return 1;
+  }
+  return 0;
+}
+
 valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_error *err) {
   FILE *f = fopen(path, "rb");
   if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  int strips = ply_has_tristrips(f);
   fclose(f);
+  if (strips)
+    return err_set(err, VALO_ERR_UNSUPPORTED, "%s: PLY triangle strips (element tristrips) are not supported; convert the mesh to faces", path);
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
   const struct aiScene *ai = aiImportFile(path, flags);
   if (!ai) {
