@@ -61,6 +61,8 @@ typedef struct valo_options {
                              the average budget per pixel; VALO_UNSET = no */
   double noise_threshold; /* adaptive: stop when every pixel's relative standard error is
                              below this (e.g. 0.01); VALO_UNSET or <= 0: use the budget */
+  int spectral;           /* non-zero: spectral rendering (path integrator only): hero
+                             wavelength + 3, dispersion; VALO_UNSET = RGB */
 } valo_options;
 
 /* Sets every field of `o` to "unset". */

@@ -59,6 +59,7 @@ static void usage_render(FILE *f) {
           " (default path)\n"
           "  --accel NAME           kdtree (default) or embree\n"
           "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
+          "  --spectral             spectral rendering (path): 4 wavelengths per path, dispersion\n"
           "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
           "                         noisiest pixels get more (spp:FILE writes the count map)\n"
           "  --noise-threshold X    with --adaptive: stop once every pixel's relative\n"
@@ -190,6 +191,8 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_int(val, -1, 100000, &lv)) BAD_VALUE("-1 or a whole number >= 0");
       opt.max_depth = (int)lv;
+    } else if (!strcmp(a, "--spectral")) {
+      opt.spectral = 1;
     } else if (!strcmp(a, "--adaptive")) {
       opt.adaptive = 1;
     } else if (!strcmp(a, "--noise-threshold")) {

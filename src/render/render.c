@@ -26,6 +26,7 @@
 #define MAX_PIXEL_SAMPLES 4.0e12
 
 struct valo_scene { scene *s; };
+extern const integrator_ops integrator_path_spectral;
 
 struct valo_render {
   const scene *s;
@@ -65,6 +66,7 @@ VALO_API void valo_options_init(valo_options *o) {
   o->aovs = VALO_UNSET;
   o->adaptive = VALO_UNSET;
   o->noise_threshold = VALO_UNSET;
+  o->spectral = VALO_UNSET;
   o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
 }
 
@@ -120,6 +122,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
     if (o->adaptive != VALO_UNSET) dst->adaptive = o->adaptive;
     if (o->noise_threshold != VALO_UNSET) dst->noise_threshold = o->noise_threshold;
+    if (o->spectral != VALO_UNSET) dst->spectral = o->spectral;
   }
   if (dst->width == VALO_UNSET) dst->width = 256;
   if (dst->height == VALO_UNSET) dst->height = 256;
@@ -129,6 +132,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
   if (dst->aovs == VALO_UNSET) dst->aovs = 0;
   if (dst->adaptive == VALO_UNSET) dst->adaptive = 0;
   if (dst->noise_threshold == VALO_UNSET) dst->noise_threshold = 0;
+  if (dst->spectral == VALO_UNSET) dst->spectral = 0;
   if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
@@ -153,6 +157,10 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     char list[256] = "";
     for (const char *const *n = valo_integrator_names(); *n; n++) { strncat(list, " ", sizeof list - strlen(list) - 1); strncat(list, *n, sizeof list - strlen(list) - 1); }
     return err_set(err, VALO_ERR_INVALID, "unknown integrator \"%s\" (available:%s)", o.integrator, list);
+  }
+  if (o.spectral) {
+    if (strcmp(o.integrator, "path")) return err_set(err, VALO_ERR_UNSUPPORTED, "spectral mode works with the path integrator only");
+    integ = &integrator_path_spectral;
   }
   valo_render *r = calloc(1, sizeof *r);
   if (!r) return err_set(err, VALO_ERR_NOMEM, "out of memory");

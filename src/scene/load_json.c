@@ -5,6 +5,7 @@
 #include "scene/scene.h"
 #include "core/error.h"
 #include "light/envmap.h"
+#include "core/spectrum.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <limits.h>
@@ -201,7 +202,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "roughness", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", NULL};
   if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
@@ -228,6 +229,14 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     double ior = 1.5;
     TRY(get_num(c, o, "ior", where, 1.0, 10.0, &ior));
     m->ior = (float)ior;
+    const char *disp = NULL;
+    TRY(get_str(c, o, "dispersion", where, &disp));
+    if (disp) {
+      dispersion d;
+      if (dispersion_parse(disp, &d)) return bad(c, where, "unknown dispersion (fused_silica, sapphire, water, cauchy_glass)");
+      m->dispersion = (int)d;
+      m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
+    }
   } else if (!strcmp(type, "conductor")) {
     TRY(check_keys(c, o, where, k_conductor));
     m->type = MAT_CONDUCTOR;

@@ -23,6 +23,7 @@ typedef struct material {
   float ior;
   rgb eta, k;
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
+  int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
