@@ -78,37 +78,46 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return accel_occluded(c->acc, &r);
 }
 
-static rgb direct_impl(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                       thread_stats *ts, int mis) {
+int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                  thread_stats *ts, int mis, direct_sample *out) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
-  if (c->ls.table.n == 0) return c3(0, 0, 0);
+  if (c->ls.table.n == 0) return 0;
   float pmf;
   uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
   const light *l = &c->s->lights[li];
   light_li ls;
-  if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return c3(0, 0, 0);
+  if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return 0;
   vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
   rgb f = bsdf_eval(b, wo_l, wi_l);
-  if (c3_black(f)) return c3(0, 0, 0);
+  if (c3_black(f)) return 0;
   /* Reflection vs transmission must agree between the shading frame and the true
    * surface (no leaks through shading normals). */
   int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(ls.wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) return c3(0, 0, 0);
-  f = c3_scale(f, fabsf(wi_l.z));
-  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return c3(0, 0, 0);
+  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) return 0;
+  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return 0;
   float light_pdf = pmf * ls.pdf;
   float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
-  return c3_scale(c3_mul(f, ls.L), w / light_pdf);
+  out->f_cos = c3_scale(f, fabsf(wi_l.z));
+  out->Li = ls.L;
+  out->scale = w / light_pdf;
+  return 1;
+}
+
+static rgb direct_rgb(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                      thread_stats *ts, int mis) {
+  direct_sample d;
+  if (!sample_direct(c, it, b, fr, wo, smp, ts, mis, &d)) return c3(0, 0, 0);
+  return c3_scale(c3_mul(d.f_cos, d.Li), d.scale);
 }
 
 rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                     thread_stats *ts) {
-  return direct_impl(c, it, b, fr, wo, smp, ts, 1);
+  return direct_rgb(c, it, b, fr, wo, smp, ts, 1);
 }
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                           thread_stats *ts) {
-  return direct_impl(c, it, b, fr, wo, smp, ts, 0);
+  return direct_rgb(c, it, b, fr, wo, smp, ts, 0);
 }
 
 rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, const isect *it) {

@@ -65,6 +65,12 @@ static inline ray spawn_ray(const isect *it, vec3 d) {
  * (already faced for opaque BSDFs). */
 rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                     thread_stats *ts);
+/* The parts of one next-event sample, for integrators that multiply them their own way
+ * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
+ * Returns 0 when the sample contributes nothing. */
+typedef struct direct_sample { rgb f_cos, Li; float scale; } direct_sample;
+int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                  thread_stats *ts, int mis, direct_sample *out);
 /* The same estimate with weight 1 (light sampling alone): for integrators that never
  * count emission found by BSDF-sampled rays at non-specular vertices. */
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

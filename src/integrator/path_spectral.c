@@ -10,27 +10,13 @@
 #include "core/sampling.h"
 #include "core/spectrum.h"
 
-/* Spectral next-event estimation: f and Li upsampled separately, multiplied per
- * wavelength (as estimate_direct, whose product is per RGB channel). */
+/* Next-event estimation with f and Li upsampled separately and multiplied per
+ * wavelength (estimate_direct multiplies them per RGB channel). */
 static spec4 direct_spectral(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, const wavelengths *wl) {
-  float ul = sampler_1d(smp), u1, u2;
-  sampler_2d(smp, &u1, &u2);
-  if (c->ls.table.n == 0) return spec_const(0);
-  float pmf;
-  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
-  light_li ls;
-  if (!light_sample(c->s, &c->s->lights[li], it->p, u1, u2, &ls)) return spec_const(0);
-  vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
-  rgb f = bsdf_eval(b, wo_l, wi_l);
-  if (c3_black(f)) return spec_const(0);
-  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(ls.wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g) return spec_const(0);
-  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return spec_const(0);
-  float light_pdf = pmf * ls.pdf;
-  float w = ls.delta ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
-  spec4 r = spec_mul(spec_from_rgb(c3_scale(f, fabsf(wi_l.z)), wl), spec_from_rgb(ls.L, wl));
-  return spec_scale(r, w / light_pdf);
+  direct_sample d;
+  if (!sample_direct(c, it, b, fr, wo, smp, ts, 1, &d)) return spec_const(0);
+  return spec_scale(spec_mul(spec_from_rgb(d.f_cos, wl), spec_from_rgb(d.Li, wl)), d.scale);
 }
 
 static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
