@@ -3,7 +3,7 @@
  * build seconds, Mrays/s for closest-hit and for shadow (any-hit) queries, and the
  * kd/Embree ratio. Then the kd-tree build on the dragon's four resolutions (N log N
  * growth) with memory per triangle. Prints a Markdown table; scenes come from
- * ../shared/scenes (or VALO_SHARED). Usage: bench_raykernel [--quick] */
+ * ../shared/scenes (or VALO_SHARED). Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] */
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/offset.h"
@@ -141,7 +141,14 @@ static void bench_scene(const char *name, scene *s) {
 }
 
 int main(int argc, char **argv) {
-  int quick = argc > 1 && !strcmp(argv[1], "--quick");
+  int quick = 0, build_table = 1;
+  const char *only = NULL;
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--quick")) quick = 1;
+    else if (!strcmp(argv[i], "--no-build-table")) build_table = 0;
+    else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|cornell] [--no-build-table]\n"); return 2; }
+  }
   printf("## Ray kernel: kd-tree vs Embree %s (same rays; camera + 1 cosine bounce; 512x512)\n\n", embree_available() ? "3" : "(absent)");
   printf("| scene | triangles | kd build s | Embree build s | kd Mrays/s 1t / 2t | Embree Mrays/s 1t / 2t | kd/Embree 1t / 2t "
          "| kd shadow Mrays/s 1t / 2t | Embree shadow 1t / 2t | kd/Embree shadow 1t / 2t |\n");
@@ -149,12 +156,12 @@ int main(int argc, char **argv) {
   const char *meshes[4][2] = {{"bunny", "scenes/models/stanford-bunny.obj"}, {"nefertiti", "scenes/models/nefertiti.obj"},
                               {"dragon", "scenes/dragon/dragon_vrip.ply"}, {NULL, NULL}};
   for (int i = 0; meshes[i][0]; i++) {
-    if (quick && i == 2) continue;
+    if ((quick && i == 2) || (only && strcmp(only, meshes[i][0]))) continue;
     scene *s = scene_new(meshes[i][1]);
     if (load(s, meshes[i][1], NULL) == 0) bench_scene(meshes[i][0], s);
     scene_free(s);
   }
-  {
+  if (!only || !strcmp(only, "cornell")) {
     scene *s = scene_new("cornell+bunny");
     /* The bunny (about 0.15 units tall, base at y=0.033) scaled into the box. */
     float xf[12] = {4, 0, 0, 0.1f, 0, 4, 0, -0.13f, 0, 0, 4, 0.2f};
@@ -164,6 +171,7 @@ int main(int argc, char **argv) {
     }
     scene_free(s);
   }
+  if (!build_table) return 0;
   printf("\n## kd-tree build growth on the dragon (N log N)\n\n");
   printf("| triangles | build s | ns per N log2 N | nodes | refs per triangle | kd bytes per triangle | peak RSS MiB |\n|---|---|---|---|---|---|---|\n");
   const char *res[4] = {"scenes/dragon/dragon_vrip_res4.ply", "scenes/dragon/dragon_vrip_res3.ply", "scenes/dragon/dragon_vrip_res2.ply",
