@@ -260,16 +260,9 @@ static int aovs(void) {
 /* Thin lens: a tiny emitter at distance D, focus at F, aperture radius A spreads into a
  * uniform disk of angular radius atan(A |1 - F/D| / F) (plus the emitter's own size);
  * in focus it stays a dot. */
-static double spot_radius_px(double aperture, double focus) {
-  char json[1024];
-  snprintf(json, sizeof json,
-           "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [0,0,-1], \"fov\": 20, \"aperture_radius\": %g, \"focus_distance\": %g},\n"
-           "  \"film\": {\"width\": 96, \"height\": 96}, \"render\": {\"spp\": 256},\n"
-           "  \"materials\": {\"e\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1000}},\n"
-           "  \"shapes\": [{\"type\": \"sphere\", \"center\": [0,0,-4], \"radius\": 0.005, \"subdivisions\": 2, \"material\": \"e\"}] }\n",
-           aperture, focus);
+static double spot_radius(const char *json, const valo_options *opt) {
   int w, h;
-  float *px = render_json_text(json, NULL, &w, &h);
+  float *px = render_json_text(json, opt, &w, &h);
   if (!px) return -1;
   /* Energy-weighted second moment of the spot: a uniform disk of radius R has
    * E[r^2] = R^2 / 2. */
@@ -282,6 +275,17 @@ static double spot_radius_px(double aperture, double focus) {
   free(px);
   return sum > 0 ? sqrt(2 * m2 / sum) : -1;
 }
+#define SPOT_SCENE_TAIL                                                                            \
+  "  \"film\": {\"width\": 96, \"height\": 96}, \"render\": {\"spp\": 256},\n"                     \
+  "  \"materials\": {\"e\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1000}},\n"   \
+  "  \"shapes\": [%s{\"type\": \"sphere\", \"center\": [%g,0,-4], \"radius\": 0.005, \"subdivisions\": 2, \"material\": \"e\"}] }\n"
+static double spot_radius_px(double aperture, double focus) {
+  char json[1024];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [0,0,-1], \"fov\": 20, \"aperture_radius\": %g, \"focus_distance\": %g},\n" SPOT_SCENE_TAIL,
+           aperture, focus, "", 0.0);
+  return spot_radius(json, NULL);
+}
 static int thin_lens_circle_of_confusion(void) {
   double A = 0.1, F = 2, D = 4;
   double tan_half = tan(10.0 * M_PI / 180);
@@ -291,6 +295,44 @@ static int thin_lens_circle_of_confusion(void) {
   CHECK(r > 0 && r_focus >= 0 && r_pin >= 0, "render failed");
   CHECK(fabs(r - predicted) < 0.05 * predicted + 0.5, "defocus radius %.2f px, predicted %.2f", r, predicted);
   CHECK(r_focus < 1.5 && r_pin < 1.5, "in focus the spot should stay within a pixel or so (%.2f, %.2f)", r_focus, r_pin);
+  return 0;
+}
+
+/* The same lens on a glTF camera (glTF has no aperture): the camera node sits at x = 1
+ * looking down -z with a 20 degree yfov; the JSON file takes it with camera.from_file
+ * and adds the lens, or the render options add it (as --aperture/--focus do). With no
+ * focus distance a file camera focuses on the surface at the image centre: the spot. */
+static const char gltf_camera[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}],\n"
+    " \"nodes\": [{\"camera\": 0, \"translation\": [1, 0, 0], \"name\": \"cam\"}, {\"mesh\": 0}],\n"
+    " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.34906585, \"aspectRatio\": 1.0, \"znear\": 0.01}}],\n"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0,0,10], \"max\": [0.1,0.1,10]}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}],\n"
+    " \"buffers\": [{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAACBBzczMPQAAAAAAACBBAAAAAM3MzD0AACBB\"}]}\n";
+static int thin_lens_gltf_camera(void) {
+  double A = 0.1, F = 2;
+  double predicted = A * fabs(1 - F / 4) / F / tan(10.0 * M_PI / 180) * 48;
+  CHECK(scratch_file("lens_camera.gltf", gltf_camera), "cannot write the glTF file");
+  const char *shape = "{\"file\": \"lens_camera.gltf\"}, "; /* beside the JSON file */
+  char json[2400];
+  snprintf(json, sizeof json, "{ \"camera\": {\"from_file\": true, \"aperture_radius\": %g, \"focus_distance\": %g},\n" SPOT_SCENE_TAIL, A, F, shape, 1.0);
+  double r_json = spot_radius(json, NULL);
+  snprintf(json, sizeof json, "{ \"camera\": {\"from_file\": true},\n" SPOT_SCENE_TAIL, shape, 1.0);
+  valo_options o;
+  valo_options_init(&o);
+  o.aperture_radius = A;
+  o.focus_distance = F;
+  double r_opt = spot_radius(json, &o);
+  o.focus_distance = VALO_UNSET; /* autofocus: on the spot itself */
+  double r_auto = spot_radius(json, &o);
+  double r_pin = spot_radius(json, NULL);
+  fprintf(stderr, "glTF camera spot radius: JSON lens %.2f px, option lens %.2f px (predicted %.2f), autofocus %.2f px, pinhole %.2f px\n",
+          r_json, r_opt, predicted, r_auto, r_pin);
+  CHECK(r_json > 0 && r_opt > 0 && r_auto >= 0 && r_pin >= 0, "render failed (is the spot in view?)");
+  CHECK(fabs(r_json - predicted) < 0.05 * predicted + 0.5, "from_file lens: %.2f px, predicted %.2f", r_json, predicted);
+  CHECK(fabs(r_opt - predicted) < 0.05 * predicted + 0.5, "option lens: %.2f px, predicted %.2f", r_opt, predicted);
+  CHECK(r_auto < 1.5 && r_pin < 1.5, "autofocus and pinhole should keep the spot sharp (%.2f, %.2f)", r_auto, r_pin);
   return 0;
 }
 
@@ -364,6 +406,7 @@ int main(int argc, char **argv) {
                                     {"envmap_orientation", envmap_orientation},
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
+                                    {"thin_lens_gltf_camera", thin_lens_gltf_camera},
                                     {"adaptive_sampling", adaptive_sampling},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);

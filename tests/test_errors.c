@@ -114,6 +114,12 @@ static int wrong_type(void) {
   p = write_file("type3.json", "{ \"materials\": {\"m\": {\"type\": \"velvet\"}} }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("materials.m"); SAID("unknown material type"); NO_SANITIZER();
+  p = write_file("type5.json", "{ \"camera\": {\"from_file\": true, \"position\": [0,0,1]} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("type5.json"); SAID("from_file"); NO_SANITIZER();
+  p = write_file("type6.json", "{ \"camera\": {\"from_file\": true}, \"shapes\": [{\"type\": \"sphere\"}] }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("type6.json"); SAID("no shape file has a camera"); NO_SANITIZER();
   p = write_file("type4.json", "{ \"shapes\": [{\"type\": \"sphere\", \"material\": \"nope\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("shapes[0]"); SAID("\"nope\""); NO_SANITIZER();
@@ -213,6 +219,10 @@ static int bad_options(void) {
   SAID("no scene");
   EXPECT_FAIL(2, "render", obj, "--spp");
   SAID("needs a value");
+  EXPECT_FAIL(2, "render", obj, "--aperture", "-1");
+  SAID("--aperture");
+  EXPECT_FAIL(2, "render", obj, "--focus", "0");
+  SAID("--focus");
   EXPECT_FAIL(2, "dance");
   { const char *const none[] = {NULL}; CHECK(run_valo(none) == 2, "no arguments should be a usage error"); }
   return 0;

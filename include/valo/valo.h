@@ -63,6 +63,11 @@ typedef struct valo_options {
                              below this (e.g. 0.01); VALO_UNSET or <= 0: use the budget */
   int spectral;           /* non-zero: spectral rendering (path integrator only): hero
                              wavelength + 3, dispersion; VALO_UNSET = RGB */
+  double aperture_radius; /* thin-lens radius in scene units, over the scene camera's;
+                             0 = pinhole; VALO_UNSET = the scene's */
+  double focus_distance;  /* distance to the plane of focus along the view axis, > 0;
+                             VALO_UNSET = the scene's (file cameras: autofocus on the
+                             surface at the image centre) */
 } valo_options;
 
 /* Sets every field of `o` to "unset". */

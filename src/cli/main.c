@@ -59,6 +59,9 @@ static void usage_render(FILE *f) {
           " (default path)\n"
           "  --accel NAME           kdtree (default) or embree\n"
           "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
+          "  --aperture R           thin-lens radius in scene units (0 = pinhole), over the scene's\n"
+          "  --focus D              focus distance along the view axis (default: the scene's; for\n"
+          "                         a file camera, the surface at the image centre)\n"
           "  --spectral             spectral rendering (path): 4 wavelengths per path, dispersion\n"
           "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
           "                         noisiest pixels get more (spp:FILE writes the count map)\n"
@@ -191,6 +194,14 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_int(val, -1, 100000, &lv)) BAD_VALUE("-1 or a whole number >= 0");
       opt.max_depth = (int)lv;
+    } else if (!strcmp(a, "--aperture")) {
+      NEED_VALUE();
+      if (parse_double(val, 0, 1e6, &dv)) BAD_VALUE("a lens radius in scene units, >= 0");
+      opt.aperture_radius = dv;
+    } else if (!strcmp(a, "--focus")) {
+      NEED_VALUE();
+      if (parse_double(val, 1e-6, 1e9, &dv)) BAD_VALUE("a distance in scene units, > 0");
+      opt.focus_distance = dv;
     } else if (!strcmp(a, "--spectral")) {
       opt.spectral = 1;
     } else if (!strcmp(a, "--adaptive")) {

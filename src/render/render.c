@@ -46,6 +46,7 @@ struct valo_render {
   /* camera basis */
   vec3 cam_o, cam_fwd, cam_right, cam_up;
   float tan_half, aspect;
+  float aperture, focus;   /* thin lens: radius (0 = pinhole) and focus distance */
 };
 
 static double now_seconds(void) {
@@ -67,6 +68,7 @@ VALO_API void valo_options_init(valo_options *o) {
   o->adaptive = VALO_UNSET;
   o->noise_threshold = VALO_UNSET;
   o->spectral = VALO_UNSET;
+  o->aperture_radius = o->focus_distance = VALO_UNSET;
   o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
 }
 
@@ -123,6 +125,8 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->adaptive != VALO_UNSET) dst->adaptive = o->adaptive;
     if (o->noise_threshold != VALO_UNSET) dst->noise_threshold = o->noise_threshold;
     if (o->spectral != VALO_UNSET) dst->spectral = o->spectral;
+    if (o->aperture_radius != VALO_UNSET) dst->aperture_radius = o->aperture_radius;
+    if (o->focus_distance != VALO_UNSET) dst->focus_distance = o->focus_distance;
   }
   if (dst->width == VALO_UNSET) dst->width = 256;
   if (dst->height == VALO_UNSET) dst->height = 256;
@@ -151,6 +155,10 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     return err_set(err, VALO_ERR_INVALID, "%dx%d at %d spp is more than %.0e samples", o.width, o.height, o.spp, MAX_PIXEL_SAMPLES);
   if (o.threads < 1 || o.threads > 1024) return err_set(err, VALO_ERR_INVALID, "thread count %d is out of range (1..1024)", o.threads);
   if (o.seed < 0) return err_set(err, VALO_ERR_INVALID, "seed must not be negative");
+  if (o.aperture_radius != VALO_UNSET && !(o.aperture_radius >= 0 && o.aperture_radius < 1e6))
+    return err_set(err, VALO_ERR_INVALID, "aperture radius must be >= 0");
+  if (o.focus_distance != VALO_UNSET && !(o.focus_distance > 0 && o.focus_distance < 1e9))
+    return err_set(err, VALO_ERR_INVALID, "focus distance must be > 0");
   if (o.max_depth < -1) return err_set(err, VALO_ERR_INVALID, "max_depth must be -1 (unlimited) or >= 0");
   const integrator_ops *integ = integrator_find(o.integrator);
   if (!integ) {
@@ -202,6 +210,16 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     valo_render_destroy(r);
     return err_set(err, VALO_ERR_INVALID, "%s: camera up vector is parallel to the view direction", s->path);
   }
+  r->aperture = o.aperture_radius != VALO_UNSET ? (float)o.aperture_radius : c->aperture_radius;
+  r->focus = o.focus_distance != VALO_UNSET ? (float)o.focus_distance : c->focus_distance;
+  if (!(r->focus > 0)) {
+    /* Autofocus (file cameras carry no focus distance): the surface at the image
+     * centre, or the distance to the look-at point if the centre ray escapes. */
+    ray cr = {r->cam_o, r->cam_fwd, INFINITY};
+    hit h;
+    r->focus = accel_intersect(r->acc, &cr, &h) ? h.t : v3_len(v3_sub(c->look_at, c->pos));
+    if (!(r->focus > 0)) r->focus = 1;
+  }
   *out = r;
   return VALO_OK;
 }
@@ -215,16 +233,15 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   ray ry;
   ry.o = r->cam_o;
   ry.tmax = INFINITY;
-  const camera *c = &r->s->cam;
   float lu, lv;
   sampler_2d(smp, &lu, &lv);
-  if (c->aperture_radius > 0) {
+  if (r->aperture > 0) {
     /* Thin lens: every ray through the lens meets at the plane of focus. */
-    float ft = c->focus_distance / v3_dot(d, r->cam_fwd);
+    float ft = r->focus / v3_dot(d, r->cam_fwd);
     vec3 pf = v3_add(r->cam_o, v3_scale(d, ft));
     float dx, dy;
     sample_concentric_disk(lu, lv, &dx, &dy);
-    ry.o = v3_add(r->cam_o, v3_add(v3_scale(r->cam_right, dx * c->aperture_radius), v3_scale(r->cam_up, dy * c->aperture_radius)));
+    ry.o = v3_add(r->cam_o, v3_add(v3_scale(r->cam_right, dx * r->aperture), v3_scale(r->cam_up, dy * r->aperture)));
     d = v3_norm(v3_sub(pf, ry.o));
   }
   ry.d = d;

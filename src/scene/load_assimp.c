@@ -5,6 +5,7 @@
  * out-of-range indices, degenerate or empty meshes). */
 #include "scene/scene.h"
 #include "core/error.h"
+#include <strings.h>
 #include <assimp/cimport.h>
 #include <assimp/scene.h>
 #include <assimp/postprocess.h>
@@ -275,19 +276,27 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   mat34 node_xf = m34_identity(), id = m34_identity();
   if (!find_node(c->ai->mRootNode, cam->mName.data, &node_xf, &id)) node_xf = m34_identity();
   mat34 full = m34_mul(xf, &node_xf);
-  vec3 pos = m34_point(&full, v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z));
+  /* Assimp's glTF 2 importer (5.2) departs from aiCamera's definition twice: it copies
+   * the node's translation into mPosition although the node transform already holds it,
+   * and it stores yfov * aspectRatio in mHorizontalFOV (not half the horizontal angle). */
+  const char *ext = strrchr(c->path, '.');
+  int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
+  vec3 local = gltf ? v3(0, 0, 0) : v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z);
+  vec3 pos = m34_point(&full, local);
   vec3 look = m34_vector(&full, v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
   vec3 up = m34_vector(&full, v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
   if (!v3_finite(pos) || !(v3_len2(look) > 0) || !(v3_len2(up) > 0)) return;
   float aspect = cam->mAspect > 0 ? cam->mAspect : 1.0f;
-  float half_h = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f;
-  float vfov = 2.0f * atanf(tanf(half_h) / aspect);
+  float vfov;
+  if (gltf) vfov = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV / (cam->mAspect > 0 ? cam->mAspect : 1.0f) : 0.8f;
+  else vfov = 2.0f * atanf(tanf(cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f) / aspect);
+  if (!(vfov > 1e-4f && vfov < 3.1f)) vfov = 0.8f;
   c->s->cam.pos = pos;
   c->s->cam.look_at = v3_add(pos, v3_norm(look));
   c->s->cam.up = v3_norm(up);
   c->s->cam.fov_deg = vfov * 180.0f / PI_F;
   c->s->cam.aperture_radius = 0;
-  c->s->cam.focus_distance = 1;
+  c->s->cam.focus_distance = -1; /* glTF/Assimp cameras have none: autofocus (render.c) */
   c->s->has_camera = 1;
   if (cam->mAspect > 0 && c->s->file_opts.width == VALO_UNSET) {
     c->s->file_opts.height = 256;

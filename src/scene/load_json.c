@@ -13,7 +13,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct jctx { scene *s; const char *path; char dir[1024]; valo_error *err; } jctx;
+typedef struct jctx {
+  scene *s; const char *path; char dir[1024]; valo_error *err;
+  int cam_from_file;           /* camera.from_file: take the first shape file's camera */
+  float cam_fov, cam_aperture, cam_focus; /* its overrides (fov <= 0: keep the file's) */
+} jctx;
 
 static void resolve_path(const struct jctx *c, const char *rel, char *out, size_t n);
 
@@ -123,9 +127,24 @@ static valo_status get_bool(jctx *c, const cJSON *o, const char *key, const char
 #define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
 static valo_status parse_camera(jctx *c, const cJSON *o) {
-  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", NULL};
+  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", "from_file", NULL};
   TRY(check_keys(c, o, "camera", keys));
   camera *cam = &c->s->cam;
+  const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
+  if (ff && !cJSON_IsBool(ff)) return bad(c, "camera.from_file", "must be true or false");
+  if (cJSON_IsTrue(ff)) {
+    /* The first shape file with a camera supplies position, orientation and fov; the
+     * lens (and optionally fov) come from here. */
+    if (cJSON_GetObjectItemCaseSensitive(o, "position") || cJSON_GetObjectItemCaseSensitive(o, "look_at") ||
+        cJSON_GetObjectItemCaseSensitive(o, "up"))
+      return bad(c, "camera", "\"from_file\" takes position, look_at and up from the file; give only fov, aperture_radius, focus_distance");
+    double d = -1;
+    TRY(get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); c->cam_fov = (float)d;
+    d = 0; TRY(get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); c->cam_aperture = (float)d;
+    d = -1; TRY(get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); c->cam_focus = (float)d;
+    c->cam_from_file = 1;
+    return VALO_OK;
+  }
   cam->pos = v3(0, 0, 5); cam->look_at = v3(0, 0, 0); cam->up = v3(0, 1, 0);
   cam->fov_deg = 40; cam->aperture_radius = 0; cam->focus_distance = -1;
   double d;
@@ -343,7 +362,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
     }
     char full[2048];
     resolve_path(c, file, full, sizeof full);
-    return load_mesh(c->s, full, xf, mat, 0, c->err);
+    return load_mesh(c->s, full, xf, mat, c->cam_from_file && !c->s->has_camera, c->err);
   }
   if (!strcmp(type, "sphere")) {
     vec3 center = v3(0, 0, 0);
@@ -420,7 +439,7 @@ static void line_col(const char *text, const char *at, int *line, int *col) {
 }
 
 valo_status load_json(scene *s, const char *path, valo_error *err) {
-  jctx c = {s, path, "", err};
+  jctx c = {.s = s, .path = path, .err = err};
   const char *slash = strrchr(path, '/');
   if (slash) snprintf(c.dir, sizeof c.dir, "%.*s", (int)(slash - path), path);
   FILE *f = fopen(path, "rb");
@@ -487,6 +506,12 @@ valo_status load_json(scene *s, const char *path, valo_error *err) {
     if (!cJSON_IsArray(shapes)) { st = bad(&c, "shapes", "must be an array"); goto done; }
     int i = 0;
     for (const cJSON *sh = shapes->child; sh; sh = sh->next, i++) TRY(parse_shape(&c, sh, i, mfirst, mend));
+  }
+  if (c.cam_from_file) {
+    if (!s->has_camera) { st = bad(&c, "camera.from_file", "no shape file has a camera"); goto done; }
+    if (c.cam_fov > 0) s->cam.fov_deg = c.cam_fov;
+    s->cam.aperture_radius = c.cam_aperture;
+    s->cam.focus_distance = c.cam_focus; /* <= 0: autofocus */
   }
   const cJSON *lights = cJSON_GetObjectItemCaseSensitive(root, "lights");
   if (lights) {
