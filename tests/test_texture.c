@@ -165,9 +165,79 @@ static int normal_map(void) {
   return 0;
 }
 
+/* The normal AOV at the centre of an 8x8 render of `json` (scratch file name). */
+static int centre_normal(const char *name, const char *json, float out[3]) {
+  const char *path = scratch_file(name, json);
+  valo_options o;
+  valo_options_init(&o);
+  o.aovs = 1;
+  valo_error err;
+  valo_scene *sc;
+  valo_render *r;
+  CHECK(path && valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  char out_spec[1300], file[1200];
+  snprintf(file, sizeof file, "%s/centre_normal.pfm", scratch_dir());
+  snprintf(out_spec, sizeof out_spec, "normal:%s", file);
+  CHECK(valo_render_write(r, out_spec, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  image im;
+  CHECK(image_read(file, &im, &err) == VALO_OK, "%s", err.message);
+  memcpy(out, &im.rgb[3 * (4 * 8 + 4)], 3 * sizeof(float));
+  image_free(&im);
+  return 0;
+}
+
+/* Bump maps: the same quad (2 units across, so dp/du = (2,0,0)) under a 16x16 grey
+ * height ramp rising by 16/255 per texel along u (then along v). Displaced by
+ * scale * height, the surface rises with slope scale * (256/255) / 2 per unit, so its
+ * normal tilts away from the rise by atan of that: 30 degrees for the scale below.
+ * Checked from JSON (bump_map, bump_scale) and from MTL (map_bump -bm); scale 0 and a
+ * flat map leave the normal alone. */
+static int bump_map(void) {
+  CHECK(scratch_file("nquad.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  double th = 30.0 * M_PI / 180, scale = 2 * tan(th) * 255.0 / 256.0;
+  for (int axis = 0; axis < 3; axis++) { /* 0: ramp in u, 1: ramp in v, 2: flat */
+    unsigned char bytes[16 * 16];
+    for (int y = 0; y < 16; y++)
+      for (int x = 0; x < 16; x++) bytes[16 * y + x] = (unsigned char)(axis == 0 ? 16 * x + 8 : axis == 1 ? 16 * (15 - y) + 8 : 128);
+    char png[1200];
+    snprintf(png, sizeof png, "%s/ramp%d.png", scratch_dir(), axis);
+    CHECK(stbi_write_png(png, 16, 16, 1, bytes, 16), "png");
+    float n[3] = {axis == 0 ? (float)-sin(th) : 0, axis == 1 ? (float)-sin(th) : 0, axis == 2 ? 1 : (float)cos(th)};
+    for (int form = 0; form < 3; form++) { /* JSON, MTL, JSON with scale 0 */
+      char json[1024], mtl[300], obj[300];
+      const char *mat = "";
+      if (form == 1) {
+        snprintf(mtl, sizeof mtl, "newmtl m\nKd 0.5 0.5 0.5\nmap_bump -bm %.6f ramp%d.png\n", scale, axis);
+        CHECK(scratch_file("bquad.mtl", mtl), "write");
+        snprintf(obj, sizeof obj, "mtllib bquad.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n");
+        CHECK(scratch_file("bquad.obj", obj), "write");
+      } else mat = ", \"material\": \"m\"";
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 20},\n"
+               "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 2},\n"
+               "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"bump_map\": \"ramp%d.png\", \"bump_scale\": %.6f}},\n"
+               "  \"shapes\": [{\"file\": \"%s\"%s}],\n"
+               "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n",
+               axis, form == 2 ? 0.0 : scale, form == 1 ? "bquad.obj" : "nquad.obj", mat);
+      float c[3];
+      if (centre_normal("bump.json", json, c)) return 1;
+      float e[3] = {n[0], n[1], n[2]};
+      if (form == 2) { e[0] = 0; e[1] = 0; e[2] = 1; }
+      fprintf(stderr, "ramp %s, %s: normal (%.4f %.4f %.4f), expected (%.4f %.4f %.4f)\n", axis == 0 ? "in u" : axis == 1 ? "in v" : "flat",
+              form == 0 ? "JSON" : form == 1 ? "MTL -bm" : "scale 0", c[0], c[1], c[2], e[0], e[1], e[2]);
+      for (int k = 0; k < 3; k++) CHECK(fabsf(c[k] - e[k]) < 0.01f, "normal component %d: %g vs %g", k, c[k], e[k]);
+    }
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
-                                    {"normal_map", normal_map}, {NULL, NULL}};
+                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -16,6 +16,37 @@ const integrator_ops *integrator_find(const char *name) {
 }
 VALO_API const char *const *valo_integrator_names(void) { return names; }
 
+/* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
+ * shading normal n by d(u,v) = scale * height(u,v) has tangents dp/du + d_u n and
+ * dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is the new shading
+ * normal. dp/du and dp/dv are the triangle's own UV derivatives, made orthogonal to n so
+ * that a flat height map leaves n unchanged; d_u and d_v are central differences over
+ * half a texel of the bilinearly filtered map, so the slope of a linear ramp is exact. */
+static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
+  const texture *tx = &s->tex[it->m->tex_bump];
+  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
+  float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
+  float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
+  float det = du1 * dv2 - du2 * dv1;
+  if (!(fabsf(det) > 1e-20f) || tx->w < 1 || tx->h < 1) return;
+  float r = 1 / det;
+  vec3 n = it->ns;
+  vec3 dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), r);
+  vec3 dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), r);
+  dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
+  dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
+  float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
+  texture_lookup(tx, it->u + hu, it->v, px); a = px[0] + px[1] + px[2];
+  texture_lookup(tx, it->u - hu, it->v, px); b = px[0] + px[1] + px[2];
+  float d_u = it->m->bump_scale * (a - b) / (3 * 2 * hu);
+  texture_lookup(tx, it->u, it->v + hv, px); a = px[0] + px[1] + px[2];
+  texture_lookup(tx, it->u, it->v - hv, px); b = px[0] + px[1] + px[2];
+  float d_v = it->m->bump_scale * (a - b) / (3 * 2 * hv);
+  vec3 nb = v3_cross(v3_add(dpdu, v3_scale(n, d_u)), v3_add(dpdv, v3_scale(n, d_v)));
+  if (v3_dot(nb, n) < 0) nb = v3_neg(nb);
+  if (v3_len2(nb) > 1e-30f && v3_finite(nb)) it->ns = v3_norm(nb);
+}
+
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   (void)r;
   const uint32_t *ix = &s->idx[3 * h->tri];
@@ -50,6 +81,7 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
       if (v3_len2(n2) > 1e-12f && v3_finite(n2)) it->ns = v3_norm(n2);
     }
   }
+  if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
 }
 
 bsdf bsdf_at(const scene *s, const isect *it) {

@@ -134,9 +134,25 @@ static material convert_material(const struct aiMaterial *am) {
   else m.type = MAT_DIFFUSE;
   if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
-  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = -1;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
+  m.bump_scale = 1;
   m.alpha_cutoff = 0.5f;
   return m;
+}
+
+/* Some OBJ exporters put tangent-space normal maps under map_bump: such a map is
+ * coloured with mean near (0.5, 0.5, 1), which a height map never is. */
+static int looks_like_normal_map(const texture *t) {
+  double r = 0, g = 0, b = 0, spread = 0;
+  size_t n = (size_t)t->w * t->h;
+  if (n == 0) return 0;
+  for (size_t i = 0; i < n; i++) {
+    const float *p = &t->px[4 * i];
+    r += p[0]; g += p[1]; b += p[2];
+    spread += fabsf(p[2] - p[0]);
+  }
+  r /= n; g /= n; b /= n; spread /= n;
+  return b > 0.7 && fabs(r - 0.5) < 0.15 && fabs(g - 0.5) < 0.15 && spread > 0.2;
 }
 
 static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir) {
@@ -146,6 +162,17 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   if (m->tex_kd >= 0) s->tex[m->tex_kd].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
   m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, dir, 0, NULL);
+  /* MTL bump / map_bump (Assimp's HEIGHT slot) with its -bm multiplier. */
+  int height = load_slot(s, ai, am, aiTextureType_HEIGHT, dir, 0, NULL);
+  if (height >= 0) {
+    if (m->tex_normal < 0 && looks_like_normal_map(&s->tex[height])) m->tex_normal = height;
+    else {
+      m->tex_bump = height;
+      float bm = 1;
+      unsigned int one = 1;
+      if (aiGetMaterialFloatArray(am, AI_MATKEY_OBJ_BUMPMULT_HEIGHT(0), &bm, &one) == aiReturn_SUCCESS && isfinite(bm)) m->bump_scale = bm;
+    }
+  }
   m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
   /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */

@@ -218,11 +218,11 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   if (!type) return bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", NULL};
-  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", NULL};
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
@@ -284,6 +284,21 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
       return bad(c, w, "cannot read the normal map");
     }
   }
+  const char *bmap = NULL;
+  TRY(get_str(c, o, "bump_map", where, &bmap));
+  if (bmap) {
+    char full[2048];
+    resolve_path(c, bmap, full, sizeof full);
+    m->tex_bump = scene_texture_file(c->s, full, 0);
+    if (m->tex_bump < 0) {
+      char w[300];
+      snprintf(w, sizeof w, "%s.bump_map", where);
+      return bad(c, w, "cannot read the bump (height) map");
+    }
+  }
+  double bscale = 1;
+  TRY(get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
+  m->bump_scale = (float)bscale;
   double rough = 0;
   TRY(get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;

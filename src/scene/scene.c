@@ -66,7 +66,8 @@ material material_default(void) {
   m.kd = c3(0.8f, 0.8f, 0.8f);
   m.exponent = 1;
   m.ior = 1.5f;
-  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = -1;
+  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
+  m.bump_scale = 1;
   m.alpha_cutoff = 0.5f;
   snprintf(m.name, sizeof m.name, "default");
   return m;
