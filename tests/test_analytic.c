@@ -211,6 +211,53 @@ static int envmap_orientation(void) {
   return 0;
 }
 
+/* Cube maps: six 64x64 faces, each marked with its index (red) and its left/right and
+ * top/bottom halves (green, blue). A camera at the centre facing each face in turn (up
+ * +y for the sides; looking up or down from facing -z for +y and -y) sees that face,
+ * upright and not mirrored, as envmap.h defines the convention. */
+static int envmap_cube(void) {
+  static const char *const names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+  float *px = malloc(sizeof(float) * 64 * 64 * 3);
+  CHECK(px, "oom");
+  valo_error err;
+  for (int f = 0; f < 6; f++) {
+    for (int y = 0; y < 64; y++)
+      for (int x = 0; x < 64; x++) {
+        float *p = &px[3 * (y * 64 + x)];
+        p[0] = (f + 1) / 8.0f; p[1] = x < 32 ? 0.25f : 0.75f; p[2] = y < 32 ? 0.25f : 0.75f;
+      }
+    char path[1200];
+    snprintf(path, sizeof path, "%s/cube_%s.pfm", scratch_dir(), names[f]);
+    CHECK(image_write(path, 64, 64, px, NULL, &err) == VALO_OK, "%s", err.message);
+  }
+  free(px);
+  /* look direction, up, expected face */
+  static const float views[6][7] = {{0, 0, -1, 0, 1, 0, 4}, {0, 0, 1, 0, 1, 0, 5}, {1, 0, 0, 0, 1, 0, 0},
+                                    {-1, 0, 0, 0, 1, 0, 1}, {0, 1, 0, 0, 0, 1, 2}, {0, -1, 0, 0, 0, -1, 3}};
+  for (int v = 0; v < 6; v++) {
+    const float *V = views[v];
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [%g,%g,%g], \"up\": [%g,%g,%g], \"fov\": 30},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 4},\n"
+             "  \"environment\": {\"type\": \"cube\", \"faces\": [\"cube_px.pfm\", \"cube_nx.pfm\", \"cube_py.pfm\", \"cube_ny.pfm\", \"cube_pz.pfm\", \"cube_nz.pfm\"]} }\n",
+             V[0], V[1], V[2], V[3], V[4], V[5]);
+    int w, h;
+    float *img = render_json_text(json, NULL, &w, &h);
+    CHECK(img, "render failed");
+    const float *left = &img[3 * (8 * w + 2)], *right = &img[3 * (8 * w + 13)];
+    const float *top = &img[3 * (1 * w + 8)], *bottom = &img[3 * (14 * w + 8)];
+    float face = (V[6] + 1) / 8.0f;
+    fprintf(stderr, "looking (%g %g %g): face red %.3f (expected %.3f), left/right green %.3f/%.3f, top/bottom blue %.3f/%.3f\n", V[0], V[1],
+            V[2], left[0], face, left[1], right[1], top[2], bottom[2]);
+    int ok = fabsf(left[0] - face) < 0.01f && fabsf(right[0] - face) < 0.01f && fabsf(left[1] - 0.25f) < 0.05f &&
+             fabsf(right[1] - 0.75f) < 0.05f && fabsf(top[2] - 0.25f) < 0.05f && fabsf(bottom[2] - 0.75f) < 0.05f;
+    free(img);
+    CHECK(ok, "wrong face or orientation when looking along (%g %g %g)", V[0], V[1], V[2]);
+  }
+  return 0;
+}
+
 /* AOVs of a plane facing the camera: albedo = its reflectance, normal = +z (towards the
  * camera, though the plane's winding faces away), depth = distance along each ray. */
 static int aovs(void) {
@@ -403,7 +450,7 @@ int main(int argc, char **argv) {
                                     {"emission_front_side_only", emission_front_side_only},
                                     {"max_depth_direct_only", max_depth_direct_only},
                                     {"furnace_constant_map", furnace_constant_map},
-                                    {"envmap_orientation", envmap_orientation},
+                                    {"envmap_orientation", envmap_orientation}, {"envmap_cube", envmap_cube},
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {"thin_lens_gltf_camera", thin_lens_gltf_camera},

@@ -1,6 +1,7 @@
 /* envmap.c — see envmap.h. */
 #include "light/envmap.h"
 #include "image/image_io.h"
+#include "scene/texture.h"
 #include "core/error.h"
 #include <stdlib.h>
 #include <string.h>
@@ -80,6 +81,57 @@ valo_status envmap_load(envmap *e, const char *path, float scale, float rotation
   if (im.w < 2 || im.h < 1) { image_free(&im); return err_set(err, VALO_ERR_INVALID, "%s: environment map too small", path); }
   if (envmap_init(e, im.w, im.h, im.rgb, scale, rotation_deg)) { envmap_free(e); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   return VALO_OK;
+}
+
+/* Radiance of the cube in direction d (map frame, right-handed y up): the face of the
+ * major axis of the left-handed direction (x, y, -z), then the OpenGL face coordinates
+ * (s right, t down) looked up bilinearly with clamping inside that face. */
+static void cube_lookup(const texture *faces, vec3 d, float out[4]) {
+  float x = d.x, y = d.y, z = -d.z, ax = fabsf(x), ay = fabsf(y), az = fabsf(z), sc, tc, ma;
+  int f;
+  if (ax >= ay && ax >= az) { f = x > 0 ? 0 : 1; ma = ax; sc = x > 0 ? -z : z; tc = -y; }
+  else if (ay >= az) { f = y > 0 ? 2 : 3; ma = ay; sc = x; tc = y > 0 ? z : -z; }
+  else { f = z > 0 ? 4 : 5; ma = az; sc = z > 0 ? x : -x; tc = -y; }
+  float s = 0.5f * (sc / ma + 1), t = 0.5f * (tc / ma + 1);
+  texture_lookup(&faces[f], s, 1 - t, out);
+}
+
+valo_status envmap_load_cube(envmap *e, const char *const paths[6], float scale, float rotation_deg, valo_error *err) {
+  texture faces[6];
+  memset(faces, 0, sizeof faces);
+  valo_status st = VALO_OK;
+  int n = 0;
+  for (int i = 0; i < 6 && !st; i++) {
+    st = texture_load_file(&faces[i], paths[i], 1, err);
+    if (st) break;
+    faces[i].wrap = TEX_CLAMP;
+    if (faces[i].w != faces[i].h || faces[i].w < 1)
+      st = err_set(err, VALO_ERR_INVALID, "%s: a cube face must be square (it is %dx%d)", paths[i], faces[i].w, faces[i].h);
+    else if (i > 0 && faces[i].w != faces[0].w)
+      st = err_set(err, VALO_ERR_INVALID, "%s: cube faces differ in size (%d against %d in %s)", paths[i], faces[i].w, faces[0].w, paths[0]);
+    n = faces[0].w;
+  }
+  if (!st) {
+    /* Equirectangular resolution 4n x 2n (about the cube's own texel density at the
+     * equator), at most 4096 x 2048, each texel the mean of 2x2 cube lookups. */
+    int N = n < 1024 ? n : 1024, W = 4 * N, H = 2 * N;
+    float *px = malloc((size_t)W * H * 3 * sizeof(float));
+    if (!px) st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d environment map", W, H);
+    else {
+      for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+          float acc[3] = {0, 0, 0}, v[4];
+          for (int k = 0; k < 4; k++) {
+            cube_lookup(faces, uv_to_dir((x + 0.25f + 0.5f * (k & 1)) / W, (y + 0.25f + 0.5f * (k >> 1)) / H), v);
+            for (int c = 0; c < 3; c++) acc[c] += 0.25f * v[c];
+          }
+          for (int c = 0; c < 3; c++) px[3 * ((size_t)y * W + x) + c] = acc[c];
+        }
+      if (envmap_init(e, W, H, px, scale, rotation_deg)) { envmap_free(e); st = err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+    }
+  }
+  for (int i = 0; i < 6; i++) texture_free(&faces[i]);
+  return st;
 }
 
 void envmap_free(envmap *e) {

@@ -4,7 +4,14 @@
  * density is non-zero wherever the looked-up radiance is), and the matching solid-angle
  * density pdf(w) = pdf(u,v) / (2 pi^2 sin theta) (pbrt-v3 §14.2.4).
  * Convention: y is up; direction -z maps to the image centre (u = 0.5); the top row is
- * straight up. `rotation` turns the map about +y (degrees). */
+ * straight up. `rotation` turns the map about +y (degrees).
+ * Cube maps (six face images) are resampled into an equirectangular map at load time
+ * (envmap_load_cube), so they share the lookup, sampling and MIS code. Face convention:
+ * the OpenGL/DirectX cube-map layout of a left-handed world, as skybox packs are made
+ * for it, brought into valo's right-handed y-up world by flipping z: each face image
+ * is what a viewer at the centre sees facing it (side faces upright; the +y face seen
+ * looking up from facing -z, the -y face looking down), and the "+z" image lies straight
+ * ahead of a camera looking down -z. */
 #ifndef VALO_ENVMAP_H
 #define VALO_ENVMAP_H
 #include "core/vec.h"
@@ -23,6 +30,9 @@ typedef struct envmap {
 /* Takes ownership of rgb (w*h*3 floats). */
 int envmap_init(envmap *e, int w, int h, float *rgb, float scale, float rotation_deg);
 valo_status envmap_load(envmap *e, const char *path, float scale, float rotation_deg, valo_error *err);
+/* faces: +x, -x, +y, -y, +z, -z image files (any texture format; 8-bit decoded from sRGB),
+ * square and of one size. */
+valo_status envmap_load_cube(envmap *e, const char *const faces[6], float scale, float rotation_deg, valo_error *err);
 void envmap_free(envmap *e);
 rgb envmap_eval(const envmap *e, vec3 dir);
 /* Samples a unit direction; returns 0 if the density there is zero. */
