@@ -21,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 34
+#define CHI2_TESTS 38
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -128,6 +128,7 @@ static int run_chi2(const char *what, void *ctx, sample_fn sf, pdf_fn pf) {
 typedef struct bsdf_ctx { bsdf b; vec3 wo; } bsdf_ctx;
 static int bsdf_sf(void *c, sampler *s, vec3 *d);
 static int test_bsdf_wo(const char *name, material m, vec3 wo);
+static int test_bsdf(const char *name, material m, float theta_o_deg);
 
 /* GGX rough conductor (6 tests) and rough dielectric seen from outside and inside
  * (4 tests). */
@@ -160,6 +161,44 @@ static int rough_dielectric(void) {
     snprintf(name, sizeof name, "GGX dielectric roughness %.1f, theta_o %.0f, %s", cfg[i].r, cfg[i].th, cfg[i].inside ? "inside" : "outside");
     rc |= test_bsdf_wo(name, m, v3(sinf(t), 0, cfg[i].inside ? -cosf(t) : cosf(t)));
   }
+  return rc;
+}
+
+/* glTF metallic-roughness (4 tests): dielectric, metal and a half-metal mix, smooth to
+ * rough; then its directional albedo with a white base colour stays at most 1. */
+static int pbr_metallic_roughness(void) {
+  struct { float metallic, rough, base, th; } cfg[4] = {{0, 0.3f, 0.5f, 20}, {0, 0.7f, 0.8f, 70}, {1, 0.4f, 0.9f, 45}, {0.5f, 0.2f, 0.6f, 60}};
+  int rc = 0;
+  for (int i = 0; i < 4; i++) {
+    material m = material_default();
+    m.type = MAT_PBR;
+    m.metallic = cfg[i].metallic; m.roughness = cfg[i].rough; m.kd = c3(cfg[i].base, cfg[i].base * 0.8f, cfg[i].base * 0.5f);
+    char name[96];
+    snprintf(name, sizeof name, "glTF PBR metallic %.1f roughness %.1f", cfg[i].metallic, cfg[i].rough);
+    rc |= test_bsdf(name, m, cfg[i].th);
+  }
+  float rough[3] = {0.1f, 0.5f, 1.0f}, th[3] = {0, 45, 80};
+  for (int metal = 0; metal < 2; metal++)
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) {
+        material m = material_default();
+        m.type = MAT_PBR;
+        m.metallic = (float)metal; m.roughness = rough[i]; m.kd = c3(1, 1, 1);
+        bsdf b = bsdf_from_material(&m);
+        float t = th[j] * (float)M_PI / 180;
+        vec3 wo = v3(sinf(t), 0, cosf(t));
+        double sum = 0;
+        long n = 200000;
+        for (long k = 0; k < n; k++) {
+          sampler sm = sampler_make(23, (uint64_t)k, 0);
+          bsdf_sample bs;
+          float ul = sampler_1d(&sm), u1 = sampler_1d(&sm), u2 = sampler_1d(&sm);
+          if (bsdf_sample_dir(&b, wo, ul, u1, u2, &bs)) sum += bs.weight.g;
+        }
+        fprintf(stderr, "glTF PBR white %s roughness %.1f theta_o %2.0f: albedo %.4f\n", metal ? "metal     " : "dielectric", rough[i], th[j], sum / n);
+        CHECK(sum / n <= 1.0 + 5e-3, "albedo %.4f > 1", sum / n);
+        CHECK(sum / n > 0.25, "albedo %.4f: implausibly low (GGX single scattering at roughness 1 keeps about 0.3)", sum / n);
+      }
   return rc;
 }
 
@@ -437,6 +476,7 @@ int main(int argc, char **argv) {
                                     {"rough_conductor", rough_conductor},
                                     {"rough_dielectric", rough_dielectric},
                                     {"microfacet_furnace", microfacet_furnace},
+                                    {"pbr_metallic_roughness", pbr_metallic_roughness},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -38,6 +38,23 @@ static int helmet_texels(const char *rel) {
     }
   }
   stbi_image_free(raw);
+  /* The metallic-roughness map: linear (no sRGB decoding), G = roughness, B = metallic,
+   * texel-exact too; the material is the glTF metallic-roughness model. */
+  const material *m = &s->mats[s->tri_mat[0]];
+  const char *mrjpg = shared_file("scenes/damaged-helmet/glTF/Default_metalRoughness.jpg");
+  CHECK(m->type == MAT_PBR && m->tex_mr >= 0 && mrjpg, "no metallic-roughness material or map");
+  t = &s->tex[m->tex_mr];
+  raw = stbi_load(mrjpg, &w, &h, &n, 3);
+  CHECK(raw && t->w == w && t->h == h, "metallic-roughness map %dx%d vs file %dx%d", t->w, t->h, w, h);
+  for (int i = 0; i < 5; i++) {
+    float u = (xs[i] + 0.5f) / w, v = 1 - (ys[i] + 0.5f) / h, px[4];
+    texture_lookup(t, u, v, px);
+    for (int c = 1; c < 3; c++) {
+      float expect = raw[3 * (ys[i] * w + xs[i]) + c] / 255.0f;
+      CHECK(fabsf(px[c] - expect) < 1e-6f, "metallic-roughness texel (%d,%d) channel %d: %g, expected %g", xs[i], ys[i], c, px[c], expect);
+    }
+  }
+  stbi_image_free(raw);
   /* Emissive map present too. */
   CHECK(s->mats[s->tri_mat[0]].tex_ke >= 0, "no emissive texture");
   scene_free(s);
@@ -235,9 +252,64 @@ static int bump_map(void) {
   return 0;
 }
 
+/* glTF metallic-roughness per texel: a quad whose 2x1 metallic-roughness map is metal
+ * with roughness 0 on the left (B = 255, G = 0) and a rough dielectric on the right
+ * (B = 0, G = 255), lit by a point light off to the side. The mirror-like left half
+ * reflects nothing towards the camera; the right half is diffusely lit. Checked for the
+ * glTF file (factors 1 x texels, clamped by its sampler) and for the JSON "pbr" material. */
+static const char gltf_mr_quad[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"NORMAL\": 1, \"TEXCOORD_0\": 2}, \"indices\": 3, \"material\": 0}]}],\n"
+    " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], \"metallicFactor\": 1, \"roughnessFactor\": 1,\n"
+    "                 \"metallicRoughnessTexture\": {\"index\": 0}}}],\n"
+    " \"textures\": [{\"source\": 0, \"sampler\": 0}], \"samplers\": [{\"wrapS\": 33071, \"wrapT\": 33071}], \"images\": [{\"uri\": \"mr.png\"}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1,-1,0], \"max\": [1,1,0]},\n"
+    "               {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\"},\n"
+    "               {\"bufferView\": 2, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"},\n"
+    "               {\"bufferView\": 3, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 48},\n"
+    "                 {\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 128, \"byteLength\": 12}],\n"
+    " \"buffers\": [{\"byteLength\": 140, \"uri\": \"data:application/octet-stream;base64,"
+    "AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/AAAAAAAAAAAAAIA/"
+    "AAAAAAAAAAAAAIA/AAAAAAAAgD8AAIA/AACAPwAAgD8AAAAAAAAAAAAAAAAAAAEAAgAAAAIAAwA=\"}]}\n";
+static int gltf_metallic_roughness(void) {
+  unsigned char mr[6] = {0, 0, 255, 0, 255, 0};
+  char png[1200];
+  snprintf(png, sizeof png, "%s/mr.png", scratch_dir());
+  CHECK(stbi_write_png(png, 2, 1, 3, mr, 6), "png");
+  /* JSON textures repeat, so the JSON material gets a 4x1 map (two texels per half). */
+  unsigned char mr4[12] = {0, 0, 255, 0, 0, 255, 0, 255, 0, 0, 255, 0};
+  snprintf(png, sizeof png, "%s/mr4.png", scratch_dir());
+  CHECK(stbi_write_png(png, 4, 1, 3, mr4, 12), "png");
+  CHECK(scratch_file("mr_quad.gltf", gltf_mr_quad), "write");
+  for (int form = 0; form < 2; form++) {
+    char json[1200];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 30},\n"
+             "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 64},\n"
+             "  %s\"shapes\": [{\"file\": \"mr_quad.gltf\"%s}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [3,0,2], \"intensity\": 10}] }\n",
+             form ? "\"materials\": {\"m\": {\"type\": \"pbr\", \"base_color\": 0.8, \"metallic\": 1, \"roughness\": 1, "
+                    "\"metallic_roughness_map\": \"mr4.png\"}},\n  " : "",
+             form ? ", \"material\": \"m\"" : "");
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "render failed");
+    /* Columns 4-5 see only texel 0 (u < 0.25, clamped), 26-27 only texel 1; rows 14-17. */
+    double left = 0, right = 0;
+    for (int y = 14; y < 18; y++)
+      for (int k = 0; k < 2; k++) { left += px[3 * (y * w + 4 + k) + 1]; right += px[3 * (y * w + 26 + k) + 1]; }
+    free(px);
+    fprintf(stderr, "%s: metal (roughness 0) half %.5f, rough dielectric half %.5f\n", form ? "JSON pbr" : "glTF", left / 8, right / 8);
+    CHECK(right / 8 > 0.05, "the rough dielectric half should be lit (%g)", right / 8);
+    CHECK(left < 0.01 * right, "the mirror-like metal half should reflect no light towards the camera (%g vs %g)", left / 8, right / 8);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
-                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {NULL, NULL}};
+                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -43,6 +43,7 @@ static inline rgb c3(float r, float g, float b) { rgb c = {r, g, b}; return c; }
 static inline rgb c3_add(rgb a, rgb b) { return c3(a.r + b.r, a.g + b.g, a.b + b.b); }
 static inline rgb c3_mul(rgb a, rgb b) { return c3(a.r * b.r, a.g * b.g, a.b * b.b); }
 static inline rgb c3_scale(rgb a, float s) { return c3(a.r * s, a.g * s, a.b * s); }
+static inline rgb c3_sub(rgb a, rgb b) { return c3(a.r - b.r, a.g - b.g, a.b - b.b); }
 static inline float c3_max(rgb a) { return fmaxf(a.r, fmaxf(a.g, a.b)); }
 static inline float c3_lum(rgb a) { return 0.2126f * a.r + 0.7152f * a.g + 0.0722f * a.b; }
 static inline float c3_avg(rgb a) { return (a.r + a.g + a.b) * (1.0f / 3.0f); }

@@ -10,7 +10,7 @@
 
 typedef enum bsdf_type {
   BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR,
-  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC
+  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR
 } bsdf_type;
 
 typedef struct bsdf {
@@ -21,6 +21,7 @@ typedef struct bsdf {
   rgb cond_eta, cond_k;
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types) */
+  float metallic;     /* BSDF_PBR */
 } bsdf;
 
 typedef struct bsdf_sample {

@@ -87,8 +87,8 @@ static float ai_float(const struct aiMaterial *m, const char *key, unsigned type
 
 /* Loads texture slot `type` of am into the scene: a file beside the mesh, or an image
  * embedded in the file ("*N"). Returns the texture index or -1. */
-static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type,
-                     const char *dir, int srgb, int *wrap_mode) {
+static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type,
+                           const char *dir, int srgb, int *wrap_mode) {
   if (aiGetMaterialTextureCount(am, type) == 0) return -1;
   struct aiString path;
   enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
@@ -109,6 +109,17 @@ static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial
   else snprintf(full, sizeof full, "%s%s", dir, p);
   for (char *q = full; *q; q++) if (*q == '\\') *q = '/';
   return scene_texture_file(s, full, srgb);
+}
+
+/* The texture of a material slot (-1 if none or unreadable), with the slot's wrap mode
+ * (glTF sampler wrapS; Assimp reports one mode per slot). */
+static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type, const char *dir, int srgb,
+                     int *wrap_out) {
+  int wrap = aiTextureMapMode_Wrap;
+  int t = load_slot_image(s, ai, am, type, dir, srgb, &wrap);
+  if (t >= 0) s->tex[t].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
+  if (wrap_out) *wrap_out = wrap;
+  return t;
 }
 
 static material convert_material(const struct aiMaterial *am) {
@@ -136,6 +147,7 @@ static material convert_material(const struct aiMaterial *am) {
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
   m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
   m.bump_scale = 1;
+  m.tex_mr = -1;
   m.alpha_cutoff = 0.5f;
   return m;
 }
@@ -155,11 +167,10 @@ static int looks_like_normal_map(const texture *t) {
   return b > 0.7 && fabs(r - 0.5) < 0.15 && fabs(g - 0.5) < 0.15 && spread > 0.2;
 }
 
-static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir) {
+static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf) {
   int wrap = 0;
   m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
-  if (m->tex_kd >= 0) s->tex[m->tex_kd].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
   m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, dir, 0, NULL);
   /* MTL bump / map_bump (Assimp's HEIGHT slot) with its -bm multiplier. */
@@ -176,23 +187,15 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
   /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */
-  /* glTF metallic-roughness (docs/scene-format.md): a metal (metallic >= 0.5, no
-   * per-texel metallic map) becomes a GGX conductor whose Fresnel term has F0 = base
-   * colour (eta = (1 + sqrt F0) / (1 - sqrt F0), k = 0) and alpha = roughness^2;
-   * anything else stays Lambertian in its base colour. */
-  float metallic = ai_float(am, AI_MATKEY_METALLIC_FACTOR, -1);
-  if (metallic >= 0.5f && aiGetMaterialTextureCount(am, aiTextureType_METALNESS) == 0 &&
-      aiGetMaterialTextureCount(am, aiTextureType_UNKNOWN) == 0 && m->type == MAT_DIFFUSE) {
-    float f0[3] = {m->kd.r, m->kd.g, m->kd.b}, eta[3];
-    for (int c = 0; c < 3; c++) {
-      float r = sqrtf(clampf(f0[c], 0, 0.998f));
-      eta[c] = (1 + r) / (1 - r);
-    }
-    m->type = MAT_CONDUCTOR;
-    m->eta = c3(eta[0], eta[1], eta[2]);
-    m->k = c3(0, 0, 0);
+  /* glTF 2.0 metallic-roughness (docs/scene-format.md): MAT_PBR with the factors (glTF
+   * defaults 1 and 1) times the metallic-roughness texture (G roughness, B metallic),
+   * which Assimp 5.2 files under METALNESS or, for older files, UNKNOWN. */
+  if (gltf) {
+    m->type = MAT_PBR;
+    m->metallic = clampf(ai_float(am, AI_MATKEY_METALLIC_FACTOR, 1), 0, 1);
     m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
-    m->tex_kd = -1;
+    m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, dir, 0, NULL);
+    if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, dir, 0, NULL);
   }
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
@@ -401,9 +404,11 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     char dir[1024] = "";
     const char *slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
+    const char *ext = strrchr(path, '.');
+    int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
       material m = convert_material(ai->mMaterials[i]);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, gltf);
       s->mats[c.mat_base + i] = m;
     }
     if (ai->mNumMaterials == 0) {

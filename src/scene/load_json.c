@@ -215,7 +215,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   if (!cJSON_IsObject(o)) return bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(get_str(c, o, "type", where, &type));
-  if (!type) return bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor)");
+  if (!type) return bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor, pbr)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -223,7 +223,29 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  if (!strcmp(type, "diffuse")) {
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
+                                      "two_sided", "bump_map", "bump_scale", NULL};
+  if (!strcmp(type, "pbr")) {
+    TRY(check_keys(c, o, where, k_pbr));
+    m->type = MAT_PBR;
+    m->roughness = 0.5f;
+    TRY(get_rgb_tex(c, o, "base_color", where, &m->kd, &m->tex_kd));
+    double metal = 0;
+    TRY(get_num(c, o, "metallic", where, 0, 1, &metal));
+    m->metallic = (float)metal;
+    const char *mr = NULL;
+    TRY(get_str(c, o, "metallic_roughness_map", where, &mr));
+    if (mr) {
+      char full[2048];
+      resolve_path(c, mr, full, sizeof full);
+      m->tex_mr = scene_texture_file(c->s, full, 0);
+      if (m->tex_mr < 0) {
+        char w[300];
+        snprintf(w, sizeof w, "%s.metallic_roughness_map", where);
+        return bad(c, w, "cannot read the metallic-roughness map");
+      }
+    }
+  } else if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
     TRY(get_rgb_tex(c, o, "reflectance", where, &m->kd, &m->tex_kd));
@@ -270,7 +292,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     TRY(get_rgb(c, o, "eta", where, &m->eta));
     TRY(get_rgb(c, o, "k", where, &m->k));
   } else {
-    return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor)");
+    return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr)");
   }
   const char *nmap = NULL;
   TRY(get_str(c, o, "normal_map", where, &nmap));
@@ -299,7 +321,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   double bscale = 1;
   TRY(get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
   m->bump_scale = (float)bscale;
-  double rough = 0;
+  double rough = m->roughness;
   TRY(get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));

@@ -13,7 +13,8 @@ typedef enum mat_type {
   MAT_PHONG,       /* kd/pi + normalised Phong lobe ks (n+2)/(2pi) cos^n */
   MAT_MIRROR,      /* kd/pi + ideal mirror ks, no Fresnel (MTL illum 5; JSON mirror: kd=0) */
   MAT_DIELECTRIC,  /* smooth dielectric, index ior */
-  MAT_CONDUCTOR    /* smooth conductor, complex index eta + i k per channel */
+  MAT_CONDUCTOR,   /* smooth conductor, complex index eta + i k per channel */
+  MAT_PBR          /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
 } mat_type;
 
 typedef struct material {
@@ -23,6 +24,8 @@ typedef struct material {
   float ior;
   rgb eta, k;
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
+  float metallic;    /* MAT_PBR: 0 dielectric .. 1 metal */
+  int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
