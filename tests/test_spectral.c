@@ -11,9 +11,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifndef VALO_SOURCE_DIR
+#define VALO_SOURCE_DIR "."
+#endif
+
 static int sellmeier_table(void) {
-  struct { dispersion d; float n; } t[3] = {{DISP_FUSED_SILICA, 1.4584f}, {DISP_SAPPHIRE, 1.7682f}, {DISP_WATER, 1.3332f}};
-  for (int i = 0; i < 3; i++) {
+  struct { dispersion d; float n; } t[4] = {{DISP_FUSED_SILICA, 1.4584f}, {DISP_SAPPHIRE, 1.7682f}, {DISP_WATER, 1.3332f}, {DISP_DENSE_FLINT, 1.7845f}};
+  for (int i = 0; i < 4; i++) { /* the thesis table; SF11: n_d = 1.78472 at 587.6 nm is 1.7845 at 589.3 */
     float n = dispersion_ior(t[i].d, 589.3f);
     CHECK(fabsf(n - t[i].n) < 2e-4f, "preset %d: n(589) = %.5f, thesis %.4f", i, n, t[i].n);
     CHECK(dispersion_ior(t[i].d, 450) > dispersion_ior(t[i].d, 650), "normal dispersion: blue bends more");
@@ -156,8 +160,54 @@ static int dispersive_slab(void) {
   return 0;
 }
 
+/* The bundled prism demo (scenes/prism.json: a slit seen through a dense-flint prism at
+ * minimum deviation) shows a rainbow in spectral mode — saturated red, green and blue
+ * pixels, red above blue as a prism orders them seen from this side — and none in RGB
+ * mode, where the slit's image stays white. Small film and sample count. */
+static int prism_rainbow(void) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/scenes/prism.json", VALO_SOURCE_DIR);
+  for (int spectral = 0; spectral < 2; spectral++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.spectral = spectral;
+    o.width = 96; o.height = 64; o.spp = 64;
+    valo_error err;
+    valo_scene *sc;
+    valo_render *r;
+    CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    float *px = malloc(sizeof(float) * 96 * 64 * 3);
+    CHECK(px, "oom");
+    valo_render_pixels(r, px);
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+    int n[3] = {0, 0, 0}, bright = 0;
+    double yc[3] = {0, 0, 0};
+    for (int i = 0; i < 96 * 64; i++) {
+      float R = px[3 * i], G = px[3 * i + 1], B = px[3 * i + 2], sum = R + G + B;
+      if (sum < 0.3f) continue;
+      bright++;
+      int c = R > 0.7f * sum ? 0 : G > 0.6f * sum ? 1 : B > 0.6f * sum ? 2 : -1;
+      if (c >= 0) { n[c]++; yc[c] += i / 96; }
+    }
+    free(px);
+    fprintf(stderr, "%s: %d bright pixels; saturated red %d, green %d, blue %d\n", spectral ? "spectral" : "RGB", bright, n[0], n[1], n[2]);
+    if (spectral) {
+      CHECK(n[0] > 20 && n[1] > 20 && n[2] > 20, "no rainbow: red %d, green %d, blue %d saturated pixels", n[0], n[1], n[2]);
+      CHECK(yc[0] / n[0] < yc[1] / n[1] && yc[1] / n[1] < yc[2] / n[2], "colours out of order (mean rows red %.1f, green %.1f, blue %.1f)",
+            yc[0] / n[0], yc[1] / n[1], yc[2] / n[2]);
+    } else {
+      CHECK(bright > 20, "RGB mode should show the slit (%d bright pixels)", bright);
+      CHECK(n[0] + n[1] + n[2] < bright / 20, "RGB mode has no dispersion, yet %d of %d pixels are saturated", n[0] + n[1] + n[2], bright);
+    }
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"sellmeier_table", sellmeier_table}, {"rgb_equals_spectral", rgb_equals_spectral},
-                                    {"dispersive_slab", dispersive_slab}, {NULL, NULL}};
+                                    {"dispersive_slab", dispersive_slab}, {"prism_rainbow", prism_rainbow}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -129,17 +129,20 @@ rgb spec_to_rgb(spec4 L, const wavelengths *w) {
 
 int dispersion_parse(const char *name, dispersion *d) {
   static const struct { const char *n; dispersion d; } t[] = {
-      {"fused_silica", DISP_FUSED_SILICA}, {"sapphire", DISP_SAPPHIRE}, {"water", DISP_WATER}, {"cauchy_glass", DISP_CAUCHY_GLASS}};
+      {"fused_silica", DISP_FUSED_SILICA}, {"sapphire", DISP_SAPPHIRE}, {"water", DISP_WATER}, {"cauchy_glass", DISP_CAUCHY_GLASS},
+      {"dense_flint", DISP_DENSE_FLINT}};
   for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
     if (!strcmp(name, t[i].n)) { *d = t[i].d; return 0; }
   return -1;
 }
 
-/* Sellmeier n^2 = 1 + sum A_j l^2 / (l^2 - B_j^2), B_j in micrometres (thesis table 2.1);
+/* Sellmeier n^2 = 1 + sum A_j l^2 / (l^2 - B_j^2), B_j in micrometres (thesis table 2.1;
+ * dense flint: Schott's published SF11 coefficients, n_d = 1.7847, Abbe number 25.8);
  * Cauchy n = A + B / l^2 with the thesis' fused-silica fit. */
 float dispersion_ior(dispersion d, float lambda_nm) {
   static const float silica[2][3] = {{0.66347f, 0.44065f, 0.89901f}, {0.06652f, 0.11502f, 9.9032f}};
   static const float sapphire[2][3] = {{0.53148f, 1.55060f, 5.28958f}, {0.02179f, 0.10335f, 17.9393f}};
+  static const float flint[2][3] = {{1.73759695f, 0.313747346f, 1.89878101f}, {0.114842f, 0.249613f, 12.459385f}};
   static const float water[2][4] = {{0.5689f, 0.17197f, 0.02063f, 0.11240f}, {0.07149f, 0.13510f, 0.16199f, 3.26727f}};
   float l = lambda_nm * 1e-3f, l2 = l * l, n2 = 1;
   switch (d) {
@@ -148,6 +151,7 @@ float dispersion_ior(dispersion d, float lambda_nm) {
   case DISP_SAPPHIRE: for (int j = 0; j < 3; j++) n2 += sapphire[0][j] * l2 / (l2 - sapphire[1][j] * sapphire[1][j]); break;
   case DISP_WATER: for (int j = 0; j < 4; j++) n2 += water[0][j] * l2 / (l2 - water[1][j] * water[1][j]); break;
   case DISP_CAUCHY_GLASS: return 1.4481f + 0.00354f / l2;
+  case DISP_DENSE_FLINT: for (int j = 0; j < 3; j++) n2 += flint[0][j] * l2 / (l2 - flint[1][j] * flint[1][j]); break;
   }
   return sqrtf(n2);
 }

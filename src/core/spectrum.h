@@ -32,7 +32,7 @@ static inline int spec_black(spec4 a) { for (int i = 0; i < N_LAMBDA; i++) if (a
 void cie_xyz(float lambda_nm, float *x, float *y, float *z);
 
 /* Dispersion (digest 000, thesis table 2.1): index of refraction at wavelength lambda. */
-typedef enum dispersion { DISP_NONE, DISP_FUSED_SILICA, DISP_SAPPHIRE, DISP_WATER, DISP_CAUCHY_GLASS } dispersion;
+typedef enum dispersion { DISP_NONE, DISP_FUSED_SILICA, DISP_SAPPHIRE, DISP_WATER, DISP_CAUCHY_GLASS, DISP_DENSE_FLINT } dispersion;
 int dispersion_parse(const char *name, dispersion *d);
 float dispersion_ior(dispersion d, float lambda_nm);
 #endif

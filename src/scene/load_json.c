@@ -274,7 +274,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     TRY(get_str(c, o, "dispersion", where, &disp));
     if (disp) {
       dispersion d;
-      if (dispersion_parse(disp, &d)) return bad(c, where, "unknown dispersion (fused_silica, sapphire, water, cauchy_glass)");
+      if (dispersion_parse(disp, &d)) return bad(c, where, "unknown dispersion (fused_silica, sapphire, water, cauchy_glass, dense_flint)");
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
