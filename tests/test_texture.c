@@ -307,9 +307,47 @@ static int gltf_metallic_roughness(void) {
   return 0;
 }
 
+/* MTL map_Ns multiplies the Phong exponent: Ns 250 with a map of value 0.2 (51/255)
+ * renders as Ns 50 (to float rounding), and differs clearly from Ns 250 alone. */
+static float *phong_quad(const char *mtl_body) {
+  char mtl[300];
+  snprintf(mtl, sizeof mtl, "newmtl m\nKd 0.3 0.3 0.3\nKs 0.5 0.5 0.5\nillum 2\n%s", mtl_body);
+  if (!scratch_file("nsquad.mtl", mtl)) return NULL;
+  if (!scratch_file("nsquad.obj", "mtllib nsquad.mtl\nusemtl m\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                  "vn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"))
+    return NULL;
+  int w, h;
+  return render_json_text("{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 30},\n"
+                          "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 64},\n"
+                          "  \"shapes\": [{\"file\": \"nsquad.obj\"}],\n"
+                          "  \"lights\": [{\"type\": \"point\", \"position\": [0.3,0,3], \"intensity\": 5}] }\n",
+                          NULL, &w, &h);
+}
+static int phong_exponent_map(void) {
+  unsigned char v[4 * 4];
+  memset(v, 51, sizeof v);
+  char png[1200];
+  snprintf(png, sizeof png, "%s/ns.png", scratch_dir());
+  CHECK(stbi_write_png(png, 4, 4, 1, v, 4), "png");
+  float *mapped = phong_quad("Ns 250\nmap_Ns ns.png\n"), *ns50 = phong_quad("Ns 50\n"), *ns250 = phong_quad("Ns 250\n");
+  CHECK(mapped && ns50 && ns250, "render failed");
+  double d50 = 0, d250 = 0, peak = 0;
+  for (int i = 0; i < 16 * 16 * 3; i++) {
+    d50 = fmax(d50, fabs(mapped[i] - ns50[i]));
+    d250 = fmax(d250, fabs(mapped[i] - ns250[i]));
+    peak = fmax(peak, ns50[i]);
+  }
+  free(mapped); free(ns50); free(ns250);
+  fprintf(stderr, "Ns 250 x map 0.2 against Ns 50: max difference %.5f; against Ns 250: %.5f (peak %.4f)\n", d50, d250, peak);
+  CHECK(d50 < 0.01 * peak, "map_Ns should give exponent 50 (max difference %g of peak %g)", d50, peak);
+  CHECK(d250 > 0.2 * peak, "map_Ns had no effect (difference from Ns 250 only %g)", d250);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
-                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness}, {NULL, NULL}};
+                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
+                                    {"phong_exponent_map", phong_exponent_map}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

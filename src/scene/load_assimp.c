@@ -147,7 +147,7 @@ static material convert_material(const struct aiMaterial *am) {
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
   m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
   m.bump_scale = 1;
-  m.tex_mr = -1;
+  m.tex_mr = m.tex_ns = -1;
   m.alpha_cutoff = 0.5f;
   return m;
 }
@@ -172,6 +172,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
+  m->tex_ns = load_slot(s, ai, am, aiTextureType_SHININESS, dir, 0, NULL);
   m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, dir, 0, NULL);
   /* MTL bump / map_bump (Assimp's HEIGHT slot) with its -bm multiplier. */
   int height = load_slot(s, ai, am, aiTextureType_HEIGHT, dir, 0, NULL);

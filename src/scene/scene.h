@@ -32,6 +32,7 @@ typedef struct material {
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
   int tex_alpha;     /* alpha-cutout texture, -1 = none */
   int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
+  int tex_ns;        /* Phong exponent map (MTL map_Ns; linear, mean of RGB multiplies exponent), -1 = none */
   int tex_bump;      /* height map for bump mapping (mean of RGB, linear), -1 = none */
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
