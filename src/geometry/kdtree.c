@@ -17,9 +17,15 @@
 #define KD_ISECT_COST 80.0f
 #define KD_EMPTY_BONUS 0.5f
 #define KD_LEAF 3u
+#define KD_BELOW_EMPTY 4u /* interior: the child below the plane is an empty leaf, not stored */
+#define KD_ABOVE_EMPTY 8u /* interior: the child above the plane is an empty leaf, not stored */
+#define KD_MAX_NODES (1u << 28)
 
-/* 8 bytes: split position or leaf primitive offset; low 2 bits of flags: axis or leaf;
- * upper 30 bits: leaf primitive count or index of the above child. */
+/* 8 bytes: split position or leaf primitive offset; low 2 bits of flags: axis or leaf.
+ * Leaf: upper 30 bits = primitive count. Interior: bits 2-3 = KD_BELOW_EMPTY and
+ * KD_ABOVE_EMPTY, upper 28 bits = index of the above child; the below child, when
+ * stored, follows its parent. Empty leaves (over half of all leaves: the SAH cuts off
+ * empty space) are not stored, so rays never load them. */
 typedef struct kd_node {
   union { float split; uint32_t prim_offset; };
   uint32_t flags;
@@ -72,6 +78,7 @@ static void evlist_free(evlist *l) { for (int k = 0; k < 3; k++) { free(l->e[k])
 
 static uint32_t push_node(kd_builder *b) {
   kdtree *kd = b->kd;
+  if (kd->nnodes >= KD_MAX_NODES) { b->oom = 1; return UINT32_MAX; }
   if (kd->nnodes == kd->cap_nodes) {
     uint32_t nc = kd->cap_nodes ? kd->cap_nodes * 2 : 1024;
     kd_node *n = realloc(kd->nodes, (size_t)nc * sizeof *n);
@@ -281,14 +288,23 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
   R.ntris = rcount;
 
   kd->nodes[node].split = best_pos;
-  kd->nodes[node].flags = (uint32_t)k;
-  uint32_t below = push_node(b);
-  if (below == UINT32_MAX) { evlist_free(&L); evlist_free(&R); return; }
-  build(b, below, lbox, &L, depth - 1, bad_refines);
-  uint32_t above = push_node(b);
-  if (above == UINT32_MAX) { evlist_free(&R); return; }
-  kd->nodes[node].flags = (uint32_t)k | (above << 2);
-  build(b, above, rbox, &R, depth - 1, bad_refines);
+  uint32_t fl = (uint32_t)k;
+  kd->nodes[node].flags = fl | KD_BELOW_EMPTY | KD_ABOVE_EMPTY;
+  if (lcount == 0) { fl |= KD_BELOW_EMPTY; evlist_free(&L); }
+  else {
+    uint32_t below = push_node(b);
+    if (below == UINT32_MAX) { evlist_free(&L); evlist_free(&R); return; }
+    build(b, below, lbox, &L, depth - 1, bad_refines);
+  }
+  if (rcount == 0) { fl |= KD_ABOVE_EMPTY; evlist_free(&R); }
+  else {
+    uint32_t above = push_node(b);
+    if (above == UINT32_MAX) { evlist_free(&R); return; }
+    fl |= above << 4;
+    kd->nodes[node].flags = fl | KD_ABOVE_EMPTY; /* valid while the above subtree builds */
+    build(b, above, rbox, &R, depth - 1, bad_refines);
+  }
+  kd->nodes[node].flags = fl;
 }
 
 /* ---------------------------------------------------------------- queries */
@@ -407,17 +423,23 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
       /* Near child by the sign of 1/d (so -0 counts as negative, +0 as positive): the
        * near side is the one the ray enters first. t = tp splits [tmin, tmax]. */
       float tp = (n->split - o[axis]) * id[axis];
-      uint32_t below = ni + 1, above = n->flags >> 2;
+      uint32_t fl = n->flags, below = ni + 1, above = fl >> 4;
+      int below_ok = !(fl & KD_BELOW_EMPTY), above_ok = !(fl & KD_ABOVE_EMPTY);
       uint32_t nearc = neg[axis] ? above : below, farc = neg[axis] ? below : above;
-      if (tp > tmax) ni = nearc;
-      else if (tp < tmin) ni = farc;
+      int near_ok = neg[axis] ? above_ok : below_ok, far_ok = neg[axis] ? below_ok : above_ok;
+      if (tp > tmax) { if (!near_ok) goto pop; ni = nearc; }
+      else if (tp < tmin) { if (!far_ok) goto pop; ni = farc; }
       else if (tp == tp) {
-        todo[ntodo].node = farc; todo[ntodo].tmin = tp; todo[ntodo].tmax = tmax; ntodo++;
-        ni = nearc;
-        tmax = tp;
+        if (!far_ok) { ni = nearc; tmax = tp; }
+        else if (!near_ok) { ni = farc; tmin = tp; }
+        else {
+          todo[ntodo].node = farc; todo[ntodo].tmin = tp; todo[ntodo].tmax = tmax; ntodo++;
+          ni = nearc;
+          tmax = tp;
+        }
       } else { /* origin on the plane, ray in it: visit both over the whole interval */
-        todo[ntodo].node = farc; todo[ntodo].tmin = tmin; todo[ntodo].tmax = tmax; ntodo++;
-        ni = nearc;
+        if (near_ok && far_ok) { todo[ntodo].node = farc; todo[ntodo].tmin = tmin; todo[ntodo].tmax = tmax; ntodo++; }
+        ni = near_ok ? nearc : farc;
       }
       continue;
     }
@@ -449,6 +471,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
         h->t = t; h->b1 = b1; h->b2 = b2; h->tri = g->id[lane];
       }
     }
+  pop:
     if (ntodo == 0) break;
     ntodo--;
     ni = todo[ntodo].node; tmin = todo[ntodo].tmin; tmax = todo[ntodo].tmax;
@@ -470,8 +493,14 @@ void kdtree_stats(const accel *a, kd_stats *st) {
   if (a->ops != &kd_ops) return;
   const kdtree *kd = (const kdtree *)a;
   st->nodes = kd->nnodes;
-  for (uint32_t i = 0; i < kd->nnodes; i++)
-    if ((kd->nodes[i].flags & 3) == KD_LEAF) { st->leaves++; if ((kd->nodes[i].flags >> 2) == 0) st->empty_leaves++; }
+  for (uint32_t i = 0; i < kd->nnodes; i++) {
+    uint32_t f = kd->nodes[i].flags;
+    if ((f & 3) == KD_LEAF) { st->leaves++; if ((f >> 2) == 0) st->empty_leaves++; }
+    else { /* elided empty children count as (unstored) empty leaves */
+      st->leaves += ((f & KD_BELOW_EMPTY) != 0) + ((f & KD_ABOVE_EMPTY) != 0);
+      st->empty_leaves += ((f & KD_BELOW_EMPTY) != 0) + ((f & KD_ABOVE_EMPTY) != 0);
+    }
+  }
   for (uint32_t i = 0; i < kd->nnodes; i++)
     if ((kd->nodes[i].flags & 3) == KD_LEAF) st->refs += kd->nodes[i].flags >> 2;
   st->max_depth = kd->max_depth_seen;
