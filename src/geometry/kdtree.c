@@ -33,8 +33,11 @@ typedef struct kd_node {
 
 /* A leaf's triangles are stored in leaf order, vertices inline, in groups of four laid
  * out for SSE (v[vertex][axis][lane]), so a leaf is read sequentially and tested four
- * triangles at a time (tri4_intersect). Unused lanes have id UINT32_MAX. */
-typedef struct kd_tri4 { float v[3][3][4]; uint32_t id[4]; uint32_t filt; } kd_tri4; /* filt: lanes needing the hit filter */
+ * triangles at a time (tri4_intersect). Unused lanes of a leaf's last group repeat its
+ * first triangle and are masked by the leaf's count. Triangle ids (read only for a hit)
+ * and alpha-filter lanes sit in parallel arrays: triangle data is where the cache
+ * misses are (docs/performance.md), so the groups hold vertices only. */
+typedef struct kd_tri4 { float v[3][3][4]; } kd_tri4; /* 144 bytes */
 
 typedef struct kdtree {
   accel base;
@@ -43,6 +46,8 @@ typedef struct kdtree {
   kd_node *nodes;
   uint32_t nnodes, cap_nodes;
   kd_tri4 *prims;     /* leaf-ordered triangle groups */
+  uint32_t *ids;      /* 4 per group: triangle index (UINT32_MAX in unused lanes) */
+  uint8_t *gfilt;     /* per group: lanes that need the hit filter (alpha) */
   accel_filter filter;
   int has_filter;
   uint64_t nprims, cap_prims;
@@ -95,8 +100,13 @@ static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {
     uint64_t nc = kd->cap_prims ? kd->cap_prims : 1024;
     while (nc < kd->nprims + groups) nc *= 2;
     kd_tri4 *p = realloc(kd->prims, nc * sizeof *p);
-    if (!p) { b->oom = 1; return; }
-    kd->prims = p; kd->cap_prims = nc;
+    if (p) kd->prims = p;
+    uint32_t *ids = realloc(kd->ids, nc * 4 * sizeof *ids);
+    if (ids) kd->ids = ids;
+    uint8_t *gf = realloc(kd->gfilt, nc);
+    if (gf) kd->gfilt = gf;
+    if (!p || !ids || !gf) { b->oom = 1; return; }
+    kd->cap_prims = nc;
   }
   if (kd->nprims > 0xFFFFFFFFu) { b->oom = 1; return; }
   kd->nodes[node].prim_offset = (uint32_t)kd->nprims;
@@ -105,13 +115,15 @@ static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {
     uint32_t type = l->e[0][i].v & 3;
     if (type != EV_START && type != EV_PLANAR) continue;
     uint32_t t = l->e[0][i].v >> 2;
-    kd_tri4 *g = &kd->prims[kd->nprims + count / 4];
+    uint64_t gi = kd->nprims + count / 4;
+    kd_tri4 *g = &kd->prims[gi];
     int lane = count % 4;
-    if (lane == 0) { memset(g, 0, sizeof *g); for (int k = 0; k < 4; k++) g->id[k] = UINT32_MAX; }
-    for (int vtx = 0; vtx < 3; vtx++)
-      for (int ax = 0; ax < 3; ax++) g->v[vtx][ax][lane] = kd->tv[9 * (size_t)t + 3 * vtx + ax];
-    g->id[lane] = t;
-    if (kd->has_filter && (kd->filter.tri_flags[t] & kd->filter.flag_bit)) g->filt |= 1u << lane;
+    for (int k = lane == 0 ? 0 : lane; k < (lane == 0 ? 4 : lane + 1); k++) /* lane 0 fills all four */
+      for (int vtx = 0; vtx < 3; vtx++)
+        for (int ax = 0; ax < 3; ax++) g->v[vtx][ax][k] = kd->tv[9 * (size_t)t + 3 * vtx + ax];
+    if (lane == 0) { for (int k = 0; k < 4; k++) kd->ids[4 * gi + k] = UINT32_MAX; kd->gfilt[gi] = 0; }
+    kd->ids[4 * gi + lane] = t;
+    if (kd->has_filter && (kd->filter.tri_flags[t] & kd->filter.flag_bit)) kd->gfilt[gi] |= (uint8_t)(1u << lane);
     count++;
   }
   kd->nprims += (count + 3) / 4;
@@ -328,8 +340,8 @@ static inline int box_clip(const kdtree *kd, const ray *r, vec3 inv, float *t0, 
  * same operation order, so every lane's t and barycentrics equal the scalar test's bit
  * for bit. A lane whose edge function is exactly zero sends the group to the scalar
  * test (which then re-evaluates in double precision). Returns the nearest hit. */
-static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, float tmax, float *t_out, float *b1_out, float *b2_out,
-                                 int *lane_out) {
+static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, uint32_t nvalid, float tmax, float *t_out, float *b1_out,
+                                 float *b2_out, int *lane_out) {
   const float o[3] = {s->o.x, s->o.y, s->o.z};
   const int kx = s->kx, ky = s->ky, kz = s->kz;
   __m128 ox = _mm_set1_ps(o[kx]), oy = _mm_set1_ps(o[ky]), oz = _mm_set1_ps(o[kz]);
@@ -344,14 +356,13 @@ static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, float tma
   __m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
   __m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
   __m128 zero = _mm_setzero_ps();
-  __m128i ids = _mm_loadu_si128((const __m128i *)g->id);
-  __m128 valid = _mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(ids, _mm_set1_epi32(-1)), _mm_set1_epi32(-1)));
+  static const int32_t lanes_valid[5][4] = {{0, 0, 0, 0}, {-1, 0, 0, 0}, {-1, -1, 0, 0}, {-1, -1, -1, 0}, {-1, -1, -1, -1}};
+  __m128 valid = _mm_castsi128_ps(_mm_loadu_si128((const __m128i *)lanes_valid[nvalid < 4 ? nvalid : 4]));
   __m128 anyzero = _mm_and_ps(valid, _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)), _mm_cmpeq_ps(w, zero)));
   if (_mm_movemask_ps(anyzero)) {
     /* Rare: an edge function is exactly zero; the scalar test handles it in double. */
     int found = 0;
-    for (int k = 0; k < 4; k++) {
-      if (g->id[k] == UINT32_MAX) continue;
+    for (int k = 0; k < 4 && (uint32_t)k < nvalid; k++) {
       float tv[9], t, b1, b2;
       for (int vtx = 0; vtx < 3; vtx++)
         for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
@@ -444,31 +455,33 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
       continue;
     }
     uint32_t cnt = n->flags >> 2;
-    const kd_tri4 *g = &kd->prims[n->prim_offset];
-    for (uint32_t i = 0; i < cnt; i += 4, g++) {
+    uint32_t gi = n->prim_offset;
+    const kd_tri4 *g = &kd->prims[gi];
+    for (uint32_t i = 0; i < cnt; i += 4, g++, gi++) {
       float t, b1, b2;
       int lane;
-      if (g->filt) {
+      if (kd->has_filter && kd->gfilt[gi]) {
         /* Alpha-tested triangles: lane by lane, each hit through the filter. */
+        const uint32_t *gid = &kd->ids[4 * (size_t)gi];
         for (int k = 0; k < 4; k++) {
-          if (g->id[k] == UINT32_MAX) continue;
+          if (gid[k] == UINT32_MAX) continue;
           float tv[9];
           for (int vtx = 0; vtx < 3; vtx++)
             for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
           if (!tri_intersect(&sh, tv, best, &t, &b1, &b2)) continue;
-          if (((g->filt >> k) & 1) && !kd->filter.pass(kd->filter.user, g->id[k], b1, b2)) continue;
+          if (((kd->gfilt[gi] >> k) & 1) && !kd->filter.pass(kd->filter.user, gid[k], b1, b2)) continue;
           if (any) return 1;
           best = t;
           found = 1;
-          h->t = t; h->b1 = b1; h->b2 = b2; h->tri = g->id[k];
+          h->t = t; h->b1 = b1; h->b2 = b2; h->tri = gid[k];
         }
         continue;
       }
-      if (tri4_intersect(&sh, g, best, &t, &b1, &b2, &lane)) {
+      if (tri4_intersect(&sh, g, cnt - i, best, &t, &b1, &b2, &lane)) {
         if (any) return 1;
         best = t;
         found = 1;
-        h->t = t; h->b1 = b1; h->b2 = b2; h->tri = g->id[lane];
+        h->t = t; h->b1 = b1; h->b2 = b2; h->tri = kd->ids[4 * (size_t)gi + lane];
       }
     }
   pop:
@@ -484,7 +497,7 @@ static int kd_occluded(const accel *a, const ray *r) { hit h; return kd_query((c
 static void kd_destroy(accel *a) {
   kdtree *kd = (kdtree *)a;
   if (!kd) return;
-  free(kd->tv); free(kd->nodes); free(kd->prims); free(kd);
+  free(kd->tv); free(kd->nodes); free(kd->prims); free(kd->ids); free(kd->gfilt); free(kd);
 }
 static const accel_ops kd_ops = {"kdtree", kd_intersect, kd_occluded, kd_destroy};
 
@@ -504,7 +517,7 @@ void kdtree_stats(const accel *a, kd_stats *st) {
   for (uint32_t i = 0; i < kd->nnodes; i++)
     if ((kd->nodes[i].flags & 3) == KD_LEAF) st->refs += kd->nodes[i].flags >> 2;
   st->max_depth = kd->max_depth_seen;
-  st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * sizeof(kd_tri4);
+  st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * (sizeof(kd_tri4) + 4 * sizeof(uint32_t) + 1);
 }
 
 valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
