@@ -3,7 +3,9 @@
  * build seconds, Mrays/s for closest-hit and for shadow (any-hit) queries, and the
  * kd/Embree ratio. Then the kd-tree build on the dragon's four resolutions (N log N
  * growth) with memory per triangle. Prints a Markdown table; scenes come from
- * ../shared/scenes (or VALO_SHARED). Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] */
+ * ../shared/scenes (or VALO_SHARED). --classes instead times camera misses, camera hits
+ * and bounce rays apart. Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table]
+ * [--classes] */
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/offset.h"
@@ -113,6 +115,34 @@ static int load(scene *s, const char *rel, const float *xf) {
   return 0;
 }
 
+/* --classes: the closest-hit rays split into camera rays that miss, camera rays that hit
+ * and bounce rays (which start on a surface, go anywhere and find cold caches), each
+ * class timed on both backends, single-threaded, alternating. */
+static void class_table(const char *name, accel *const acc[2], const ray *rays, long n) {
+  ray *cls[3];
+  long nc[3] = {0, 0, 0};
+  for (int k = 0; k < 3; k++) cls[k] = malloc(sizeof(ray) * (size_t)n);
+  if (!cls[0] || !cls[1] || !cls[2]) { for (int k = 0; k < 3; k++) free(cls[k]); return; }
+  vec3 eye = rays[0].o; /* make_rays starts with a camera ray */
+  for (long i = 0; i < n; i++) {
+    hit h;
+    int from_eye = rays[i].o.x == eye.x && rays[i].o.y == eye.y && rays[i].o.z == eye.z;
+    int k = from_eye ? accel_intersect(acc[1], &rays[i], &h) : 2;
+    cls[k][nc[k]++] = rays[i];
+  }
+  static const char *const names[3] = {"camera, miss", "camera, hit", "bounce"};
+  for (int k = 0; k < 3; k++) {
+    double m[2];
+    long h[2];
+    if (nc[k] == 0) { free(cls[k]); continue; }
+    trace_pair(acc, cls[k], nc[k], 1, 0, m, h);
+    printf("| %s | %s | %ld | %.2f | %.2f | %.2f |\n", name, names[k], nc[k], m[0], m[1], m[0] / m[1]);
+    free(cls[k]);
+  }
+  fflush(stdout);
+}
+static int g_classes;
+
 static void bench_scene(const char *name, scene *s) {
   valo_error err;
   if (scene_commit(s, &err)) { fprintf(stderr, "%s: %s\n", name, err.message); return; }
@@ -128,6 +158,12 @@ static void bench_scene(const char *name, scene *s) {
   long n, ns;
   ray *sh;
   ray *rays = make_rays(s, acc[1], &n, &sh, &ns);
+  if (g_classes) {
+    class_table(name, acc, rays, n);
+    free(rays); free(sh);
+    accel_destroy(acc[0]); accel_destroy(acc[1]);
+    return;
+  }
   double mr[2][2], ms[2][2]; /* [backend][threads - 1] */
   long hits[2][2], shits[2][2];
   (void)shits;
@@ -153,13 +189,19 @@ int main(int argc, char **argv) {
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--no-build-table")) build_table = 0;
+    else if (!strcmp(argv[i], "--classes")) g_classes = 1, build_table = 0;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|cornell] [--no-build-table]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|cornell] [--no-build-table] [--classes]\n"); return 2; }
   }
+  if (g_classes) {
+    printf("## Closest-hit rays by class, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
+    printf("| scene | rays | count | kd Mrays/s | Embree Mrays/s | kd/Embree |\n|---|---|---|---|---|---|\n");
+  } else {
   printf("## Ray kernel: kd-tree vs Embree %s (same rays; camera + 1 cosine bounce; 512x512)\n\n", embree_available() ? "3" : "(absent)");
   printf("| scene | triangles | kd build s | Embree build s | kd Mrays/s 1t / 2t | Embree Mrays/s 1t / 2t | kd/Embree 1t / 2t "
          "| kd shadow Mrays/s 1t / 2t | Embree shadow 1t / 2t | kd/Embree shadow 1t / 2t |\n");
   printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  }
   const char *meshes[4][2] = {{"bunny", "scenes/models/stanford-bunny.obj"}, {"nefertiti", "scenes/models/nefertiti.obj"},
                               {"dragon", "scenes/dragon/dragon_vrip.ply"}, {NULL, NULL}};
   for (int i = 0; meshes[i][0]; i++) {

@@ -135,53 +135,6 @@ static int alpha_cutout(void) {
   return 0;
 }
 
-/* Normal maps: a quad facing the camera (u along +x, v along +y) with a constant map
- * tilting the normal 30 degrees towards +u, then towards +v, shows that normal in the
- * normal AOV (to 8-bit precision). */
-static int normal_map(void) {
-  CHECK(scratch_file("nquad.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
-  float th = 30.0f * 3.14159265f / 180;
-  for (int axis = 0; axis < 2; axis++) {
-    float n[3] = {axis == 0 ? sinf(th) : 0, axis == 1 ? sinf(th) : 0, cosf(th)};
-    unsigned char bytes[4 * 4 * 3];
-    for (int i = 0; i < 16; i++)
-      for (int c = 0; c < 3; c++) bytes[3 * i + c] = (unsigned char)lrintf((n[c] * 0.5f + 0.5f) * 255);
-    char png[1200];
-    snprintf(png, sizeof png, "%s/nmap%d.png", scratch_dir(), axis);
-    CHECK(stbi_write_png(png, 4, 4, 3, bytes, 12), "png");
-    char json[1024];
-    snprintf(json, sizeof json,
-             "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 20},\n"
-             "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 2},\n"
-             "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"normal_map\": \"nmap%d.png\"}},\n"
-             "  \"shapes\": [{\"file\": \"nquad.obj\", \"material\": \"m\"}],\n"
-             "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n", axis);
-    const char *path = scratch_file("nmap.json", json);
-    valo_options o;
-    valo_options_init(&o);
-    o.aovs = 1;
-    valo_error err;
-    valo_scene *sc;
-    valo_render *r;
-    CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
-    char out[1300], file[1200];
-    snprintf(file, sizeof file, "%s/n%d.pfm", scratch_dir(), axis);
-    snprintf(out, sizeof out, "normal:%s", file);
-    CHECK(valo_render_write(r, out, NULL, &err) == VALO_OK, "%s", err.message);
-    valo_render_destroy(r);
-    valo_scene_destroy(sc);
-    image im;
-    CHECK(image_read(file, &im, &err) == VALO_OK, "%s", err.message);
-    const float *c = &im.rgb[3 * (4 * 8 + 4)];
-    fprintf(stderr, "map tilted towards %s: normal (%.4f %.4f %.4f), expected (%.4f %.4f %.4f)\n", axis ? "+v" : "+u", c[0], c[1], c[2], n[0], n[1], n[2]);
-    for (int k = 0; k < 3; k++) CHECK(fabsf(c[k] - n[k]) < 0.01f, "normal component %d: %g vs %g", k, c[k], n[k]);
-    image_free(&im);
-  }
-  return 0;
-}
-
 /* The normal AOV at the centre of an 8x8 render of `json` (scratch file name). */
 static int centre_normal(const char *name, const char *json, float out[3]) {
   const char *path = scratch_file(name, json);
@@ -204,6 +157,35 @@ static int centre_normal(const char *name, const char *json, float out[3]) {
   CHECK(image_read(file, &im, &err) == VALO_OK, "%s", err.message);
   memcpy(out, &im.rgb[3 * (4 * 8 + 4)], 3 * sizeof(float));
   image_free(&im);
+  return 0;
+}
+
+/* Normal maps: a quad facing the camera (u along +x, v along +y) with a constant map
+ * tilting the normal 30 degrees towards +u, then towards +v, shows that normal in the
+ * normal AOV (to 8-bit precision). */
+static int normal_map(void) {
+  CHECK(scratch_file("nquad.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  float th = 30.0f * 3.14159265f / 180;
+  for (int axis = 0; axis < 2; axis++) {
+    float n[3] = {axis == 0 ? sinf(th) : 0, axis == 1 ? sinf(th) : 0, cosf(th)};
+    unsigned char bytes[4 * 4 * 3];
+    for (int i = 0; i < 16; i++)
+      for (int c = 0; c < 3; c++) bytes[3 * i + c] = (unsigned char)lrintf((n[c] * 0.5f + 0.5f) * 255);
+    char png[1200];
+    snprintf(png, sizeof png, "%s/nmap%d.png", scratch_dir(), axis);
+    CHECK(stbi_write_png(png, 4, 4, 3, bytes, 12), "png");
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 20},\n"
+             "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 2},\n"
+             "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"normal_map\": \"nmap%d.png\"}},\n"
+             "  \"shapes\": [{\"file\": \"nquad.obj\", \"material\": \"m\"}],\n"
+             "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n", axis);
+    float c[3];
+    if (centre_normal("nmap.json", json, c)) return 1;
+    fprintf(stderr, "map tilted towards %s: normal (%.4f %.4f %.4f), expected (%.4f %.4f %.4f)\n", axis ? "+v" : "+u", c[0], c[1], c[2], n[0], n[1], n[2]);
+    for (int k = 0; k < 3; k++) CHECK(fabsf(c[k] - n[k]) < 0.01f, "normal component %d: %g vs %g", k, c[k], n[k]);
+  }
   return 0;
 }
 
