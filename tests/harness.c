@@ -74,25 +74,39 @@ int test_main(int argc, char **argv, const test_case *cases) {
   return failed ? 1 : 0;
 }
 
+valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene) {
+  valo_error err;
+  valo_scene *sc = NULL;
+  valo_render *r = NULL;
+  *scene = NULL;
+  if (!path) { fprintf(stderr, "no scene file\n"); return NULL; }
+  if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "load: %s\n", err.message); return NULL; }
+  if (valo_render_create(sc, opt, &r, &err)) { fprintf(stderr, "create: %s\n", err.message); valo_scene_destroy(sc); return NULL; }
+  if (valo_render_run(r, NULL, NULL, &err)) {
+    fprintf(stderr, "run: %s\n", err.message);
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+    return NULL;
+  }
+  *scene = sc;
+  return r;
+}
+
 float *render_json_text(const char *json, const valo_options *opt, int *w, int *h) {
   static int counter;
   char name[64];
   snprintf(name, sizeof name, "scene%d.json", counter++);
   const char *path = scratch_file(name, json);
-  valo_error err;
   valo_scene *sc = NULL;
-  valo_render *r = NULL;
   float *px = NULL;
   if (!path) { fprintf(stderr, "cannot write %s\n", name); return NULL; }
-  if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "load: %s\n", err.message); return NULL; }
-  if (valo_render_create(sc, opt, &r, &err)) { fprintf(stderr, "create: %s\n", err.message); valo_scene_destroy(sc); return NULL; }
-  if (valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "run: %s\n", err.message); goto out; }
+  valo_render *r = render_file(path, opt, &sc);
+  if (!r) return NULL;
   valo_stats st;
   valo_render_stats(r, &st);
   *w = st.width; *h = st.height;
   px = malloc((size_t)st.width * st.height * 3 * sizeof(float));
   if (px) valo_render_pixels(r, px);
-out:
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   return px;

@@ -32,4 +32,8 @@ const char *scratch_dir(void);
  * overrides; returns malloc'd RGB pixels and the size, or NULL (message printed). */
 #include "valo/valo.h"
 float *render_json_text(const char *json, const valo_options *opt, int *w, int *h);
+/* Loads the scene file at `path`, creates a render with `opt` (may be NULL) and runs it;
+ * returns the finished render and its scene in *scene (destroy both), or NULL with the
+ * message printed. */
+valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene);
 #endif

@@ -273,10 +273,8 @@ static int aovs(void) {
   o.aovs = 1;
   valo_error err;
   valo_scene *sc;
-  valo_render *r;
-  CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
-  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_render *r = render_file(path, &o, &sc);
+  CHECK(r, "render failed");
   const char *names[3] = {"albedo", "normal", "depth"};
   image im[3];
   for (int k = 0; k < 3; k++) {

@@ -77,10 +77,8 @@ static int exr_bytes_identical(void) {
     o.threads = threads[i];
     valo_error err;
     valo_scene *sc;
-    valo_render *r;
-    CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    valo_render *r = render_file(path, &o, &sc);
+    CHECK(r, "render failed");
     snprintf(out[i], sizeof out[i], "%s/det%d.exr", scratch_dir(), threads[i]);
     CHECK(valo_render_write(r, out[i], NULL, &err) == VALO_OK, "%s", err.message);
     valo_render_destroy(r);

@@ -172,12 +172,9 @@ static int prism_rainbow(void) {
     valo_options_init(&o);
     o.spectral = spectral;
     o.width = 96; o.height = 64; o.spp = 64;
-    valo_error err;
     valo_scene *sc;
-    valo_render *r;
-    CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-    CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    valo_render *r = render_file(path, &o, &sc);
+    CHECK(r, "render failed");
     float *px = malloc(sizeof(float) * 96 * 64 * 3);
     CHECK(px, "oom");
     valo_render_pixels(r, px);

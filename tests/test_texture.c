@@ -143,10 +143,8 @@ static int centre_normal(const char *name, const char *json, float out[3]) {
   o.aovs = 1;
   valo_error err;
   valo_scene *sc;
-  valo_render *r;
-  CHECK(path && valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
-  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_render *r = render_file(path, &o, &sc);
+  CHECK(r, "render failed");
   char out_spec[1300], file[1200];
   snprintf(file, sizeof file, "%s/centre_normal.pfm", scratch_dir());
   snprintf(out_spec, sizeof out_spec, "normal:%s", file);

@@ -165,6 +165,43 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
   return light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
 }
 
+float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
+  if (st->specular) return 1;
+  const scene *s = c->s;
+  if (env) return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)c->ls.env_index) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
+  return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)lid) * light_pdf_area(s, &s->lights[lid], st->prev_p, it->p, it->ng));
+}
+
+int path_continue(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st,
+                  rgb *weight, ray *r) {
+  (void)c;
+  bsdf_sample bs;
+  float ul = sampler_1d(smp), u1, u2;
+  sampler_2d(smp, &u1, &u2);
+  vec3 wo_l = frame_to_local(fr, wo);
+  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, &bs)) return 0;
+  vec3 wi = v3_norm(frame_to_world(fr, bs.wi));
+  /* The sampled direction must agree with the geometric normal about reflection vs
+   * transmission, or shading normals would leak light. */
+  int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g) return 0;
+  *weight = bs.weight;
+  st->specular = bs.delta;
+  st->prev_pdf = bs.pdf;
+  st->prev_p = it->p;
+  st->eta_acc /= bs.eta_scale;
+  *r = spawn_ray(it, wi);
+  return 1;
+}
+
+float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp) {
+  float rr = max_beta * st->eta_acc;
+  if (depth < 2 || rr >= 1) return 1;
+  float q = fmaxf(0.0f, 1 - rr);
+  if (sampler_1d(smp) < q) return 0;
+  return 1 / (1 - q);
+}
+
 frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
   vec3 ns = it->ns;
   if (!bsdf_transmits(b)) {

@@ -85,4 +85,28 @@ frame shading_frame(isect *it, const bsdf *b, vec3 wo);
 static inline float light_select_pmf(const render_ctx *c, uint32_t li) {
   return c->ls.table.n ? alias_pmf(&c->ls.table, li) : 0;
 }
+
+/* The state a path tracer carries from one vertex to the next, apart from its
+ * throughput (RGB in path.c, four wavelengths in path_spectral.c): what the previous
+ * bounce was, for MIS-weighting emission found by it, and the relative index it
+ * crossed, for Russian roulette. */
+typedef struct path_state {
+  int specular;      /* the last bounce was a delta lobe (or the camera): no MIS */
+  float prev_pdf;    /* its solid-angle pdf */
+  vec3 prev_p;       /* where it left from */
+  float eta_acc;     /* product of 1/eta_scale over refractions */
+} path_state;
+static inline path_state path_state_start(vec3 origin) { path_state st = {1, 0, origin, 1}; return st; }
+/* MIS weight (power heuristic) of emission that the previous bounce's ray found: from the
+ * environment in direction d (env) or from area light lid at it (otherwise). */
+float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it);
+/* Samples the BSDF at it to continue the path: on success returns 1 with the weight
+ * f |cos| / pdf in *weight, the state updated and *r the next ray. 0 ends the path
+ * (no direction, or one on which shading and geometric normals disagree). */
+int path_continue(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st,
+                  rgb *weight, ray *r);
+/* Russian roulette (pbrt-v4) after depth 2: survive with probability
+ * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
+ * survival, 0 to end the path. */
+float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp);
 #endif

@@ -183,6 +183,21 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
 
 /* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
  * then multiplies 1. */
+/* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
+static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
+  const char *file = NULL;
+  valo_status st = get_str(c, o, key, where, &file);
+  if (st || !file) return st;
+  char full[2048];
+  resolve_path(c, file, full, sizeof full);
+  *tex = scene_texture_file(c->s, full, 0);
+  if (*tex >= 0) return VALO_OK;
+  char w[300], msg[200];
+  snprintf(w, sizeof w, "%s.%s", where, key);
+  snprintf(msg, sizeof msg, "cannot read the %s", what);
+  return bad(c, w, msg);
+}
+
 static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (v && cJSON_IsString(v)) {
@@ -233,18 +248,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     double metal = 0;
     TRY(get_num(c, o, "metallic", where, 0, 1, &metal));
     m->metallic = (float)metal;
-    const char *mr = NULL;
-    TRY(get_str(c, o, "metallic_roughness_map", where, &mr));
-    if (mr) {
-      char full[2048];
-      resolve_path(c, mr, full, sizeof full);
-      m->tex_mr = scene_texture_file(c->s, full, 0);
-      if (m->tex_mr < 0) {
-        char w[300];
-        snprintf(w, sizeof w, "%s.metallic_roughness_map", where);
-        return bad(c, w, "cannot read the metallic-roughness map");
-      }
-    }
+    TRY(get_data_map(c, o, "metallic_roughness_map", where, "metallic-roughness map", &m->tex_mr));
   } else if (!strcmp(type, "diffuse")) {
     TRY(check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;
@@ -294,30 +298,8 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   } else {
     return bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr)");
   }
-  const char *nmap = NULL;
-  TRY(get_str(c, o, "normal_map", where, &nmap));
-  if (nmap) {
-    char full[2048];
-    resolve_path(c, nmap, full, sizeof full);
-    m->tex_normal = scene_texture_file(c->s, full, 0);
-    if (m->tex_normal < 0) {
-      char w[300];
-      snprintf(w, sizeof w, "%s.normal_map", where);
-      return bad(c, w, "cannot read the normal map");
-    }
-  }
-  const char *bmap = NULL;
-  TRY(get_str(c, o, "bump_map", where, &bmap));
-  if (bmap) {
-    char full[2048];
-    resolve_path(c, bmap, full, sizeof full);
-    m->tex_bump = scene_texture_file(c->s, full, 0);
-    if (m->tex_bump < 0) {
-      char w[300];
-      snprintf(w, sizeof w, "%s.bump_map", where);
-      return bad(c, w, "cannot read the bump (height) map");
-    }
-  }
+  TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
+  TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));
   double bscale = 1;
   TRY(get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
   m->bump_scale = (float)bscale;
