@@ -12,17 +12,13 @@
 #define DIST_DEFAULT_DEPTH 3
 
 static rgb dist_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int depth, int count_emission) {
-  hit h;
-  int found = ctx_intersect(c, &r, &h, ts);
+  rgb L;
   isect it;
-  if (found) isect_from_hit(c->s, &r, &h, &it);
-  rgb L = count_emission ? emitted_along(c, &r, &h, found, &it) : c3(0, 0, 0);
+  bsdf b;
+  frame fr;
+  vec3 wo;
   int max_depth = c->max_depth >= 0 ? c->max_depth : DIST_DEFAULT_DEPTH;
-  if (!found || depth >= max_depth) return L;
-  bsdf b = bsdf_at(c->s, &it);
-  vec3 wo = v3_neg(r.d);
-  frame fr = shading_frame(&it, &b, wo);
-  if (bsdf_has_smooth(&b)) L = c3_add(L, estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts));
+  if (!recursive_vertex(c, &r, smp, ts, depth, max_depth, count_emission, &L, &it, &b, &fr, &wo)) return L;
   vec3 wo_l = frame_to_local(&fr, wo);
   rgb acc = c3(0, 0, 0);
   for (int k = 0; k < DIST_BRANCH; k++) {

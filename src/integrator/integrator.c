@@ -165,6 +165,20 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
   return light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
 }
 
+int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_stats *ts, int depth, int max_depth, int count_emission,
+                     rgb *L, isect *it, bsdf *b, frame *fr, vec3 *wo) {
+  hit h;
+  int found = ctx_intersect(c, r, &h, ts);
+  if (found) isect_from_hit(c->s, r, &h, it);
+  *L = count_emission ? emitted_along(c, r, &h, found, it) : c3(0, 0, 0);
+  if (!found || depth >= max_depth) return 0;
+  *b = bsdf_at(c->s, it);
+  *wo = v3_neg(r->d);
+  *fr = shading_frame(it, b, *wo);
+  if (bsdf_has_smooth(b)) *L = c3_add(*L, estimate_direct_nomis(c, it, b, fr, *wo, smp, ts));
+  return 1;
+}
+
 float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
   if (st->specular) return 1;
   const scene *s = c->s;

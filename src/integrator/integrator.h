@@ -86,6 +86,13 @@ static inline float light_select_pmf(const render_ctx *c, uint32_t li) {
   return c->ls.table.n ? alias_pmf(&c->ls.table, li) : 0;
 }
 
+/* The common start of a vertex of the recursive integrators (whitted, distribution):
+ * traces r, puts the emission it finds in *L (if count_emission), and, when it hit a
+ * surface and depth < max_depth, fills the hit, its BSDF, the shading frame and wo, adds
+ * the direct light without MIS to *L and returns 1; otherwise returns 0. */
+int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_stats *ts, int depth, int max_depth, int count_emission,
+                     rgb *L, isect *it, bsdf *b, frame *fr, vec3 *wo);
+
 /* The state a path tracer carries from one vertex to the next, apart from its
  * throughput (RGB in path.c, four wavelengths in path_spectral.c): what the previous
  * bounce was, for MIS-weighting emission found by it, and the relative index it

@@ -11,17 +11,13 @@
 #define WHITTED_DEFAULT_DEPTH 5
 
 static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int depth) {
-  hit h;
-  int found = ctx_intersect(c, &r, &h, ts);
+  rgb L;
   isect it;
-  if (found) isect_from_hit(c->s, &r, &h, &it);
-  rgb L = emitted_along(c, &r, &h, found, &it);
+  bsdf b;
+  frame fr;
+  vec3 wo;
   int max_depth = c->max_depth >= 0 ? c->max_depth : WHITTED_DEFAULT_DEPTH;
-  if (!found || depth >= max_depth) return L;
-  bsdf b = bsdf_at(c->s, &it);
-  vec3 wo = v3_neg(r.d);
-  frame fr = shading_frame(&it, &b, wo);
-  if (bsdf_has_smooth(&b)) L = c3_add(L, estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts));
+  if (!recursive_vertex(c, &r, smp, ts, depth, max_depth, 1, &L, &it, &b, &fr, &wo)) return L;
   vec3 wo_l = frame_to_local(&fr, wo);
   vec3 refl_l = v3(-wo_l.x, -wo_l.y, wo_l.z);
   rgb k_refl = c3(0, 0, 0), k_refr = c3(0, 0, 0);
