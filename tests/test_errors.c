@@ -120,6 +120,12 @@ static int wrong_type(void) {
   p = write_file("type6.json", "{ \"camera\": {\"from_file\": true}, \"shapes\": [{\"type\": \"sphere\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("type6.json"); SAID("no shape file has a camera"); NO_SANITIZER();
+  p = write_file("type7.json", "{ \"environment\": {\"type\": \"cube\", \"faces\": [\"a.png\", \"b.png\"]} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("type7.json"); SAID("environment.faces"); SAID("six"); NO_SANITIZER();
+  p = write_file("type8.json", "{ \"environment\": {\"type\": \"cube\", \"faces\": [\"n1.png\", \"n2.png\", \"n3.png\", \"n4.png\", \"n5.png\", \"n6.png\"]} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("n1.png"); NO_SANITIZER();
   p = write_file("type4.json", "{ \"shapes\": [{\"type\": \"sphere\", \"material\": \"nope\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("shapes[0]"); SAID("\"nope\""); NO_SANITIZER();
