@@ -421,6 +421,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   ray_shear sh = ray_shear_make(r->o, r->d);
   float o[3] = {r->o.x, r->o.y, r->o.z}, id[3] = {inv.x, inv.y, inv.z};
   int neg[3] = {signbit(inv.x) != 0, signbit(inv.y) != 0, signbit(inv.z) != 0};
+  const kd_node *nodes = kd->nodes; /* a local copy: gcc would reload kd->nodes per step */
   float best = r->tmax;
   int found = 0;
   kd_todo todo[64];
@@ -428,7 +429,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   uint32_t ni = 0;
   for (;;) {
     if (best < tmin) break;
-    const kd_node *n = &kd->nodes[ni];
+    const kd_node *n = &nodes[ni];
     uint32_t axis = n->flags & 3;
     if (axis != KD_LEAF) {
       /* Near child by the sign of 1/d (so -0 counts as negative, +0 as positive): the
