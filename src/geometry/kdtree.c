@@ -118,7 +118,8 @@ static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {
     uint64_t gi = kd->nprims + count / 4;
     kd_tri4 *g = &kd->prims[gi];
     int lane = count % 4;
-    for (int k = lane == 0 ? 0 : lane; k < (lane == 0 ? 4 : lane + 1); k++) /* lane 0 fills all four */
+    int last = lane == 0 ? 3 : lane; /* the first triangle of a group also fills the unused lanes */
+    for (int k = lane; k <= last; k++)
       for (int vtx = 0; vtx < 3; vtx++)
         for (int ax = 0; ax < 3; ax++) g->v[vtx][ax][k] = kd->tv[9 * (size_t)t + 3 * vtx + ax];
     if (lane == 0) { for (int k = 0; k < 4; k++) kd->ids[4 * gi + k] = UINT32_MAX; kd->gfilt[gi] = 0; }
@@ -300,8 +301,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
   R.ntris = rcount;
 
   kd->nodes[node].split = best_pos;
-  uint32_t fl = (uint32_t)k;
-  kd->nodes[node].flags = fl | KD_BELOW_EMPTY | KD_ABOVE_EMPTY;
+  uint32_t fl = (uint32_t)k; /* the node's flags are written once its children are placed */
   if (lcount == 0) { fl |= KD_BELOW_EMPTY; evlist_free(&L); }
   else {
     uint32_t below = push_node(b);
@@ -313,7 +313,6 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
     uint32_t above = push_node(b);
     if (above == UINT32_MAX) { evlist_free(&R); return; }
     fl |= above << 4;
-    kd->nodes[node].flags = fl | KD_ABOVE_EMPTY; /* valid while the above subtree builds */
     build(b, above, rbox, &R, depth - 1, bad_refines);
   }
   kd->nodes[node].flags = fl;
@@ -509,14 +508,13 @@ void kdtree_stats(const accel *a, kd_stats *st) {
   st->nodes = kd->nnodes;
   for (uint32_t i = 0; i < kd->nnodes; i++) {
     uint32_t f = kd->nodes[i].flags;
-    if ((f & 3) == KD_LEAF) { st->leaves++; if ((f >> 2) == 0) st->empty_leaves++; }
+    if ((f & 3) == KD_LEAF) { st->leaves++; st->refs += f >> 2; if ((f >> 2) == 0) st->empty_leaves++; }
     else { /* elided empty children count as (unstored) empty leaves */
-      st->leaves += ((f & KD_BELOW_EMPTY) != 0) + ((f & KD_ABOVE_EMPTY) != 0);
-      st->empty_leaves += ((f & KD_BELOW_EMPTY) != 0) + ((f & KD_ABOVE_EMPTY) != 0);
+      uint32_t elided = ((f & KD_BELOW_EMPTY) != 0) + ((f & KD_ABOVE_EMPTY) != 0);
+      st->leaves += elided;
+      st->empty_leaves += elided;
     }
   }
-  for (uint32_t i = 0; i < kd->nnodes; i++)
-    if ((kd->nodes[i].flags & 3) == KD_LEAF) st->refs += kd->nodes[i].flags >> 2;
   st->max_depth = kd->max_depth_seen;
   st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * (sizeof(kd_tri4) + 4 * sizeof(uint32_t) + 1);
 }

@@ -145,11 +145,7 @@ static material convert_material(const struct aiMaterial *am) {
   else m.type = MAT_DIFFUSE;
   if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
-  m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
-  m.bump_scale = 1;
-  m.tex_mr = m.tex_ns = -1;
-  m.alpha_cutoff = 0.5f;
-  return m;
+  return m; /* texture slots stay as material_default left them: none */
 }
 
 /* Some OBJ exporters put tangent-space normal maps under map_bump: such a map is
@@ -217,6 +213,7 @@ typedef struct load_ctx {
   uint32_t override_mat;
   uint64_t added, degenerate;
   valo_error *err;
+  int gltf;          /* a .gltf/.glb file: its cameras and materials need glTF meanings */
 } load_ctx;
 
 static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 *xf) {
@@ -310,8 +307,7 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   /* Assimp's glTF 2 importer (5.2) departs from aiCamera's definition twice: it copies
    * the node's translation into mPosition although the node transform already holds it,
    * and it stores yfov * aspectRatio in mHorizontalFOV (not half the horizontal angle). */
-  const char *ext = strrchr(c->path, '.');
-  int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
+  int gltf = c->gltf;
   vec3 local = gltf ? v3(0, 0, 0) : v3(cam->mPosition.x, cam->mPosition.y, cam->mPosition.z);
   vec3 pos = m34_point(&full, local);
   vec3 look = m34_vector(&full, v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
@@ -397,7 +393,8 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     const char *msg = aiGetErrorString();
     return err_set(err, VALO_ERR_PARSE, "%s: cannot read mesh: %s", path, msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err};
+  const char *ext = strrchr(path, '.');
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"))};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
@@ -405,11 +402,9 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     char dir[1024] = "";
     const char *slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
-    const char *ext = strrchr(path, '.');
-    int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
       material m = convert_material(ai->mMaterials[i]);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir, gltf);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf);
       s->mats[c.mat_base + i] = m;
     }
     if (ai->mNumMaterials == 0) {
