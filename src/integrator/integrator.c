@@ -179,16 +179,35 @@ int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_sta
   return 1;
 }
 
-float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
+static float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
   if (st->specular) return 1;
   const scene *s = c->s;
   if (env) return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)c->ls.env_index) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
   return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)lid) * light_pdf_area(s, &s->lights[lid], st->prev_p, it->p, it->ng));
 }
 
-int path_continue(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st,
-                  rgb *weight, ray *r) {
-  (void)c;
+int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
+  const scene *s = c->s;
+  hit h;
+  *Le = c3(0, 0, 0);
+  *w = 1;
+  if (!ctx_intersect(c, r, &h, ts)) {
+    if (c->ls.env_index >= 0) {
+      *Le = light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
+      *w = path_emission_weight(c, st, 1, r->d, -1, NULL);
+    }
+    return 0;
+  }
+  isect_from_hit(s, r, &h, it);
+  int32_t lid = s->tri_light[h.tri];
+  if (lid >= 0) {
+    *Le = light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
+    if (!c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
+  }
+  return 1;
+}
+
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r) {
   bsdf_sample bs;
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);

@@ -104,14 +104,15 @@ typedef struct path_state {
   float eta_acc;     /* product of 1/eta_scale over refractions */
 } path_state;
 static inline path_state path_state_start(vec3 origin) { path_state st = {1, 0, origin, 1}; return st; }
-/* MIS weight (power heuristic) of emission that the previous bounce's ray found: from the
- * environment in direction d (env) or from area light lid at it (otherwise). */
-float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it);
+/* Traces the path's next ray r: returns 1 at a surface (filling *it), 0 when it escapes.
+ * Either way *Le is the radiance emitted back along r there (the area light hit, or the
+ * environment; black if none) and *w its MIS weight (power heuristic) against the
+ * next-event estimation that could have found the same light. */
+int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w);
 /* Samples the BSDF at it to continue the path: on success returns 1 with the weight
  * f |cos| / pdf in *weight, the state updated and *r the next ray. 0 ends the path
  * (no direction, or one on which shading and geometric normals disagree). */
-int path_continue(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st,
-                  rgb *weight, ray *r);
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r);
 /* Russian roulette (pbrt-v4) after depth 2: survive with probability
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */

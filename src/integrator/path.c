@@ -13,30 +13,20 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   path_state st = path_state_start(r.o); /* camera rays count emission fully */
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
   for (int depth = 0;; depth++) {
-    hit h;
-    if (!ctx_intersect(c, &r, &h, ts)) {
-      if (c->ls.env_index >= 0) {
-        rgb Le = light_env_radiance(s, &s->lights[c->ls.env_index], r.d);
-        L = c3_add(L, c3_scale(c3_mul(beta, Le), path_emission_weight(c, &st, 1, r.d, -1, NULL)));
-      }
-      break;
-    }
     isect it;
-    isect_from_hit(s, &r, &h, &it);
+    rgb Le;
+    float w;
+    int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
+    if (!c3_black(Le)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
+    if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
-    int32_t lid = s->tri_light[h.tri];
-    if (lid >= 0) {
-      rgb Le = light_area_radiance(s, &s->lights[lid], it.ng, wo, it.u, it.v);
-      if (!c3_black(Le)) L = c3_add(L, c3_scale(c3_mul(beta, Le), path_emission_weight(c, &st, 0, r.d, lid, &it)));
-    }
-    if (depth >= max_depth) break;
 
     bsdf b = bsdf_at(s, &it);
     frame fr = shading_frame(&it, &b, wo); /* opaque surfaces are two-sided */
     if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, estimate_direct(c, &it, &b, &fr, wo, smp, ts)));
 
     rgb weight;
-    if (!path_continue(c, &it, &b, &fr, wo, smp, &st, &weight, &r)) break;
+    if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
     beta = c3_mul(beta, weight);
     if (c3_black(beta) || !c3_finite(beta)) break;
     float survive = path_roulette(&st, c3_max(beta), depth, smp);

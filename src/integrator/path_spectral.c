@@ -26,23 +26,13 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
   path_state st = path_state_start(r.o);
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
   for (int depth = 0;; depth++) {
-    hit h;
-    if (!ctx_intersect(c, &r, &h, ts)) {
-      if (c->ls.env_index >= 0) {
-        spec4 Le = spec_from_rgb(light_env_radiance(s, &s->lights[c->ls.env_index], r.d), &wl);
-        L = spec_add(L, spec_scale(spec_mul(beta, Le), path_emission_weight(c, &st, 1, r.d, -1, NULL)));
-      }
-      break;
-    }
     isect it;
-    isect_from_hit(s, &r, &h, &it);
+    rgb Le;
+    float w;
+    int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
+    if (!c3_black(Le)) L = spec_add(L, spec_scale(spec_mul(beta, spec_from_rgb(Le, &wl)), w));
+    if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
-    int32_t lid = s->tri_light[h.tri];
-    if (lid >= 0) {
-      rgb Le = light_area_radiance(s, &s->lights[lid], it.ng, wo, it.u, it.v);
-      if (!c3_black(Le)) L = spec_add(L, spec_scale(spec_mul(beta, spec_from_rgb(Le, &wl)), path_emission_weight(c, &st, 0, r.d, lid, &it)));
-    }
-    if (depth >= max_depth) break;
     bsdf b = bsdf_at(s, &it);
     if (it.m->dispersion && bsdf_transmits(&b)) {
       b.eta = dispersion_ior((dispersion)it.m->dispersion, wl.lambda[0]);
@@ -51,7 +41,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
     frame fr = shading_frame(&it, &b, wo);
     if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl)));
     rgb weight;
-    if (!path_continue(c, &it, &b, &fr, wo, smp, &st, &weight, &r)) break;
+    if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
     beta = spec_mul(beta, spec_from_rgb(weight, &wl));
     if (spec_black(beta)) break;
     float survive = path_roulette(&st, spec_max(beta), depth, smp);
