@@ -6,6 +6,11 @@
 #include "core/vec.h"
 
 /* cos_i > 0 on the side of index eta_i; eta = eta_t / eta_i. */
+/* Schlick's (1 - cos)^5, the weight of 1 - F0 in his Fresnel approximation. */
+static inline float schlick_weight(float cos_i) {
+  float m = 1 - cos_i;
+  return m * m * m * m * m;
+}
 static inline float fresnel_dielectric(float cos_i, float eta) {
   cos_i = clampf(cos_i, -1, 1);
   if (cos_i < 0) { eta = 1 / eta; cos_i = -cos_i; }

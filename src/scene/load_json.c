@@ -569,22 +569,20 @@ valo_status load_json(scene *s, const char *path, valo_error *err) {
         st = bad(&c, "environment.faces", "must be an array of six image files: +x, -x, +y, -y, +z, -z");
         goto done;
       }
-      char (*full)[2048] = malloc(6 * sizeof *full);
-      if (!full) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      char full[6][2048];
       const char *paths[6];
       int i = 0;
       for (const cJSON *fe = faces->child; fe; fe = fe->next, i++) {
-        if (!cJSON_IsString(fe)) { free(full); st = bad(&c, "environment.faces", "must hold file names (strings)"); goto done; }
+        if (!cJSON_IsString(fe)) { st = bad(&c, "environment.faces", "must hold file names (strings)"); goto done; }
         resolve_path(&c, fe->valuestring, full[i], sizeof full[i]);
         paths[i] = full[i];
       }
       double scale = 1, rot = 0;
-      st = get_num(&c, env, "scale", "environment", 0, 1e9, &scale);
-      if (!st) st = get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot);
-      if (!st && !(s->env_map = calloc(1, sizeof *s->env_map))) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
-      if (!st) st = envmap_load_cube(s->env_map, paths, (float)scale, (float)rot, err);
-      free(full);
-      if (st) goto done;
+      TRY(get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
+      TRY(get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
+      s->env_map = calloc(1, sizeof *s->env_map);
+      if (!s->env_map) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      TRY(envmap_load_cube(s->env_map, paths, (float)scale, (float)rot, err));
     } else {
       st = bad(&c, "environment.type", "unknown environment type (constant, map, cube)");
       goto done;
