@@ -92,6 +92,15 @@ valo_render *render_file(const char *path, const valo_options *opt, valo_scene *
   return r;
 }
 
+int read_aov(const valo_render *r, const char *name, image *out) {
+  char file[1200], spec[1300];
+  valo_error err;
+  snprintf(file, sizeof file, "%s/aov_%s.pfm", scratch_dir(), name);
+  snprintf(spec, sizeof spec, "%s:%s", name, file);
+  if (valo_render_write(r, spec, NULL, &err) || image_read(file, out, &err)) { fprintf(stderr, "AOV %s: %s\n", name, err.message); return -1; }
+  return 0;
+}
+
 float *render_json_text(const char *json, const valo_options *opt, int *w, int *h) {
   static int counter;
   char name[64];

@@ -36,4 +36,8 @@ float *render_json_text(const char *json, const valo_options *opt, int *w, int *
  * returns the finished render and its scene in *scene (destroy both), or NULL with the
  * message printed. */
 valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene);
+/* Writes AOV `name` ("albedo", "normal", "depth") of a render made with aovs set to a PFM
+ * in the scratch folder and reads it back into *out (image_free it); 0 on success. */
+#include "image/image_io.h"
+int read_aov(const valo_render *r, const char *name, image *out);
 #endif
