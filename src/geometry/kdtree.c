@@ -324,8 +324,11 @@ static inline int box_clip(const kdtree *kd, const ray *r, vec3 inv, float *t0, 
   float tmin = 0, tmax = r->tmax;
   for (int k = 0; k < 3; k++) {
     float o = v3_get(r->o, k), id = v3_get(inv, k);
-    float tn = (v3_get(kd->bounds.lo, k) - o) * id, tf = (v3_get(kd->bounds.hi, k) - o) * id;
-    if (tn > tf) { float t = tn; tn = tf; tf = t; }
+    /* Faces by the sign of 1/d, not by comparing t: when the ray lies in a face's plane
+     * (t = 0 * inf = NaN) a comparison would keep the wrong face (test axis_rays). */
+    int neg = signbit(id) != 0;
+    float tn = ((neg ? v3_get(kd->bounds.hi, k) : v3_get(kd->bounds.lo, k)) - o) * id;
+    float tf = ((neg ? v3_get(kd->bounds.lo, k) : v3_get(kd->bounds.hi, k)) - o) * id;
     tf *= 1 + 2 * fp_gamma(3);
     tmin = tn > tmin ? tn : tmin;
     tmax = tf < tmax ? tf : tmax;
@@ -427,7 +430,10 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   int ntodo = 0;
   uint32_t ni = 0;
   for (;;) {
-    if (best < tmin) break;
+    /* Past the nearest hit: skip this subtree. Not a break, since the stack is not in
+     * front-to-back order when a ray lies in a split plane (both children get the whole
+     * interval; test axis_rays). */
+    if (best < tmin) goto pop;
     const kd_node *n = &nodes[ni];
     uint32_t axis = n->flags & 3;
     if (axis != KD_LEAF) {
