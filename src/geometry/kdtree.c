@@ -25,7 +25,13 @@
  * Leaf: upper 30 bits = primitive count. Interior: bits 2-3 = KD_BELOW_EMPTY and
  * KD_ABOVE_EMPTY, upper 28 bits = index of the above child; the below child, when
  * stored, follows its parent. Empty leaves (over half of all leaves: the SAH cuts off
- * empty space) are not stored, so rays never load them. */
+ * empty space) are not stored, so rays never load them.
+ * Box node: both empty bits set (no split makes that). The SAH's empty-space cuts come
+ * in chains (a cut whose one child is the next cut); after the build each chain becomes
+ * one box node: the node, then 3 slots holding the box's lo[3] and hi[3] (an infinite
+ * face where the chain does not cut), then the chain's non-empty end. A ray clips its
+ * interval to the box without a branch per plane: each cut was a hard-to-predict branch,
+ * and bounce rays pass about 20 of them (docs/performance.md). */
 typedef struct kd_node {
   union { float split; uint32_t prim_offset; };
   uint32_t flags;
@@ -53,6 +59,7 @@ typedef struct kdtree {
   uint64_t nprims, cap_prims;
   bbox bounds;
   uint32_t max_depth_seen;
+  kd_stats st;        /* counted before empty cuts become box nodes */
 } kdtree;
 
 /* ---------------------------------------------------------------- build */
@@ -318,6 +325,61 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
   kd->nodes[node].flags = fl;
 }
 
+/* ------------------------------------------------------------- box nodes */
+
+#define KD_BOX (KD_BELOW_EMPTY | KD_ABOVE_EMPTY)
+#define KD_BOX_SLOTS 4u
+
+typedef struct kd_boxer { const kd_node *src; kd_node *dst; uint32_t n, cap; int oom; } kd_boxer;
+
+static uint32_t boxer_push(kd_boxer *w, uint32_t k) {
+  if (w->n + k > KD_MAX_NODES) { w->oom = 1; return UINT32_MAX; }
+  while (w->n + k > w->cap) {
+    uint32_t nc = w->cap ? w->cap * 2 : 1024;
+    kd_node *d = realloc(w->dst, (size_t)nc * sizeof *d);
+    if (!d) { w->oom = 1; return UINT32_MAX; }
+    w->dst = d; w->cap = nc;
+  }
+  w->n += k;
+  return w->n - k;
+}
+
+static int is_empty_cut(uint32_t fl) {
+  return (fl & 3) != KD_LEAF && ((fl & KD_BELOW_EMPTY) != 0) != ((fl & KD_ABOVE_EMPTY) != 0);
+}
+
+/* Copies the subtree at src[si] into dst in the same depth-first order, each chain of
+ * empty cuts replaced by one box node. Recursion depth is the tree's depth (<= 60). */
+static void boxer_copy(kd_boxer *w, uint32_t si) {
+  if (w->oom) return;
+  float f[6] = {-INFINITY, -INFINITY, -INFINITY, INFINITY, INFINITY, INFINITY};
+  int chain = 0;
+  while (is_empty_cut(w->src[si].flags)) {
+    uint32_t fl = w->src[si].flags, axis = fl & 3;
+    if (fl & KD_BELOW_EMPTY) { f[axis] = w->src[si].split; si = fl >> 4; }
+    else { f[3 + axis] = w->src[si].split; si++; }
+    chain = 1;
+  }
+  if (chain) {
+    uint32_t d = boxer_push(w, KD_BOX_SLOTS);
+    if (d == UINT32_MAX) return;
+    w->dst[d].prim_offset = 0;
+    w->dst[d].flags = KD_BOX;
+    memcpy(&w->dst[d + 1], f, sizeof f);
+  }
+  uint32_t d = boxer_push(w, 1);
+  if (d == UINT32_MAX) return;
+  kd_node n = w->src[si];
+  w->dst[d] = n;
+  if ((n.flags & 3) == KD_LEAF) return;
+  if (!(n.flags & KD_BELOW_EMPTY)) boxer_copy(w, si + 1);
+  if (!(n.flags & KD_ABOVE_EMPTY)) {
+    uint32_t above = w->n;
+    boxer_copy(w, n.flags >> 4);
+    w->dst[d].flags = (n.flags & 15u) | above << 4;
+  }
+}
+
 /* ---------------------------------------------------------------- queries */
 
 static inline int box_clip(const kdtree *kd, const ray *r, vec3 inv, float *t0, float *t1) {
@@ -423,6 +485,8 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   ray_shear sh = ray_shear_make(r->o, r->d);
   float o[3] = {r->o.x, r->o.y, r->o.z}, id[3] = {inv.x, inv.y, inv.z};
   int neg[3] = {signbit(inv.x) != 0, signbit(inv.y) != 0, signbit(inv.z) != 0};
+  /* The box face a ray enters by and the one it leaves by, per axis (lo = 0-2, hi = 3-5). */
+  int fin[3] = {3 * neg[0], 1 + 3 * neg[1], 2 + 3 * neg[2]}, fout[3] = {3 - 3 * neg[0], 4 - 3 * neg[1], 5 - 3 * neg[2]};
   const kd_node *nodes = kd->nodes; /* a local copy: gcc would reload kd->nodes per step */
   float best = r->tmax;
   int found = 0;
@@ -437,10 +501,25 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
     const kd_node *n = &nodes[ni];
     uint32_t axis = n->flags & 3;
     if (axis != KD_LEAF) {
+      uint32_t fl = n->flags;
+      if ((fl & KD_BOX) == KD_BOX) {
+        /* Clip [tmin, tmax] to the box; a NaN (ray in a face's plane) clips nothing, as
+         * the cut it replaces would have let the ray through. */
+        float f[6];
+        memcpy(f, &nodes[ni + 1], sizeof f);
+        for (int k = 0; k < 3; k++) {
+          float t0 = (f[fin[k]] - o[k]) * id[k], t1 = (f[fout[k]] - o[k]) * id[k];
+          tmin = t0 > tmin ? t0 : tmin;
+          tmax = t1 < tmax ? t1 : tmax;
+        }
+        if (tmin > tmax) goto pop;
+        ni += KD_BOX_SLOTS;
+        continue;
+      }
       /* Near child by the sign of 1/d (so -0 counts as negative, +0 as positive): the
        * near side is the one the ray enters first. t = tp splits [tmin, tmax]. */
       float tp = (n->split - o[axis]) * id[axis];
-      uint32_t fl = n->flags, below = ni + 1, above = fl >> 4;
+      uint32_t below = ni + 1, above = fl >> 4;
       int below_ok = !(fl & KD_BELOW_EMPTY), above_ok = !(fl & KD_ABOVE_EMPTY);
       uint32_t nearc = neg[axis] ? above : below, farc = neg[axis] ? below : above;
       int near_ok = neg[axis] ? above_ok : below_ok, far_ok = neg[axis] ? below_ok : above_ok;
@@ -507,11 +586,9 @@ static void kd_destroy(accel *a) {
 }
 static const accel_ops kd_ops = {"kdtree", kd_intersect, kd_occluded, kd_destroy};
 
-void kdtree_stats(const accel *a, kd_stats *st) {
+/* Leaves and references of the tree as built (before box nodes). */
+static void count_tree(const kdtree *kd, kd_stats *st) {
   memset(st, 0, sizeof *st);
-  if (a->ops != &kd_ops) return;
-  const kdtree *kd = (const kdtree *)a;
-  st->nodes = kd->nnodes;
   for (uint32_t i = 0; i < kd->nnodes; i++) {
     uint32_t f = kd->nodes[i].flags;
     if ((f & 3) == KD_LEAF) { st->leaves++; st->refs += f >> 2; if ((f >> 2) == 0) st->empty_leaves++; }
@@ -521,6 +598,14 @@ void kdtree_stats(const accel *a, kd_stats *st) {
       st->empty_leaves += elided;
     }
   }
+}
+
+void kdtree_stats(const accel *a, kd_stats *st) {
+  memset(st, 0, sizeof *st);
+  if (a->ops != &kd_ops) return;
+  const kdtree *kd = (const kdtree *)a;
+  *st = kd->st;
+  st->nodes = kd->nnodes; /* 8-byte slots, box nodes included */
   st->max_depth = kd->max_depth_seen;
   st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * (sizeof(kd_tri4) + 4 * sizeof(uint32_t) + 1);
 }
@@ -569,6 +654,13 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   free(b.side); free(b.straddle);
   free(kd->tv);
   kd->tv = NULL;
+  if (!b.oom && kd->nnodes) {
+    count_tree(kd, &kd->st);
+    kd_boxer w = {kd->nodes, NULL, 0, 0, 0};
+    boxer_copy(&w, 0);
+    if (w.oom) { free(w.dst); b.oom = 1; }
+    else { free(kd->nodes); kd->nodes = w.dst; kd->nnodes = w.n; kd->cap_nodes = w.cap; }
+  }
   if (b.oom) { kd_destroy(&kd->base); return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory while building"); }
   *out = &kd->base;
   return VALO_OK;
