@@ -29,7 +29,8 @@
  * Box node: both empty bits set (no split makes that). The SAH's empty-space cuts come
  * in chains (a cut whose one child is the next cut); after the build each chain becomes
  * one box node: the node, then 3 slots holding the box's lo[3] and hi[3] (an infinite
- * face where the chain does not cut), then the chain's non-empty end. A ray clips its
+ * face where the chain does not cut), then the chain's non-empty end; so every split
+ * left has two stored children, and the empty bits only mark boxes. A ray clips its
  * interval to the box without a branch per plane: each cut was a hard-to-predict branch,
  * and bounce rays pass about 20 of them (docs/performance.md). */
 typedef struct kd_node {
@@ -517,25 +518,18 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
         continue;
       }
       /* Near child by the sign of 1/d (so -0 counts as negative, +0 as positive): the
-       * near side is the one the ray enters first. t = tp splits [tmin, tmax]. */
+       * near side is the one the ray enters first. t = tp splits [tmin, tmax]. Both
+       * children exist: a split with an empty side is an empty cut, now in a box. */
       float tp = (n->split - o[axis]) * id[axis];
-      uint32_t below = ni + 1, above = fl >> 4;
-      int below_ok = !(fl & KD_BELOW_EMPTY), above_ok = !(fl & KD_ABOVE_EMPTY);
-      uint32_t nearc = neg[axis] ? above : below, farc = neg[axis] ? below : above;
-      int near_ok = neg[axis] ? above_ok : below_ok, far_ok = neg[axis] ? below_ok : above_ok;
-      if (tp > tmax) { if (!near_ok) goto pop; ni = nearc; }
-      else if (tp < tmin) { if (!far_ok) goto pop; ni = farc; }
-      else if (tp == tp) {
-        if (!far_ok) { ni = nearc; tmax = tp; }
-        else if (!near_ok) { ni = farc; tmin = tp; }
-        else {
-          todo[ntodo].node = farc; todo[ntodo].tmin = tp; todo[ntodo].tmax = tmax; ntodo++;
-          ni = nearc;
-          tmax = tp;
-        }
-      } else { /* origin on the plane, ray in it: visit both over the whole interval */
-        if (near_ok && far_ok) { todo[ntodo].node = farc; todo[ntodo].tmin = tmin; todo[ntodo].tmax = tmax; ntodo++; }
-        ni = near_ok ? nearc : farc;
+      uint32_t nearc = neg[axis] ? fl >> 4 : ni + 1, farc = neg[axis] ? ni + 1 : fl >> 4;
+      if (tp > tmax) ni = nearc;
+      else if (tp < tmin) ni = farc;
+      else {
+        todo[ntodo].node = farc; todo[ntodo].tmax = tmax;
+        if (tp == tp) { todo[ntodo].tmin = tp; tmax = tp; }
+        else todo[ntodo].tmin = tmin; /* origin on the plane, ray in it: both, whole interval */
+        ntodo++;
+        ni = nearc;
       }
       continue;
     }
