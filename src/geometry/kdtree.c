@@ -383,22 +383,17 @@ static void boxer_copy(kd_boxer *w, uint32_t si) {
 
 /* ---------------------------------------------------------------- queries */
 
-static inline int box_clip(const kdtree *kd, const ray *r, vec3 inv, float *t0, float *t1) {
-  float tmin = 0, tmax = r->tmax;
+/* Clips [*tmin, *tmax] to the box f = lo[3], hi[3], entering by faces fin and leaving by
+ * faces fout (chosen by the sign of 1/d, not by comparing t: for a ray lying in a face's
+ * plane t = 0 * inf = NaN, and a NaN clips nothing). Exit times are scaled by widen. */
+static inline int slab_clip(const float f[6], const int fin[3], const int fout[3], const float o[3], const float id[3],
+                            float widen, float *tmin, float *tmax) {
   for (int k = 0; k < 3; k++) {
-    float o = v3_get(r->o, k), id = v3_get(inv, k);
-    /* Faces by the sign of 1/d, not by comparing t: when the ray lies in a face's plane
-     * (t = 0 * inf = NaN) a comparison would keep the wrong face (test axis_rays). */
-    int neg = signbit(id) != 0;
-    float tn = ((neg ? v3_get(kd->bounds.hi, k) : v3_get(kd->bounds.lo, k)) - o) * id;
-    float tf = ((neg ? v3_get(kd->bounds.lo, k) : v3_get(kd->bounds.hi, k)) - o) * id;
-    tf *= 1 + 2 * fp_gamma(3);
-    tmin = tn > tmin ? tn : tmin;
-    tmax = tf < tmax ? tf : tmax;
-    if (tmin > tmax) return 0;
+    float t0 = (f[fin[k]] - o[k]) * id[k], t1 = (f[fout[k]] - o[k]) * id[k] * widen;
+    *tmin = t0 > *tmin ? t0 : *tmin;
+    *tmax = t1 < *tmax ? t1 : *tmax;
   }
-  *t0 = tmin; *t1 = tmax;
-  return 1;
+  return *tmin <= *tmax;
 }
 
 /* Four triangles against one ray: the watertight test of triangle.h with SSE2, in the
@@ -481,13 +476,15 @@ typedef struct kd_todo { uint32_t node; float tmin, tmax; } kd_todo;
 
 static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   vec3 inv = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
-  float tmin, tmax;
-  if (kd->nnodes == 0 || !box_clip(kd, r, inv, &tmin, &tmax)) return 0;
-  ray_shear sh = ray_shear_make(r->o, r->d);
+  float tmin = 0, tmax = r->tmax;
   float o[3] = {r->o.x, r->o.y, r->o.z}, id[3] = {inv.x, inv.y, inv.z};
   int neg[3] = {signbit(inv.x) != 0, signbit(inv.y) != 0, signbit(inv.z) != 0};
   /* The box face a ray enters by and the one it leaves by, per axis (lo = 0-2, hi = 3-5). */
   int fin[3] = {3 * neg[0], 1 + 3 * neg[1], 2 + 3 * neg[2]}, fout[3] = {3 - 3 * neg[0], 4 - 3 * neg[1], 5 - 3 * neg[2]};
+  const float root[6] = {kd->bounds.lo.x, kd->bounds.lo.y, kd->bounds.lo.z, kd->bounds.hi.x, kd->bounds.hi.y, kd->bounds.hi.z};
+  /* The scene bounds conservatively (exit times widened by 2 gamma_3, as pbrt's box test). */
+  if (kd->nnodes == 0 || !slab_clip(root, fin, fout, o, id, 1 + 2 * fp_gamma(3), &tmin, &tmax)) return 0;
+  ray_shear sh = ray_shear_make(r->o, r->d);
   const kd_node *nodes = kd->nodes; /* a local copy: gcc would reload kd->nodes per step */
   float best = r->tmax;
   int found = 0;
@@ -504,16 +501,11 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
     if (axis != KD_LEAF) {
       uint32_t fl = n->flags;
       if ((fl & KD_BOX) == KD_BOX) {
-        /* Clip [tmin, tmax] to the box; a NaN (ray in a face's plane) clips nothing, as
-         * the cut it replaces would have let the ray through. */
+        /* Clip [tmin, tmax] to the box, exactly as its chain of cuts would have (a NaN,
+         * ray in a face's plane, passes as the cut would have let it through). */
         float f[6];
         memcpy(f, &nodes[ni + 1], sizeof f);
-        for (int k = 0; k < 3; k++) {
-          float t0 = (f[fin[k]] - o[k]) * id[k], t1 = (f[fout[k]] - o[k]) * id[k];
-          tmin = t0 > tmin ? t0 : tmin;
-          tmax = t1 < tmax ? t1 : tmax;
-        }
-        if (tmin > tmax) goto pop;
+        if (!slab_clip(f, fin, fout, o, id, 1.0f, &tmin, &tmax)) goto pop;
         ni += KD_BOX_SLOTS;
         continue;
       }
