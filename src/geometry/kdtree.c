@@ -139,25 +139,49 @@ static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {
   kd->nodes[node].flags = KD_LEAF | (count << 2);
 }
 
-/* Clips triangle t to box and returns the bounds of the clipped polygon (0 if empty). */
+/* A float at or below x (at or above with up set), one ulp further out when x came from
+ * interpolation: the clipped polygon's bounds must contain the true polygon, since a
+ * triangle nearly in an axis plane (a wall at x = -5 whose vertices round to x values an
+ * ulp or two apart) covers a large area within one ulp of x. Rounding them to nearest
+ * dropped such walls from cells they reach (veach-mis' back wall; test_kdtree
+ * camera_rays). */
+static float round_out(double x, int exact, int up) {
+  float f = (float)x;
+  if (up) { if ((double)f < x || !exact) f = next_float_up(f); }
+  else if ((double)f > x || !exact) f = next_float_down(f);
+  return f;
+}
+
+/* Clips triangle v to box and returns conservative bounds of the clipped polygon (0 if
+ * empty). Clipping runs in double; a polygon vertex's coordinate is exact when it is an
+ * input vertex's, the clipping plane's, or shared by both ends of the clipped edge. */
 static int clip_bounds(const float *v, bbox box, bbox *out) {
   double poly[2][12][3];
+  uint8_t exact[2][12];
   int n = 3, cur = 0;
-  for (int i = 0; i < 3; i++)
+  for (int i = 0; i < 3; i++) {
+    exact[0][i] = 7;
     for (int k = 0; k < 3; k++) poly[0][i][k] = v[3 * i + k];
+  }
   for (int axis = 0; axis < 3 && n > 0; axis++) {
     for (int sidei = 0; sidei < 2 && n > 0; sidei++) {
       double plane = sidei == 0 ? v3_get(box.lo, axis) : v3_get(box.hi, axis);
       double sgn = sidei == 0 ? 1.0 : -1.0; /* inside: sgn*(x - plane) >= 0 */
       int m = 0, nxt = 1 - cur;
       for (int i = 0; i < n; i++) {
-        const double *a = poly[cur][i], *c = poly[cur][(i + 1) % n];
+        int ic = (i + 1) % n;
+        const double *a = poly[cur][i], *c = poly[cur][ic];
         double da = sgn * (a[axis] - plane), dc = sgn * (c[axis] - plane);
-        if (da >= 0 && m < 12) { memcpy(poly[nxt][m++], a, sizeof(double) * 3); }
+        if (da >= 0 && m < 12) { memcpy(poly[nxt][m], a, sizeof(double) * 3); exact[nxt][m++] = exact[cur][i]; }
         if ((da >= 0) != (dc >= 0) && m < 12) {
           double t = da / (da - dc);
-          for (int k = 0; k < 3; k++) poly[nxt][m][k] = a[k] + t * (c[k] - a[k]);
+          uint8_t ex = (uint8_t)(1u << axis);
+          for (int k = 0; k < 3; k++) {
+            poly[nxt][m][k] = a[k] + t * (c[k] - a[k]);
+            if (a[k] == c[k] && (exact[cur][i] & exact[cur][ic] & (1u << k))) ex |= (uint8_t)(1u << k);
+          }
           poly[nxt][m][axis] = plane;
+          exact[nxt][m] = ex;
           m++;
         }
       }
@@ -166,8 +190,15 @@ static int clip_bounds(const float *v, bbox box, bbox *out) {
     }
   }
   if (n == 0) return 0;
-  bbox r = bbox_empty();
-  for (int i = 0; i < n; i++) r = bbox_add(r, v3((float)poly[cur][i][0], (float)poly[cur][i][1], (float)poly[cur][i][2]));
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < 3; k++) {
+      int ex = (exact[cur][i] >> k) & 1;
+      float l = round_out(poly[cur][i][k], ex, 0), h = round_out(poly[cur][i][k], ex, 1);
+      lo[k] = l < lo[k] ? l : lo[k];
+      hi[k] = h > hi[k] ? h : hi[k];
+    }
+  bbox r = {v3(lo[0], lo[1], lo[2]), v3(hi[0], hi[1], hi[2])};
   r.lo = v3_max(r.lo, box.lo);
   r.hi = v3_min(r.hi, box.hi);
   if (r.lo.x > r.hi.x || r.lo.y > r.hi.y || r.lo.z > r.hi.z) return 0;
@@ -385,11 +416,16 @@ static void boxer_copy(kd_boxer *w, uint32_t si) {
 
 /* Clips [*tmin, *tmax] to the box f = lo[3], hi[3], entering by faces fin and leaving by
  * faces fout (chosen by the sign of 1/d, not by comparing t: for a ray lying in a face's
- * plane t = 0 * inf = NaN, and a NaN clips nothing). Exit times are scaled by widen. */
+ * plane t = 0 * inf = NaN, and a NaN clips nothing). Conservative: a plane's t = (p - o)/d
+ * has relative error <= gamma_3, so entry times shrink by lo_scale and exit times grow
+ * by hi_scale (1 -/+ 2 gamma_3): a triangle whose edge lies in a cell's face is hit at a t
+ * that may round below the computed entry of that cell (test_kdtree camera_rays). */
+#define KD_T_LO (1.0f - 2 * fp_gamma(3))
+#define KD_T_HI (1.0f + 2 * fp_gamma(3))
 static inline int slab_clip(const float f[6], const int fin[3], const int fout[3], const float o[3], const float id[3],
-                            float widen, float *tmin, float *tmax) {
+                            float *tmin, float *tmax) {
   for (int k = 0; k < 3; k++) {
-    float t0 = (f[fin[k]] - o[k]) * id[k], t1 = (f[fout[k]] - o[k]) * id[k] * widen;
+    float t0 = (f[fin[k]] - o[k]) * id[k] * KD_T_LO, t1 = (f[fout[k]] - o[k]) * id[k] * KD_T_HI;
     *tmin = t0 > *tmin ? t0 : *tmin;
     *tmax = t1 < *tmax ? t1 : *tmax;
   }
@@ -482,8 +518,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   /* The box face a ray enters by and the one it leaves by, per axis (lo = 0-2, hi = 3-5). */
   int fin[3] = {3 * neg[0], 1 + 3 * neg[1], 2 + 3 * neg[2]}, fout[3] = {3 - 3 * neg[0], 4 - 3 * neg[1], 5 - 3 * neg[2]};
   const float root[6] = {kd->bounds.lo.x, kd->bounds.lo.y, kd->bounds.lo.z, kd->bounds.hi.x, kd->bounds.hi.y, kd->bounds.hi.z};
-  /* The scene bounds conservatively (exit times widened by 2 gamma_3, as pbrt's box test). */
-  if (kd->nnodes == 0 || !slab_clip(root, fin, fout, o, id, 1 + 2 * fp_gamma(3), &tmin, &tmax)) return 0;
+  if (kd->nnodes == 0 || !slab_clip(root, fin, fout, o, id, &tmin, &tmax)) return 0;
   ray_shear sh = ray_shear_make(r->o, r->d);
   const kd_node *nodes = kd->nodes; /* a local copy: gcc would reload kd->nodes per step */
   float best = r->tmax;
@@ -505,20 +540,23 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
          * ray in a face's plane, passes as the cut would have let it through). */
         float f[6];
         memcpy(f, &nodes[ni + 1], sizeof f);
-        if (!slab_clip(f, fin, fout, o, id, 1.0f, &tmin, &tmax)) goto pop;
+        if (!slab_clip(f, fin, fout, o, id, &tmin, &tmax)) goto pop;
         ni += KD_BOX_SLOTS;
         continue;
       }
       /* Near child by the sign of 1/d (so -0 counts as negative, +0 as positive): the
-       * near side is the one the ray enters first. t = tp splits [tmin, tmax]. Both
-       * children exist: a split with an empty side is an empty cut, now in a box. */
+       * near side is the one the ray enters first. t = tp splits [tmin, tmax]; within
+       * tp's rounding error (gamma_3, as in slab_clip) both children are visited, each
+       * interval ending or starting at tp widened. Both children exist: a split with an
+       * empty side is an empty cut, now in a box. */
       float tp = (n->split - o[axis]) * id[axis];
+      float tp_lo = tp * KD_T_LO, tp_hi = tp * KD_T_HI;
       uint32_t nearc = neg[axis] ? fl >> 4 : ni + 1, farc = neg[axis] ? ni + 1 : fl >> 4;
-      if (tp > tmax) ni = nearc;
-      else if (tp < tmin) ni = farc;
+      if (tp_lo > tmax) ni = nearc;
+      else if (tp_hi < tmin) ni = farc;
       else {
         todo[ntodo].node = farc; todo[ntodo].tmax = tmax;
-        if (tp == tp) { todo[ntodo].tmin = tp; tmax = tp; }
+        if (tp == tp) { todo[ntodo].tmin = tp_lo > tmin ? tp_lo : tmin; tmax = tp_hi < tmax ? tp_hi : tmax; }
         else todo[ntodo].tmin = tmin; /* origin on the plane, ray in it: both, whole interval */
         ntodo++;
         ni = nearc;
