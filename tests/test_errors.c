@@ -20,7 +20,10 @@ static char g_out[65536];
 
 /* Runs valo with args (NULL-terminated); returns the exit code (128+sig if killed), and
  * the combined stdout+stderr in g_out. */
-static int run_valo(const char *const *args) {
+static int run_valo_int(const char *const *args, int sigint_ms);
+static int run_valo(const char *const *args) { return run_valo_int(args, 0); }
+/* The same, sending SIGINT (as Ctrl-C does) after sigint_ms milliseconds when > 0. */
+static int run_valo_int(const char *const *args, int sigint_ms) {
   char log[1200];
   snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
   pid_t pid = fork();
@@ -38,6 +41,11 @@ static int run_valo(const char *const *args) {
   }
   int status = 0;
   time_t t0 = time(NULL);
+  if (sigint_ms > 0) {
+    struct timespec d = {sigint_ms / 1000, (long)(sigint_ms % 1000) * 1000000L};
+    nanosleep(&d, NULL);
+    kill(pid, SIGINT);
+  }
   for (;;) {
     pid_t r = waitpid(pid, &status, WNOHANG);
     if (r == pid) break;
@@ -267,6 +275,24 @@ static int render_ok(void) {
   return 0;
 }
 
+/* Ctrl-C (a real SIGINT) stops the render, writes every -o with the finished passes, says
+ * how many spp they hold and exits 130 (issue 8.2). */
+static int sigint_writes_image(void) {
+  const char *obj = write_file("ok.obj", CUBE_OBJ);
+  char a[1200], b[1200];
+  snprintf(a, sizeof a, "%s/int.png", scratch_dir());
+  snprintf(b, sizeof b, "%s/int.exr", scratch_dir());
+  const char *const args[] = {"render", obj, "--res", "64x64", "--spp", "1000000", "-o", a, "-o", b, NULL};
+  int rc = run_valo_int(args, 1500);
+  CHECK(rc == 130, "exit code %d, expected 130", rc);
+  SAID("interrupted after"); SAID("spp"); SAID("wrote"); NOT_SAID("no image written"); NO_SANITIZER();
+  CHECK(access(a, R_OK) == 0 && access(b, R_OK) == 0, "outputs missing after Ctrl-C");
+  const char *p = strstr(g_out, "interrupted after ");
+  int spp = p ? atoi(p + strlen("interrupted after ")) : 0;
+  CHECK(spp > 0, "reported %d spp", spp);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"missing_file", missing_file},
                                     {"malformed_json", malformed_json},
@@ -283,6 +309,7 @@ int main(int argc, char **argv) {
                                     {"help_and_version", help_and_version},
                                     {"unwritable_output", unwritable_output},
                                     {"render_ok", render_ok},
+                                    {"sigint_writes_image", sigint_writes_image},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

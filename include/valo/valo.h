@@ -94,10 +94,15 @@ typedef int (*valo_progress_fn)(void *user, double fraction, int spp_done, doubl
  * scene file's options; builds the acceleration structure. */
 VALO_API valo_status valo_render_create(const valo_scene *scene, const valo_options *opts,
                                         valo_render **out, valo_error *err);
-/* Renders until the sample or time budget is met. */
+/* Renders until the sample or time budget is met. When cancelled (valo_render_cancel, or
+ * the progress callback returning non-zero) it returns VALO_ERR_CANCELLED and the film
+ * keeps every finished sample: all pixels hold the whole passes counted in
+ * valo_stats.spp_done, and tiles of the interrupted pass that had finished hold that
+ * pass too (each pixel is averaged over its own count). valo_render_write then writes it. */
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user,
                                      valo_error *err);
-/* Asks a running render to stop after the current pass; thread-safe. */
+/* Asks a running render to stop: tiles already started finish, no new tile starts.
+ * Thread-safe and async-signal-safe (one atomic store). */
 VALO_API void valo_render_cancel(valo_render *r);
 
 typedef struct valo_stats {
@@ -105,7 +110,8 @@ typedef struct valo_stats {
   double build_seconds;   /* acceleration structure */
   double render_seconds;
   uint64_t rays;          /* all rays traced: camera, bounce and shadow */
-  int spp_done;
+  int spp_done;           /* whole passes: samples every pixel has (adaptive: the average) */
+  uint64_t samples;       /* camera samples taken over the whole film */
   int width, height;
   int threads;
   char integrator[32];

@@ -19,8 +19,11 @@
 static valo_render *volatile g_render;
 static volatile sig_atomic_t g_interrupted;
 
+/* First Ctrl-C: stop after the tiles in flight and write what is finished. Second:
+ * leave at once without writing. */
 static void on_sigint(int sig) {
   (void)sig;
+  if (g_interrupted) _exit(EXIT_INTERRUPTED);
   g_interrupted = 1;
   if (g_render) valo_render_cancel(g_render);
 }
@@ -280,18 +283,21 @@ static int cmd_render(int argc, char **argv) {
   g_render = NULL;
   if (ps.tty && !quiet) fprintf(stderr, "\n");
   int rc = 0;
+  valo_render_stats(r, &st);
   if (rs == VALO_ERR_CANCELLED || g_interrupted) {
-    fprintf(stderr, "valo: interrupted%s\n", rs == VALO_OK ? "" : "; no image written");
     rc = EXIT_INTERRUPTED;
+    if (st.spp_done > 0 || st.samples > 0)
+      fprintf(stderr, "valo: interrupted after %d spp%s; writing what is finished\n", st.spp_done,
+              st.samples > (uint64_t)st.spp_done * st.width * st.height ? " (some tiles one pass more)" : "");
+    else fprintf(stderr, "valo: interrupted before any sample finished; no image written\n");
   } else if (rs) {
     fprintf(stderr, "valo: error: %s\n", err.message);
     rc = 1;
   }
-  valo_render_stats(r, &st);
-  if (rc == 0 || (rc == EXIT_INTERRUPTED && rs == VALO_OK && st.spp_done > 0)) {
+  if (rc == 0 || (rc == EXIT_INTERRUPTED && (st.spp_done > 0 || st.samples > 0))) {
     for (int i = 0; i < nout; i++) {
       if (valo_render_write(r, outputs[i], &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
-      else if (!quiet) fprintf(stderr, "valo: wrote %s\n", outputs[i]);
+      else if (!quiet) fprintf(stderr, "valo: wrote %s (%d spp)\n", outputs[i], st.spp_done);
     }
   }
   if (!quiet) {

@@ -365,13 +365,10 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
     double pt = now_seconds() - p0;
     if (atomic_load(&r->cancel)) {
-      /* A cancelled pass is partial: the film keeps whole passes only. */
-      memset(r->sum, 0, (size_t)r->opt.width * r->opt.height * 3 * sizeof(double));
-      if (r->aov) memset(r->aov, 0, (size_t)r->opt.width * r->opt.height * 7 * sizeof(float));
-      memset(r->count, 0, (size_t)r->opt.width * r->opt.height * sizeof(uint32_t));
-      if (r->lum) memset(r->lum, 0, (size_t)r->opt.width * r->opt.height * 2 * sizeof(double));
-      r->spp_done = 0;
-      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled");
+      /* A cancelled pass stops between tiles: every tile holds whole samples (a tile
+       * that started finished its samples), so the film stays a valid image. Pixels of
+       * the tiles this pass finished hold n more samples; spp_done counts whole passes. */
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done);
       break;
     }
     r->spp_done += n;
@@ -379,7 +376,7 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     double frac = (double)r->spp_done / r->opt.spp;
     if (r->opt.adaptive) frac *= (double)uniform_spp / r->opt.spp;
     if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-    if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+    if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done); break; }
     if (budget > 0 && el >= budget) break;
     if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
   }
@@ -400,12 +397,12 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
       while (sel > 0 && !(pr[sel - 1].p > thr2)) sel--;
       adapt_job aj = {r, pr, (int64_t)sel, ts};
       parallel_for(threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
-      if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+      if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
       taken += (double)sel * ADAPT_BATCH;
       double el = now_seconds() - t0;
       double frac = taken / total;
       if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-      if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled"); break; }
+      if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
       if (budget > 0 && el >= budget) break;
     }
     r->spp_done = (int)(taken / (double)np);
@@ -427,6 +424,8 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   o->render_seconds = r->render_seconds;
   o->rays = r->rays;
   o->spp_done = r->spp_done;
+  size_t np = (size_t)r->opt.width * r->opt.height;
+  for (size_t i = 0; i < np; i++) o->samples += r->count[i];
   o->width = r->opt.width;
   o->height = r->opt.height;
   o->threads = r->opt.threads;
