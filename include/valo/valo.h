@@ -80,6 +80,26 @@ typedef struct valo_render valo_render;
  * (camera taken from the file when it has one, otherwise framed automatically).
  * On success *out owns the scene; free with valo_scene_destroy. */
 VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_error *err);
+
+/* How a scene is loaded (valo_scene_load_with). Unset fields take the defaults given. */
+typedef struct valo_load_options {
+  char env_file[1024];    /* an environment map (.exr/.hdr/.pfm, equirectangular) that
+                             replaces the scene's environment; "" = none (default) */
+  double env_scale;       /* its radiance scale (default 1) */
+  double env_rotation;    /* its rotation about the up axis in degrees (default 0) */
+  char up[4];             /* mesh files framed automatically: the model's up axis, "y"
+                             (default) or "z" (scanned and CAD models) */
+} valo_load_options;
+VALO_API void valo_load_options_init(valo_load_options *o);
+/* valo_scene_load with options (NULL = defaults). A mesh file given directly (not through
+ * a JSON scene) that has no light of its own (no emissive material, no light in the
+ * file) is lit as model viewers do: by env_file if given, else a uniform white
+ * environment of radiance 1, and a note says so. Any scene that ends up with no light
+ * at all gets a warning that the image will be black. */
+VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_options *lo, valo_scene **out, valo_error *err);
+/* Non-zero when the loaded scene has at least one light (emissive triangle, point, spot or
+ * directional light, or a non-black environment). */
+VALO_API int valo_scene_has_light(const valo_scene *scene);
 VALO_API void valo_scene_destroy(valo_scene *scene);
 /* The options the scene file itself asks for (unset fields stay VALO_UNSET). */
 VALO_API void valo_scene_file_options(const valo_scene *scene, valo_options *out);

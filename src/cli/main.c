@@ -61,15 +61,24 @@ static void usage_render(FILE *f) {
   fprintf(f,
           " (default path)\n"
           "  --accel NAME           kdtree (default) or embree\n"
-          "  --max-depth N          maximum path length; -1 = unlimited (Russian roulette)\n"
-          "  --aperture R           thin-lens radius in scene units (0 = pinhole), over the scene's\n"
+          "  --max-depth N          maximum path length (default -1: unlimited, Russian roulette\n"
+          "                         ends paths)\n"
+          "  --env FILE             light by this environment map (.exr/.hdr/.pfm), replacing\n"
+          "                         the scene's; a mesh file without lights gets a uniform\n"
+          "                         white environment otherwise\n"
+          "  --env-scale S          multiply the --env map by S (default 1)\n"
+          "  --env-rotation DEG     turn the --env map about the up axis (default 0)\n"
+          "  --up y|z               up axis of a mesh file framed automatically (default y;\n"
+          "                         z for scans and CAD models)\n"
+          "  --aperture R           thin-lens radius in scene units (0 = pinhole); overrides\n"
+          "                         the scene camera's\n"
           "  --focus D              focus distance along the view axis (default: the scene's; for\n"
           "                         a file camera, the surface at the image centre)\n"
           "  --spectral             spectral rendering (path): 4 wavelengths per path, dispersion\n"
           "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
           "                         noisiest pixels get more (spp:FILE writes the count map)\n"
-          "  --noise-threshold X    with --adaptive: stop once every pixel's relative\n"
-          "                         standard error is below X (e.g. 0.01)\n"
+          "  --noise-threshold X    adaptive sampling that stops once every pixel's relative\n"
+          "                         standard error is below X (e.g. 0.01); implies --adaptive\n"
           "  --exposure STOPS       PNG exposure (default 0)\n"
           "  --tonemap NAME         PNG tone curve: clamp (default), log, reinhard, aces\n"
           "  --bloom STRENGTH       PNG bloom: add STRENGTH x a Gaussian blur of what exceeds 1\n"
@@ -112,17 +121,18 @@ static int on_progress(void *user, double frac, int spp_done, double seconds) {
   char e[32], el[32];
   fmt_time(eta, e, sizeof e);
   fmt_time(seconds, el, sizeof el);
+  char sp[48];
+  if (p->spp_total >= 1048576) snprintf(sp, sizeof sp, "%d spp", spp_done);
+  else snprintf(sp, sizeof sp, "%d/%d spp", spp_done, p->spp_total);
   if (p->tty) {
     int width = 30, fill = (int)(frac * width + 0.5);
     char bar[64];
     for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
     bar[width] = 0;
-    fprintf(stderr, "\r[%s] %3d%%  %d/%d spp  %.2f spp/s  elapsed %s  ETA %s ", bar, (int)(frac * 100 + 0.5), spp_done,
-            p->spp_total, rate, el, e);
+    fprintf(stderr, "\r[%s] %3d%%  %s  %.2f spp/s  elapsed %s  ETA %s ", bar, (int)(frac * 100 + 0.5), sp, rate, el, e);
     fflush(stderr);
   } else if (seconds - p->last_print >= 5.0 || frac >= 1.0) {
-    fprintf(stderr, "valo: %3d%% %d/%d spp, %.2f spp/s, elapsed %s, ETA %s\n", (int)(frac * 100 + 0.5), spp_done, p->spp_total,
-            rate, el, e);
+    fprintf(stderr, "valo: %3d%% %s, %.2f spp/s, elapsed %s, ETA %s\n", (int)(frac * 100 + 0.5), sp, rate, el, e);
     p->last_print = seconds;
   }
   return g_interrupted;
@@ -139,6 +149,8 @@ static int cmd_render(int argc, char **argv) {
   valo_options_init(&opt);
   valo_output_options oo;
   valo_output_options_init(&oo);
+  valo_load_options lo;
+  valo_load_options_init(&lo);
   const char *scene_path = NULL, *outputs[MAX_OUTPUTS];
   int nout = 0, quiet = 0;
   for (int i = 0; i < argc; i++) {
@@ -170,7 +182,6 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_double(val, 0.001, 1e8, &dv)) BAD_VALUE("seconds, > 0");
       opt.time_budget = dv;
-      if (opt.spp == VALO_UNSET) opt.spp = 1048576;
     } else if (!strcmp(a, "--threads")) {
       NEED_VALUE();
       if (parse_int(val, 1, 1024, &lv)) BAD_VALUE("a whole number from 1 to 1024");
@@ -188,7 +199,30 @@ static int cmd_render(int argc, char **argv) {
       opt.width = w; opt.height = h;
     } else if (!strcmp(a, "--integrator")) {
       NEED_VALUE();
+      int known = 0;
+      for (const char *const *n = valo_integrator_names(); *n; n++) known |= !strcmp(*n, val);
+      if (!known) {
+        fprintf(stderr, "valo: --integrator: unknown integrator \"%s\" (one of:", val);
+        for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(stderr, " %s", *n);
+        fprintf(stderr, ")\n");
+        return EXIT_USAGE;
+      }
       snprintf(opt.integrator, sizeof opt.integrator, "%s", val);
+    } else if (!strcmp(a, "--env")) {
+      NEED_VALUE();
+      snprintf(lo.env_file, sizeof lo.env_file, "%s", val);
+    } else if (!strcmp(a, "--env-scale")) {
+      NEED_VALUE();
+      if (parse_double(val, 0, 1e9, &dv)) BAD_VALUE("a scale >= 0");
+      lo.env_scale = dv;
+    } else if (!strcmp(a, "--env-rotation")) {
+      NEED_VALUE();
+      if (parse_double(val, -36000, 36000, &dv)) BAD_VALUE("degrees");
+      lo.env_rotation = dv;
+    } else if (!strcmp(a, "--up")) {
+      NEED_VALUE();
+      if (strcmp(val, "y") && strcmp(val, "z")) BAD_VALUE("y or z");
+      snprintf(lo.up, sizeof lo.up, "%s", val);
     } else if (!strcmp(a, "--accel")) {
       NEED_VALUE();
       if (strcmp(val, "kdtree") && strcmp(val, "embree")) BAD_VALUE("kdtree or embree");
@@ -236,6 +270,10 @@ static int cmd_render(int argc, char **argv) {
     else { fprintf(stderr, "valo: more than one scene given (\"%s\" and \"%s\")\n", scene_path, a); return EXIT_USAGE; }
   }
   if (!scene_path) { fprintf(stderr, "valo: no scene given\n"); usage_render(stderr); return EXIT_USAGE; }
+  if (opt.noise_threshold != VALO_UNSET && opt.adaptive != 1) {
+    opt.adaptive = 1;
+    if (!quiet) fprintf(stderr, "valo: note: --noise-threshold turns on adaptive sampling (--adaptive)\n");
+  }
   char default_out[1024];
   if (nout == 0) {
     const char *base = strrchr(scene_path, '/');
@@ -254,10 +292,31 @@ static int cmd_render(int argc, char **argv) {
     }
   }
 
+  /* Every output's folder must exist and be writable before hours of rendering. */
+  for (int i = 0; i < nout; i++) {
+    const char *file = outputs[i], *colon = strchr(file, ':');
+    if (colon && (!strncmp(file, "albedo:", 7) || !strncmp(file, "normal:", 7) || !strncmp(file, "depth:", 6) || !strncmp(file, "spp:", 4)))
+      file = colon + 1;
+    char dir[4096];
+    const char *slash = strrchr(file, '/');
+    if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);
+    else snprintf(dir, sizeof dir, ".");
+    if (access(dir, W_OK) != 0) {
+      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", outputs[i], dir,
+              errno == ENOENT ? "does not exist" : strerror(errno));
+      return 1;
+    }
+  }
+
   valo_error err;
   double t0 = now_seconds();
   valo_scene *sc = NULL;
-  if (valo_scene_load(scene_path, &sc, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
+  if (valo_scene_load_with(scene_path, &lo, &sc, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
+  valo_options file_opts;
+  valo_scene_file_options(sc, &file_opts);
+  /* --time alone: the scene file's spp (if any) still bounds the render, whichever comes
+   * first; otherwise only the time does. */
+  if (opt.time_budget != VALO_UNSET && opt.spp == VALO_UNSET) opt.spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
   double load_s = now_seconds() - t0;
   valo_render *r = NULL;
   if (valo_render_create(sc, &opt, &r, &err)) {
@@ -270,10 +329,18 @@ static int cmd_render(int argc, char **argv) {
   valo_options eff;
   valo_scene_file_options(sc, &eff);
   int spp_total = opt.spp != VALO_UNSET ? opt.spp : (eff.spp != VALO_UNSET ? eff.spp : 16);
-  progress_state ps = {isatty(2), quiet, -1e9, spp_total, opt.time_budget};
-  if (!quiet)
-    fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %d spp, %s integrator, %s, %d threads\n", scene_path,
-            (unsigned long long)st.triangles, st.width, st.height, spp_total, st.integrator, st.accel, st.threads);
+  double time_total = opt.time_budget != VALO_UNSET ? opt.time_budget : eff.time_budget;
+  progress_state ps = {isatty(2), quiet, -1e9, spp_total, time_total};
+  if (!quiet) {
+    char budget[96];
+    if (time_total > 0 && spp_total >= 1048576) snprintf(budget, sizeof budget, "time budget %g s", time_total);
+    else if (time_total > 0) snprintf(budget, sizeof budget, "%d spp or %g s, whichever comes first", spp_total, time_total);
+    else snprintf(budget, sizeof budget, "%d spp", spp_total);
+    fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %s, %s integrator, %s, %d threads\n", scene_path,
+            (unsigned long long)st.triangles, st.width, st.height, budget, st.integrator, st.accel, st.threads);
+    if (!valo_scene_has_light(sc))
+      fprintf(stderr, "valo: warning: the scene has no light: the image will be black\n");
+  }
   g_render = r;
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);

@@ -27,6 +27,19 @@ void log_warning(const char *fmt, ...) {
   else fprintf(stderr, "valo: warning: %s\n", buf);
 }
 
+void log_note(const char *fmt, ...) {
+  char buf[1024];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (g_warn_fn) {
+    char nb[1100];
+    snprintf(nb, sizeof nb, "note: %s", buf);
+    g_warn_fn(g_warn_user, nb);
+  } else fprintf(stderr, "valo: note: %s\n", buf);
+}
+
 VALO_API void valo_set_warning_handler(valo_log_fn fn, void *user) { g_warn_fn = fn; g_warn_user = user; }
 
 VALO_API const char *valo_status_string(valo_status s) {

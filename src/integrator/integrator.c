@@ -86,13 +86,15 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
 
 bsdf bsdf_at(const scene *s, const isect *it) {
   const material *m = it->m;
-  if (m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0) return bsdf_from_material(m);
+  if (m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0) return bsdf_from_material(m);
   material mm = *m;
   float px[4];
   if (m->tex_kd >= 0) { texture_lookup(&s->tex[m->tex_kd], it->u, it->v, px); mm.kd = c3_mul(mm.kd, c3(px[0], px[1], px[2])); }
   if (m->tex_ks >= 0) { texture_lookup(&s->tex[m->tex_ks], it->u, it->v, px); mm.ks = c3_mul(mm.ks, c3(px[0], px[1], px[2])); }
   if (m->tex_ns >= 0) { texture_lookup(&s->tex[m->tex_ns], it->u, it->v, px); mm.exponent *= (px[0] + px[1] + px[2]) / 3; }
   if (m->tex_mr >= 0) { texture_lookup(&s->tex[m->tex_mr], it->u, it->v, px); mm.roughness *= px[1]; mm.metallic *= px[2]; }
+  if (m->tex_rough >= 0) { texture_lookup(&s->tex[m->tex_rough], it->u, it->v, px); mm.roughness *= sqrtf(fmaxf((px[0] + px[1] + px[2]) / 3, 0)); }
+  if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
   return bsdf_from_material(&mm);
 }
 

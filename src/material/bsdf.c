@@ -34,6 +34,7 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_PBR: {
     b.type = BSDF_PBR;
     b.metallic = clampf(m->metallic, 0, 1);
+    b.metal_flat = m->metal_flat;
     /* Diffuse lobe weight against the specular one (never 0 unless the diffuse term is). */
     float wd = (1 - b.metallic) * c3_avg(m->kd), ws = b.metallic + (1 - b.metallic) * 0.25f;
     b.p_first = wd + ws > 0 ? wd / (wd + ws) : 0;
@@ -72,7 +73,7 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
    * the diffuse base is weighted by 1 - F(n.v) instead of the spec's 1 - F(v.h), which
    * returns up to 35 % more energy than arrives at grazing angles (test_chi2 furnace). */
   float Fd = 0.04f + 0.96f * s5, Fo = 0.04f + 0.96f * schlick_weight(wo.z);
-  rgb Fm = c3_add(b->kd, c3_scale(c3_sub(c3(1, 1, 1), b->kd), s5));
+  rgb Fm = b->metal_flat ? b->kd : c3_add(b->kd, c3_scale(c3_sub(c3(1, 1, 1), b->kd), s5));
   rgb diel = c3_add(c3_scale(b->kd, (1 - Fo) * INV_PI_F), c3(Fd * spec, Fd * spec, Fd * spec));
   return c3_add(c3_scale(diel, 1 - b->metallic), c3_scale(Fm, b->metallic * spec));
 }

@@ -22,6 +22,7 @@ typedef struct bsdf {
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types) */
   float metallic;     /* BSDF_PBR */
+  int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */
 } bsdf;
 
 typedef struct bsdf_sample {

@@ -13,6 +13,7 @@
 #include "core/threadpool.h"
 #include "core/error.h"
 #include "core/sampling.h"
+#include "light/envmap.h"
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,20 +84,65 @@ static int ends_with(const char *s, const char *suf) {
   return n >= m && !strcasecmp(s + n - m, suf);
 }
 
-VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_error *err) {
+VALO_API void valo_load_options_init(valo_load_options *o) {
+  memset(o, 0, sizeof *o);
+  o->env_scale = 1;
+  snprintf(o->up, sizeof o->up, "y");
+}
+
+/* Lights a scene could have before commit: emissive triangles, lights, an environment. */
+static int scene_has_any_light(const scene *s) {
+  if (s->nlights > 0) return 1;
+  if (s->has_env && (s->env_map || !c3_black(s->env_radiance))) return 1;
+  for (uint32_t t = 0; t < s->ntris; t++)
+    if (!c3_black(s->mats[s->tri_mat[t]].emission)) return 1;
+  return 0;
+}
+
+VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_options *lo, valo_scene **out, valo_error *err) {
   *out = NULL;
   if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  valo_load_options def;
+  valo_load_options_init(&def);
+  if (!lo) lo = &def;
   if (!path || !*path) return err_set(err, VALO_ERR_INVALID, "no scene file given");
+  if (strcmp(lo->up, "y") && strcmp(lo->up, "z") && lo->up[0]) return err_set(err, VALO_ERR_INVALID, "up axis \"%s\" (y or z)", lo->up);
   scene *s = scene_new(path);
   valo_scene *vs = calloc(1, sizeof *vs);
   if (!s || !vs) { scene_free(s); free(vs); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  valo_status st = ends_with(path, ".json") ? load_json(s, path, err) : load_mesh(s, path, NULL, UINT32_MAX, 1, err);
+  int json = ends_with(path, ".json");
+  s->up_z = !strcmp(lo->up, "z");
+  valo_status st = json ? load_json(s, path, err) : load_mesh(s, path, NULL, UINT32_MAX, 1, err);
+  if (st == VALO_OK && lo->env_file[0]) {
+    /* --env replaces whatever environment the scene had. */
+    if (s->env_map) { envmap_free(s->env_map); free(s->env_map); s->env_map = NULL; }
+    s->env_map = calloc(1, sizeof *s->env_map);
+    if (!s->env_map) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
+    else st = envmap_load(s->env_map, lo->env_file, (float)lo->env_scale, (float)lo->env_rotation, err);
+    s->has_env = st == VALO_OK;
+  }
+  if (st == VALO_OK && !scene_has_any_light(s)) {
+    if (!json) {
+      s->has_env = 1;
+      s->env_radiance = c3(1, 1, 1);
+      log_note("%s has no light of its own (no emissive material, no light): it is lit by a uniform white environment "
+               "(radiance 1), as model viewers do; --env FILE lights it by an environment map instead", path);
+    } else {
+      log_warning("%s has no light (no emissive material, no light, no environment): the image will be black", path);
+    }
+  }
   if (st == VALO_OK) st = scene_commit(s, err);
   if (st) { scene_free(s); free(vs); return st; }
   vs->s = s;
   *out = vs;
   return VALO_OK;
 }
+
+VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_error *err) {
+  return valo_scene_load_with(path, NULL, out, err);
+}
+
+VALO_API int valo_scene_has_light(const valo_scene *vs) { return vs->s->nlights > 0; }
 
 VALO_API void valo_scene_destroy(valo_scene *vs) {
   if (!vs) return;

@@ -12,6 +12,8 @@
 #include <assimp/material.h>
 #include <assimp/ObjMaterial.h>
 #include "scene/texture.h"
+#include "scene/obj_check.h"
+#include <assimp/cfileio.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/texture.h>
 #include <errno.h>
@@ -122,7 +124,7 @@ static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial
   return t;
 }
 
-static material convert_material(const struct aiMaterial *am) {
+static material convert_material(const struct aiMaterial *am, const obj_check *oc) {
   material m = material_default();
   struct aiString name;
   if (aiGetMaterialString(am, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS) snprintf(m.name, sizeof m.name, "%s", name.data);
@@ -145,6 +147,23 @@ static material convert_material(const struct aiMaterial *am) {
   else m.type = MAT_DIFFUSE;
   if (m.type == MAT_DIELECTRIC && !(m.ior > 0)) m.ior = 1.5f;
   if (m.exponent < 0 || !isfinite(m.exponent)) m.exponent = 1;
+  /* MTL's PBR extension (docs/scene-format.md): Pr is the microfacet alpha (so valo's
+   * roughness, whose square is alpha, is its root), Pm the metallic weight. A material
+   * with either becomes the pbr model (illum 7 glass: rough glass); a metal whose Kd is
+   * black takes its colour from Ks, and reflects it at every angle as MTL mirrors do
+   * (illum 3 and 5 have no Fresnel term). */
+  const mtl_pbr *pb = oc ? obj_check_pbr(oc, m.name) : NULL;
+  if (pb && (pb->has_pr || pb->has_pm || pb->map_pr[0] || pb->map_pm[0])) {
+    float alpha = pb->has_pr ? clampf(pb->pr, 0, 1) : 0.25f;
+    if (m.type == MAT_DIELECTRIC) m.roughness = sqrtf(alpha);
+    else {
+      m.type = MAT_PBR;
+      m.metallic = pb->has_pm ? clampf(pb->pm, 0, 1) : 0;
+      m.roughness = sqrtf(alpha);
+      if (m.metallic > 0 && c3_black(m.kd) && !c3_black(m.ks)) m.kd = m.ks;
+      m.metal_flat = 1;
+    }
+  }
   return m; /* texture slots stay as material_default left them: none */
 }
 
@@ -163,8 +182,20 @@ static int looks_like_normal_map(const texture *t) {
   return b > 0.7 && fabs(r - 0.5) < 0.15 && fabs(g - 0.5) < 0.15 && spread > 0.2;
 }
 
-static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf) {
+static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf,
+                             const obj_check *oc) {
   int wrap = 0;
+  const mtl_pbr *pb = oc ? obj_check_pbr(oc, m->name) : NULL;
+  if (pb && pb->map_pr[0]) {
+    char full[2048];
+    snprintf(full, sizeof full, "%s%s", pb->map_pr[0] == '/' ? "" : dir, pb->map_pr);
+    m->tex_rough = scene_texture_file(s, full, 0);
+  }
+  if (pb && pb->map_pm[0]) {
+    char full[2048];
+    snprintf(full, sizeof full, "%s%s", pb->map_pm[0] == '/' ? "" : dir, pb->map_pm);
+    m->tex_metal = scene_texture_file(s, full, 0);
+  }
   m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
@@ -388,12 +419,25 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   if (strips)
     return err_set(err, VALO_ERR_UNSUPPORTED, "%s: PLY triangle strips (element tristrips) are not supported; convert the mesh to faces", path);
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-  const struct aiScene *ai = aiImportFile(path, flags);
+  const char *ext = strrchr(path, '.');
+  /* OBJ files are read by valo first (obj_check.c): checks with line numbers, repairs,
+   * the MTL PBR extension; Assimp then parses the repaired text. */
+  int obj = ext && !strcasecmp(ext, ".obj");
+  obj_check oc;
+  memset(&oc, 0, sizeof oc);
+  struct aiFileIO io;
+  if (obj) {
+    valo_status cst = obj_check_read(path, &oc, err);
+    if (cst) return cst;
+    obj_check_fileio(&oc, &io);
+  }
+  const struct aiScene *ai = obj ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
   if (!ai) {
     const char *msg = aiGetErrorString();
-    return err_set(err, VALO_ERR_PARSE, "%s: cannot read mesh: %s", path, msg && *msg ? msg : "unknown format");
+    obj_check_free(&oc);
+    return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
+                   ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  const char *ext = strrchr(path, '.');
   load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"))};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
@@ -403,8 +447,8 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     const char *slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
-      material m = convert_material(ai->mMaterials[i]);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf);
+      material m = convert_material(ai->mMaterials[i], obj ? &oc : NULL);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, obj ? &oc : NULL);
       s->mats[c.mat_base + i] = m;
     }
     if (ai->mNumMaterials == 0) {
@@ -429,5 +473,6 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   st = take_file_lights(&c, &x);
 done:
   aiReleaseImport(ai);
+  obj_check_free(&oc);
   return st;
 }

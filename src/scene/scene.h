@@ -25,6 +25,7 @@ typedef struct material {
   rgb eta, k;
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
   float metallic;    /* MAT_PBR: 0 dielectric .. 1 metal */
+  int metal_flat;    /* MAT_PBR: metal reflectance kd at every angle, no Schlick term (MTL PBR extension) */
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
@@ -34,6 +35,8 @@ typedef struct material {
   int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
   int tex_ns;        /* Phong exponent map (MTL map_Ns; linear, mean of RGB multiplies exponent), -1 = none */
   int tex_bump;      /* height map for bump mapping (mean of RGB, linear), -1 = none */
+  int tex_rough;     /* MTL map_Pr: multiplies alpha (mean of RGB, linear), so roughness by its root; -1 = none */
+  int tex_metal;     /* MTL map_Pm: multiplies metallic (mean of RGB, linear), -1 = none */
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
@@ -85,6 +88,7 @@ typedef struct scene {
   struct envmap *env_map;  /* equirectangular map (owned), or NULL for constant */
   camera cam;
   int has_camera;
+  int up_z;                /* automatic framing: the model's up axis is +z (else +y) */
   valo_options file_opts;
   bbox bounds;
   vec3 center;

@@ -1,0 +1,45 @@
+/* obj_check.h — owns valo's own reading of OBJ and MTL text before Assimp parses it:
+ * input checks with file:line messages in valo's words (faces that refer to missing
+ * vertices, non-finite or incomplete vertices, a truncated last line), warnings for what
+ * would otherwise vanish (faces with fewer than three vertices, line and point elements,
+ * lines it does not understand, usemtl names no MTL defines, unreadable mtllib files),
+ * repairs of valid text Assimp 5.2 misreads (numbers with a leading dot such as .8e-1;
+ * MTL lines such as `aniso` that stop its MTL parser), and the PBR extension of MTL
+ * (Pr, Pm, map_Pr, map_Pm; Ps, Pc, Pcr, aniso noted as ignored), which valo reads itself.
+ * The repaired texts are served to Assimp through its file-system callbacks. */
+#ifndef VALO_OBJ_CHECK_H
+#define VALO_OBJ_CHECK_H
+#include "valo/valo.h"
+#include <stddef.h>
+
+typedef struct mtl_pbr {
+  char name[64];
+  int has_pr, has_pm;
+  float pr, pm;                 /* MTL Pr (roughness) and Pm (metallic) */
+  char map_pr[512], map_pm[512];/* texture paths as written (relative to the MTL), or "" */
+} mtl_pbr;
+
+typedef struct obj_text {
+  char path[1024];
+  char *text;                   /* repaired text (owned) */
+  size_t len;
+} obj_text;
+
+typedef struct obj_check {
+  obj_text files[17];           /* [0] the OBJ, then its MTL files */
+  int nfiles;
+  mtl_pbr *pbr;                 /* one per newmtl of every MTL */
+  int npbr;
+} obj_check;
+
+/* Reads and checks the OBJ at path and the MTL files it names. Returns VALO_OK (with
+ * warnings logged) or an error naming file and line. Free with obj_check_free. */
+valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err);
+void obj_check_free(obj_check *oc);
+/* The PBR-extension values of material `name`, or NULL. */
+const mtl_pbr *obj_check_pbr(const obj_check *oc, const char *name);
+/* An Assimp file system (struct aiFileIO *) serving the repaired texts and reading every
+ * other file from disk; valid while oc lives. */
+struct aiFileIO;
+void obj_check_fileio(obj_check *oc, struct aiFileIO *io);
+#endif
