@@ -6,6 +6,7 @@
  * the answers are exact for the tessellated geometry. Tolerances: region means within
  * 1 %, every pixel within 6 sigma-ish bounds stated per case; all pixels finite. */
 #include "harness.h"
+#include "scene/texture.h"
 #include "image/image_io.h"
 #include <math.h>
 #include <stdlib.h>
@@ -287,6 +288,24 @@ static int aovs(void) {
   float expect = 3 * sqrtf(1 + 2 * tanh * tanh);
   CHECK(fabsf(dc[0] - expect) < 0.05f, "corner depth %g, expected about %g", dc[0], expect);
   for (int k = 0; k < 3; k++) image_free(&im[k]);
+  /* As PNG (issue 8.7): normals n/2 + 1/2, depth over its largest value, sample counts
+   * over the largest, stored linearly in the 8 bits. */
+  static const char *const pngs[3] = {"normal", "depth", "spp"};
+  for (int k = 0; k < 3; k++) {
+    char file[1200], spec[1300];
+    snprintf(file, sizeof file, "%s/aov_%s.png", scratch_dir(), pngs[k]);
+    snprintf(spec, sizeof spec, "%s:%s", pngs[k], file);
+    CHECK(valo_render_write(r, spec, NULL, &err) == VALO_OK, "%s", err.message);
+    texture t;
+    CHECK(texture_load_file(&t, file, 0, &err) == VALO_OK, "%s", err.message);
+    float c[4], corner[4];
+    texture_texel(&t, 4, 4, c);
+    texture_texel(&t, 0, 0, corner);
+    texture_free(&t);
+    if (k == 0) CHECK(fabsf(c[0] - 0.5f) < 0.01f && fabsf(c[1] - 0.5f) < 0.01f && c[2] > 0.99f, "normal PNG (%g %g %g)", c[0], c[1], c[2]);
+    if (k == 1) CHECK(fabsf(c[0] - 3 / expect) < 0.01f && corner[0] > 0.99f, "depth PNG centre %g (expected %g), corner %g", c[0], 3 / expect, corner[0]);
+    if (k == 2) CHECK(c[0] > 0.99f, "spp PNG %g (every pixel has the largest count)", c[0]);
+  }
   /* Without aovs set, asking for one is a clear error. */
   valo_render_destroy(r);
   CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);
@@ -434,6 +453,54 @@ static int adaptive_sampling(void) {
   return 0;
 }
 
+/* Automatic framing (issue 8.9): a mesh file without a camera is framed tightly from the
+ * front: the open Cornell box fills the frame (before: two thirds of it); with --up z a
+ * z-up scan (nefertiti) stands upright, so what it covers is taller than wide. */
+static int frame_coverage(const char *path, const char *up, int w, int h, double *cover, int *bw, int *bh) {
+  valo_load_options lo;
+  valo_load_options_init(&lo);
+  snprintf(lo.up, sizeof lo.up, "%s", up);
+  valo_error err;
+  valo_scene *sc;
+  if (valo_scene_load_with(path, &lo, &sc, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  valo_options o;
+  valo_options_init(&o);
+  o.aovs = 1; o.spp = 1; o.width = w; o.height = h;
+  valo_render *r;
+  if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  image d;
+  if (read_aov(r, "depth", &d)) return -1;
+  int n = 0, x0 = w, x1 = -1, y0 = h, y1 = -1;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      if (d.rgb[3 * (y * w + x)] > 0) {
+        n++;
+        x0 = x < x0 ? x : x0; x1 = x > x1 ? x : x1; y0 = y < y0 ? y : y0; y1 = y > y1 ? y : y1;
+      }
+  *cover = (double)n / (w * h);
+  *bw = x1 - x0 + 1; *bh = y1 - y0 + 1;
+  image_free(&d);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return 0;
+}
+static int auto_framing(void) {
+  const char *box = shared_file("scenes/cornell/CornellBox-Original.obj"), *nef = shared_file("scenes/models/nefertiti.obj");
+  if (!box || !nef) return TEST_SKIP;
+  double c;
+  int bw, bh;
+  CHECK(frame_coverage(box, "y", 64, 64, &c, &bw, &bh) == 0, "render failed");
+  fprintf(stderr, "Cornell box, auto-framed 64x64: %.1f %% of the pixels see it (%dx%d)\n", 100 * c, bw, bh);
+  CHECK(c > 0.9, "the box covers only %.1f %% of the frame", 100 * c);
+  CHECK(frame_coverage(box, "y", 96, 48, &c, &bw, &bh) == 0, "render failed");
+  fprintf(stderr, "Cornell box, auto-framed 96x48: covers %dx%d\n", bw, bh);
+  CHECK(bh >= 46 && bw < 96, "a wide film: the box should fill the height (%dx%d)", bw, bh);
+  CHECK(frame_coverage(nef, "z", 64, 64, &c, &bw, &bh) == 0, "render failed");
+  fprintf(stderr, "nefertiti --up z: covers %dx%d\n", bw, bh);
+  CHECK(bh >= 50 && bh > 1.5 * bw, "nefertiti is not upright and tightly framed (%dx%d)", bw, bh);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"furnace_albedo_1", furnace_albedo_1},
                                     {"furnace_albedo_half", furnace_albedo_half},
@@ -446,7 +513,7 @@ int main(int argc, char **argv) {
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {"thin_lens_gltf_camera", thin_lens_gltf_camera},
-                                    {"adaptive_sampling", adaptive_sampling},
+                                    {"adaptive_sampling", adaptive_sampling}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

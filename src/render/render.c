@@ -244,8 +244,9 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->ctx.s = s;
   r->ctx.acc = r->acc;
   r->ctx.max_depth = o.max_depth;
-  /* Camera basis. */
-  const camera *c = &s->cam;
+  /* Camera basis; an automatic camera is fitted to this film's aspect first. */
+  camera fitted = scene_camera_fit(s, (float)o.width / (float)o.height);
+  const camera *c = &fitted;
   r->cam_o = c->pos;
   r->cam_fwd = v3_norm(v3_sub(c->look_at, c->pos));
   r->cam_right = v3_norm(v3_cross(r->cam_fwd, c->up));
@@ -487,6 +488,21 @@ VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) {
   }
 }
 
+/* Data AOVs written as PNG (docs/integrators.md): mapped into [0, 1] so that they are
+ * visible, then stored linearly in the 8 bits (each value pre-decoded from sRGB, so the
+ * PNG writer's sRGB encoding gives back byte = round(255 v)). kind 0: normals, n/2 + 1/2;
+ * 1: depth, divided by the largest in the image (black where nothing was hit); 2: sample
+ * counts, divided by the largest. */
+static void png_data_map(float *px, size_t np, int kind) {
+  float mx = 0;
+  for (size_t i = 0; i < 3 * np; i++) mx = px[i] > mx ? px[i] : mx;
+  for (size_t i = 0; i < 3 * np; i++) {
+    float v = kind == 0 ? px[i] * 0.5f + 0.5f : (mx > 0 ? px[i] / mx : 0);
+    v = clampf(v, 0, 1);
+    px[i] = v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
+  }
+}
+
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {
   if (err) { err->status = VALO_OK; err->message[0] = 0; }
   valo_output_options def;
@@ -497,9 +513,10 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
     float *px = malloc(np * 3 * sizeof(float));
     if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < np; i++) px[3 * i] = px[3 * i + 1] = px[3 * i + 2] = (float)r->count[i];
-    valo_output_options raw = *o;
-    raw.bloom = 0;
-    valo_status st = image_write(path + 4, r->opt.width, r->opt.height, px, &raw, err);
+    if (ends_with(path, ".png")) png_data_map(px, np, 2);
+    valo_output_options raw;
+    valo_output_options_init(&raw);
+    valo_status st = image_write(path + 4, r->opt.width, r->opt.height, px, ends_with(path, ".png") ? &raw : o, err);
     free(px);
     return st;
   }
@@ -515,9 +532,11 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
       float inv = r->count[i] > 0 ? 1.0f / (float)r->count[i] : 0;
       for (int c = 0; c < 3; c++) px[3 * i + c] = (k == 2 ? r->aov[7 * i + 6] : r->aov[7 * i + 3 * k + c]) * inv;
     }
-    valo_output_options raw = *o;
-    raw.bloom = 0;
-    valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, &raw, err);
+    int png = ends_with(path, ".png");
+    if (png && k > 0) png_data_map(px, np, k == 1 ? 0 : 1);
+    valo_output_options raw;
+    valo_output_options_init(&raw);
+    valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, png && k > 0 ? &raw : o, err);
     free(px);
     return st;
   }

@@ -232,14 +232,16 @@ valo_status scene_commit(scene *s, valo_error *err) {
     if (!c3_black(l.L) && scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   }
   if (!s->has_camera) {
-    /* Frame the bounds from +z, looking down -z, 40 degree vertical fov. */
+    /* Framed automatically (docs/scene-format.md): a front view, 40 degree vertical fov;
+     * render.c fits the distance to the bounds for the film's aspect (camera_frame). */
     s->cam.fov_deg = 40;
-    float dist = s->radius / sinf(0.5f * 40 * PI_F / 180) * 1.05f;
     s->cam.look_at = s->center;
-    s->cam.pos = v3_add(s->center, v3(0, 0, dist));
-    s->cam.up = v3(0, 1, 0);
+    s->cam.up = s->up_z ? v3(0, 0, 1) : v3(0, 1, 0);
+    vec3 back = s->up_z ? v3(0, -1, 0) : v3(0, 0, 1);
+    s->cam.pos = v3_add(s->center, v3_scale(back, s->radius / sinf(0.5f * 40 * PI_F / 180)));
     s->cam.aperture_radius = 0;
-    s->cam.focus_distance = dist;
+    s->cam.focus_distance = -1;
+    s->cam_auto = 1;
     s->has_camera = 1;
   }
   return VALO_OK;
@@ -305,4 +307,29 @@ int conductor_preset(const char *name, rgb *eta, rgb *k) {
   for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
     if (!strcmp(name, t[i].n)) { *eta = t[i].eta; *k = t[i].k; return 0; }
   return -1;
+}
+
+/* Moves an automatic camera along its view axis to the nearest distance at which all
+ * eight corners of the bounds fit in the frame (2 % margin) for this aspect: a corner q
+ * (relative to the look-at point; x right, y up, z away from the camera) projects inside
+ * when D + z >= |x| / tan(h) and D + z >= |y| / tan(v). */
+camera scene_camera_fit(const scene *s, float aspect) {
+  camera cam = s->cam;
+  if (!s->cam_auto) return cam;
+  camera *c = &cam;
+  vec3 f = v3_norm(v3_sub(c->look_at, c->pos)), r = v3_norm(v3_cross(f, c->up)), u = v3_cross(r, f);
+  float tv = tanf(0.5f * c->fov_deg * PI_F / 180) * 0.98f, th = tv * aspect;
+  float D = 0;
+  for (int k = 0; k < 8; k++) {
+    vec3 p = v3(k & 1 ? s->bounds.hi.x : s->bounds.lo.x, k & 2 ? s->bounds.hi.y : s->bounds.lo.y, k & 4 ? s->bounds.hi.z : s->bounds.lo.z);
+    vec3 q = v3_sub(p, c->look_at);
+    float x = fabsf(v3_dot(q, r)), y = fabsf(v3_dot(q, u)), z = v3_dot(q, f);
+    float need = fmaxf(x / th, y / tv) - z;
+    D = fmaxf(D, need);
+    D = fmaxf(D, -z + 1e-3f * s->radius); /* the camera stays outside the bounds */
+  }
+  if (!(D > 0) || !isfinite(D)) D = s->radius;
+  c->pos = v3_sub(c->look_at, v3_scale(f, D));
+  c->focus_distance = D;
+  return cam;
 }

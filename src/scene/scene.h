@@ -89,6 +89,7 @@ typedef struct scene {
   camera cam;
   int has_camera;
   int up_z;                /* automatic framing: the model's up axis is +z (else +y) */
+  int cam_auto;            /* the camera was framed automatically (scene_camera_fit) */
   valo_options file_opts;
   bbox bounds;
   vec3 center;
@@ -117,6 +118,10 @@ static inline vec3 scene_tri_ng(const scene *s, uint32_t t) {
   const uint32_t *i = &s->idx[3 * t];
   return v3_cross(v3_sub(s->pos[i[1]], s->pos[i[0]]), v3_sub(s->pos[i[2]], s->pos[i[0]]));
 }
+
+/* The scene's camera for a film of this aspect: an automatic camera moved along its axis
+ * to the nearest distance that frames the bounds; any other camera as it is. */
+camera scene_camera_fit(const scene *s, float aspect);
 
 /* Loaders (one per file kind). */
 valo_status load_json(scene *s, const char *path, valo_error *err);
