@@ -6,6 +6,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -278,7 +279,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
   /* Pass 2: check and repair each line. */
   outbuf o = {0};
   long sofar[3] = {0, 0, 0};
-  long dropped_faces = 0, first_dropped = 0, elements = 0, not_understood = 0, first_nu = 0, bad_usemtl = 0;
+  long kept_faces = 0, dropped_faces = 0, first_dropped = 0, elements = 0, not_understood = 0, first_nu = 0, bad_usemtl = 0;
   char msg[256];
   valo_status st = VALO_OK;
   line = 0;
@@ -304,7 +305,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
           st = err_set(err, VALO_ERR_PARSE, "%s:%d: \"%.*s\" is not a number", path, line, (int)(te[k] - tb[k]), tb[k]);
           goto done;
         }
-        if (!isfinite(v) && k <= 3) {
+        if ((!isfinite(v) || fabs(v) > FLT_MAX) && k <= 3) {
           st = err_set(err, VALO_ERR_INVALID, "%s:%d: %s coordinate \"%.*s\" is not a finite number", path, line,
                        kv ? "vertex" : kt ? "texture" : "normal", (int)(te[k] - tb[k]), tb[k]);
           goto done;
@@ -329,7 +330,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
       int bad = 0;
       for (int k = 1; k < nt && k < 64; k++)
         if (check_ref(tb[k], te[k], sofar, total, msg, sizeof msg)) { bad = 1; break; }
-      if (bad && truncated) {
+      if ((bad || nt - 1 < 3) && truncated) {
         log_warning("%s:%d: the file ends in the middle of a line (truncated?); that face is ignored", path, line);
         continue;
       }
@@ -338,6 +339,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
         if (!dropped_faces++) first_dropped = line;
         continue;
       }
+      kept_faces++;
       ob_put(&o, s, (size_t)(next - s));
       continue;
     }
@@ -363,6 +365,11 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
   }
   if (o.oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
   if (total[0] == 0) { st = err_set(err, VALO_ERR_INVALID, "%s: no vertices (no \"v\" lines): not an OBJ file, or empty", path); goto done; }
+  if (kept_faces == 0) {
+    st = err_set(err, VALO_ERR_INVALID, "%s: no usable triangles: no face with three or more vertices (%ld vertices, %ld shorter faces, "
+                 "%ld line/point elements)", path, total[0], dropped_faces, elements);
+    goto done;
+  }
   if (dropped_faces)
     log_warning("%s:%ld: %ld face%s with fewer than three vertices dropped (first at this line)", path, first_dropped, dropped_faces,
                 dropped_faces > 1 ? "s" : "");
