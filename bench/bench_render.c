@@ -18,7 +18,12 @@
 #endif
 
 int main(int argc, char **argv) {
-  int quick = argc > 1 && !strcmp(argv[1], "--quick");
+  int quick = 0;
+  const char *sampler_name = "sobol";
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--quick")) quick = 1;
+    else if (!strcmp(argv[i], "--sampler") && i + 1 < argc) sampler_name = argv[++i];
+  }
   const char *root = getenv("VALO_SHARED");
   char obj[2048], refp[2048], json[4096];
   snprintf(obj, sizeof obj, "%s/scenes/cornell/CornellBox-Original.obj", root && *root ? root : VALO_SHARED_DIR);
@@ -47,6 +52,7 @@ int main(int argc, char **argv) {
     valo_options_init(&o);
     o.spp = spps[i];
     o.threads = 2;
+    snprintf(o.sampler, sizeof o.sampler, "%s", sampler_name);
     o.seed = 3;
     valo_render *r;
     if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
@@ -89,6 +95,7 @@ int main(int argc, char **argv) {
       valo_options_init(&o);
       o.threads = 2;
       o.seed = 5;
+      snprintf(o.sampler, sizeof o.sampler, "%s", sampler_name);
       o.spp = quick ? 64 : 256;
       if (mode == 1) { o.adaptive = 1; o.spp = 1 << 20; o.time_budget = secs; }
       valo_render *r;

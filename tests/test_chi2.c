@@ -21,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 38
+#define CHI2_TESTS 44
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -450,6 +450,64 @@ static int chi2_rejects_wrong_pdf(void) {
   return 0;
 }
 
+/* ---- the Sobol sampler (core/rng.h): a pixel's first 2^k samples are stratified in
+ * every dimension (1D: one per interval of 2^-k; 2D: one in every elementary interval of
+ * area 2^-k, a (0,k,2)-net), and across pixels each sample is uniformly distributed (so
+ * estimators stay unbiased): chi-square over 1D and 2D bins. */
+static int sobol_sampler(void) {
+  for (int pix = 0; pix < 32; pix++)
+    for (uint32_t dim = 0; dim < 24; dim++)
+      for (int logn = 4; logn <= 8; logn += 2) {
+        int n = 1 << logn;
+        int one[256] = {0};
+        static int two[9][256];
+        memset(two, 0, sizeof two);
+        for (int i = 0; i < n; i++) {
+          sampler a = sampler_make_kind(99, (uint64_t)pix, (uint64_t)i, SAMPLER_SOBOL), b = a;
+          sampler_set_dim(&a, dim);
+          sampler_set_dim(&b, dim);
+          float x = sampler_1d(&a), u, v;
+          sampler_2d(&b, &u, &v);
+          CHECK(x >= 0 && x < 1 && u >= 0 && u < 1 && v >= 0 && v < 1, "value out of [0,1)");
+          one[(int)(x * n)]++;
+          for (int ax = 0; ax <= logn; ax++) {
+            int bx = (int)(u * (1 << ax)), by = (int)(v * (1 << (logn - ax)));
+            two[ax][(bx << (logn - ax)) + by]++;
+          }
+        }
+        for (int k = 0; k < n; k++) {
+          CHECK(one[k] == 1, "pixel %d dim %u: 1D interval %d of %d holds %d samples", pix, dim, k, n, one[k]);
+          for (int ax = 0; ax <= logn; ax++)
+            CHECK(two[ax][k] == 1, "pixel %d dim %u: 2D elementary interval %d (%dx%d) of %d samples holds %d", pix, dim, k, 1 << ax,
+                  1 << (logn - ax), n, two[ax][k]);
+        }
+      }
+  /* Uniform across pixels, at a few sample indices and dimensions. */
+  int rc = 0;
+  long np = nsamples() / 5;
+  double obs1[100], exp1[100], obs2[256], exp2[256];
+  static const uint32_t idxs[3] = {0, 5, 1000}, dims[3] = {0, 7, 40};
+  for (int t = 0; t < 3; t++) {
+    for (int k = 0; k < 100; k++) { obs1[k] = 0; exp1[k] = np / 100.0; }
+    for (int k = 0; k < 256; k++) { obs2[k] = 0; exp2[k] = np / 256.0; }
+    for (long pix = 0; pix < np; pix++) {
+      sampler a = sampler_make_kind(7, (uint64_t)pix, idxs[t], SAMPLER_SOBOL), b = a;
+      sampler_set_dim(&a, dims[t]);
+      sampler_set_dim(&b, dims[t] + 1);
+      obs1[(int)(sampler_1d(&a) * 100)]++;
+      float u, v;
+      sampler_2d(&b, &u, &v);
+      obs2[(int)(u * 16) * 16 + (int)(v * 16)]++;
+    }
+    char what[96];
+    snprintf(what, sizeof what, "Sobol 1D, sample %u, dimension %u, over pixels", idxs[t], dims[t]);
+    rc |= chi2_check(what, obs1, exp1, 100);
+    snprintf(what, sizeof what, "Sobol 2D, sample %u, dimension %u, over pixels", idxs[t], dims[t] + 1);
+    rc |= chi2_check(what, obs2, exp2, 256);
+  }
+  return rc;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"diffuse", diffuse},
                                     {"phong", phong},
@@ -463,6 +521,7 @@ int main(int argc, char **argv) {
                                     {"rough_dielectric", rough_dielectric},
                                     {"microfacet_furnace", microfacet_furnace},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness},
+                                    {"sobol_sampler", sobol_sampler},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -55,6 +55,8 @@ typedef struct valo_options {
                              VALO_DEPTH_UNSET when not given */
   char integrator[32];    /* "path" (default) */
   char accel[16];         /* "kdtree" (default) or "embree" */
+  char sampler[16];       /* "sobol" (default: Owen-scrambled Sobol, padded per dimension)
+                             or "independent" (a hash per sample and dimension) */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
                              valo_render_write can then write; VALO_UNSET = no */
   int adaptive;           /* non-zero: adaptive sampling (docs/integrators.md): spp is then
@@ -136,6 +138,7 @@ typedef struct valo_stats {
   int threads;
   char integrator[32];
   char accel[16];
+  char sampler[16];
 } valo_stats;
 VALO_API void valo_render_stats(const valo_render *r, valo_stats *out);
 

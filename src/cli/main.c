@@ -61,6 +61,7 @@ static void usage_render(FILE *f) {
   fprintf(f,
           " (default path)\n"
           "  --accel NAME           kdtree (default) or embree\n"
+          "  --sampler NAME         sobol (default: Owen-scrambled Sobol) or independent\n"
           "  --max-depth N          maximum path length (default -1: unlimited, Russian roulette\n"
           "                         ends paths)\n"
           "  --env FILE             light by this environment map (.exr/.hdr/.pfm), replacing\n"
@@ -208,6 +209,10 @@ static int cmd_render(int argc, char **argv) {
         return EXIT_USAGE;
       }
       snprintf(opt.integrator, sizeof opt.integrator, "%s", val);
+    } else if (!strcmp(a, "--sampler")) {
+      NEED_VALUE();
+      if (strcmp(val, "sobol") && strcmp(val, "independent")) BAD_VALUE("sobol or independent");
+      snprintf(opt.sampler, sizeof opt.sampler, "%s", val);
     } else if (!strcmp(a, "--env")) {
       NEED_VALUE();
       snprintf(lo.env_file, sizeof lo.env_file, "%s", val);

@@ -23,12 +23,15 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
 
     bsdf b = bsdf_at(s, &it);
     frame fr = shading_frame(&it, &b, wo); /* opaque surfaces are two-sided */
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
     if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, estimate_direct(c, &it, &b, &fr, wo, smp, ts)));
 
     rgb weight;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
     if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
     beta = c3_mul(beta, weight);
     if (c3_black(beta) || !c3_finite(beta)) break;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
     float survive = path_roulette(&st, c3_max(beta), depth, smp);
     if (survive == 0) break;
     beta = c3_scale(beta, survive);

@@ -21,6 +21,7 @@ static spec4 direct_spectral(const render_ctx *c, const isect *it, const bsdf *b
 
 static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   const scene *s = c->s;
+  sampler_set_dim(smp, SDIM_WAVELENGTH);
   wavelengths wl = wavelengths_sample(sampler_1d(smp));
   spec4 L = spec_const(0), beta = spec_const(1);
   path_state st = path_state_start(r.o);
@@ -39,11 +40,14 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
       wavelengths_terminate_secondary(&wl);
     }
     frame fr = shading_frame(&it, &b, wo);
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
     if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl)));
     rgb weight;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
     if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
     beta = spec_mul(beta, spec_from_rgb(weight, &wl));
     if (spec_black(beta)) break;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
     float survive = path_roulette(&st, spec_max(beta), depth, smp);
     if (survive == 0) break;
     beta = spec_scale(beta, survive);

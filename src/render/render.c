@@ -34,6 +34,7 @@ struct valo_render {
   valo_options opt;
   render_ctx ctx;
   const integrator_ops *integ;
+  sampler_kind sampler_kind;
   accel *acc;
   accel_filter alpha_filter;
   double *sum;            /* 3 doubles per pixel */
@@ -167,6 +168,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->max_depth != VALO_DEPTH_UNSET) dst->max_depth = o->max_depth;
     if (o->integrator[0]) memcpy(dst->integrator, o->integrator, sizeof dst->integrator);
     if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
+    if (o->sampler[0]) memcpy(dst->sampler, o->sampler, sizeof dst->sampler);
     if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
     if (o->adaptive != VALO_UNSET) dst->adaptive = o->adaptive;
     if (o->noise_threshold != VALO_UNSET) dst->noise_threshold = o->noise_threshold;
@@ -186,6 +188,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
   if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
+  if (!dst->sampler[0]) snprintf(dst->sampler, sizeof dst->sampler, "sobol");
 }
 
 VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options *opts, valo_render **out, valo_error *err) {
@@ -206,6 +209,8 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   if (o.focus_distance != VALO_UNSET && !(o.focus_distance > 0 && o.focus_distance < 1e9))
     return err_set(err, VALO_ERR_INVALID, "focus distance must be > 0");
   if (o.max_depth < -1) return err_set(err, VALO_ERR_INVALID, "max_depth must be -1 (unlimited) or >= 0");
+  if (strcmp(o.sampler, "sobol") && strcmp(o.sampler, "independent"))
+    return err_set(err, VALO_ERR_INVALID, "unknown sampler \"%s\" (sobol or independent)", o.sampler);
   const integrator_ops *integ = integrator_find(o.integrator);
   if (!integ) {
     char list[256] = "";
@@ -221,6 +226,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->s = s;
   r->opt = o;
   r->integ = integ;
+  r->sampler_kind = strcmp(o.sampler, "independent") ? SAMPLER_SOBOL : SAMPLER_INDEPENDENT;
   atomic_init(&r->cancel, 0);
   r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
   if (o.aovs) r->aov = calloc((size_t)o.width * o.height * 7, sizeof(float));
@@ -273,6 +279,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
 
 static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   float jx, jy;
+  sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
   float sx = (2.0f * ((float)px + jx) / (float)r->opt.width - 1.0f) * r->tan_half * r->aspect;
   float sy = (1.0f - 2.0f * ((float)py + jy) / (float)r->opt.height) * r->tan_half;
@@ -281,7 +288,9 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   ry.o = r->cam_o;
   ry.tmax = INFINITY;
   float lu, lv;
+  sampler_set_dim(smp, SDIM_LENS);
   sampler_2d(smp, &lu, &lv);
+  sampler_set_dim(smp, SDIM_WAVELENGTH);
   if (r->aperture > 0) {
     /* Thin lens: every ray through the lens meets at the plane of focus. */
     float ft = r->focus / v3_dot(d, r->cam_fwd);
@@ -324,7 +333,7 @@ static void sample_pixel(valo_render *r, int x, int y, int s0, int s1, thread_st
   uint64_t pix = (uint64_t)y * (uint64_t)r->opt.width + (uint64_t)x;
   double *acc = &r->sum[3 * pix];
   for (int si = s0; si < s1; si++) {
-    sampler smp = sampler_make((uint64_t)r->opt.seed, pix, (uint64_t)si);
+    sampler smp = sampler_make_kind((uint64_t)r->opt.seed, pix, (uint64_t)si, r->sampler_kind);
     ray ry = camera_ray(r, x, y, &smp);
     ts->rays++;
     if (r->aov) record_aovs(r, ry, &r->aov[7 * pix], ts);
@@ -478,6 +487,7 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   o->threads = r->opt.threads;
   snprintf(o->integrator, sizeof o->integrator, "%s", r->opt.integrator);
   snprintf(o->accel, sizeof o->accel, "%s", r->opt.accel);
+  snprintf(o->sampler, sizeof o->sampler, "%s", r->opt.sampler);
 }
 
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) {

@@ -163,7 +163,7 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
 }
 
 static valo_status parse_render(jctx *c, const cJSON *o) {
-  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", NULL};
+  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", NULL};
   TRY(check_keys(c, o, "render", keys));
   valo_options *op = &c->s->file_opts;
   const char *s = NULL;
@@ -172,6 +172,10 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
   s = NULL;
   TRY(get_str(c, o, "accel", "render", &s));
   if (s) snprintf(op->accel, sizeof op->accel, "%s", s);
+  s = NULL;
+  TRY(get_str(c, o, "sampler", "render", &s));
+  if (s && strcmp(s, "sobol") && strcmp(s, "independent")) return bad(c, "render.sampler", "must be \"sobol\" or \"independent\"");
+  if (s) snprintf(op->sampler, sizeof op->sampler, "%s", s);
   TRY(get_int(c, o, "spp", "render", 1, 1048576, &op->spp));
   double seed = -1;
   TRY(get_num(c, o, "seed", "render", 0, 9007199254740992.0, &seed));
