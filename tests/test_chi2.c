@@ -21,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 44
+#define CHI2_TESTS 45
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -393,6 +393,40 @@ static int light_sampling(void) {
   int rc = run_chi2("area light (triangle) from a point", &c, light_sf, light_pf);
   c.p = v3(0.1f, 1.9f, 0.0f); /* close: strongly varying density */
   rc |= run_chi2("area light (triangle) from a close point", &c, light_sf, light_pf);
+  /* Both sample the solid angle uniformly (Arvo); far away, the triangle is sampled by
+   * area instead (solid angle below 3e-4 sr). */
+  {
+    /* Far away: points uniform over the triangle (chi-square over barycentric cells: 45
+     * squares and 10 diagonal halves of a 10x10 grid), with pdf = d^2 / (cos A). */
+    vec3 pf = v3(0.3f, -120.0f, 0.2f);
+    double obs[100] = {0}, ex[100] = {0};
+    long n = nsamples() / 4;
+    const uint32_t *ix = &s->idx[0];
+    vec3 a = s->pos[ix[0]], e1 = v3_sub(s->pos[ix[1]], a), e2 = v3_sub(s->pos[ix[2]], a);
+    double worst_pdf = 0;
+    for (long k = 0; k < n; k++) {
+      sampler sm = sampler_make(17, (uint64_t)k, 0);
+      light_li li;
+      float u1 = sampler_1d(&sm), u2 = sampler_1d(&sm);
+      CHECK(light_sample(s, &c.l, pf, u1, u2, &li), "far area sample failed");
+      vec3 q = v3_sub(li.p_light, a);
+      float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), q1 = v3_dot(q, e1), q2 = v3_dot(q, e2), den = d11 * d22 - d12 * d12;
+      float b1 = (d22 * q1 - d12 * q2) / den, b2 = (d11 * q2 - d12 * q1) / den;
+      int i = (int)(b1 * 10), j = (int)(b2 * 10);
+      if (i > 9) i = 9;
+      if (j > 9) j = 9;
+      if (i + j > 9) { if (i > j) i = 9 - j; else j = 9 - i; }
+      obs[i * 10 + j]++;
+      double expect = light_pdf_area(s, &c.l, pf, li.p_light, li.n_light);
+      double rel = fabs(li.pdf - expect) / expect;
+      if (rel > worst_pdf) worst_pdf = rel;
+    }
+    for (int i = 0; i < 10; i++)
+      for (int j = 0; j < 10; j++) ex[i * 10 + j] = i + j < 9 ? n * 0.02 : i + j == 9 ? n * 0.01 : 0;
+    rc |= chi2_check("area light far away (sampled by area): points over the triangle", obs, ex, 100);
+    fprintf(stderr, "far area light: sample pdf against light_pdf_area, worst relative difference %.2e\n", worst_pdf);
+    CHECK(worst_pdf < 1e-3, "sample pdf and light_pdf_area disagree by %.2e", worst_pdf);
+  }
   c.l.type = LIGHT_ENV;
   rc |= run_chi2("constant environment", &c, light_sf, light_pf);
   /* An equirectangular map with a bright spot, a dark hole and a gradient, upright and

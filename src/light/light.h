@@ -1,8 +1,9 @@
 /* light.h — owns light sampling for next-event estimation: the power-proportional light
  * selector (alias table) and, per light type (one switch), sampling an incident direction
  * at a reference point, the solid-angle density of that sampling, and emitted radiance.
- * Area lights sample the triangle uniformly by area and convert to solid angle with
- * pdf_w = pdf_A * d^2 / |cos theta_l|. */
+ * Area lights sample the solid angle the triangle subtends uniformly (Arvo 1995), or,
+ * when that is tiny or huge, the triangle uniformly by area with pdf_w = pdf_A * d^2 /
+ * |cos theta_l|; light_pdf_area makes the same choice. */
 #ifndef VALO_LIGHT_H
 #define VALO_LIGHT_H
 #include "scene/scene.h"
