@@ -21,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 45
+#define CHI2_TESTS 46
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -484,6 +484,57 @@ static int chi2_rejects_wrong_pdf(void) {
   return 0;
 }
 
+/* ---- light selection: one-sided lights a point is behind are never picked; the others
+ * are picked in proportion to power, as light_select_pmf says (chi-square). */
+static int light_selection_facing(void) {
+  scene *s = scene_new("select");
+  scene_reserve(s, 6, 2);
+  /* Triangle A faces +y, triangle B faces -y. */
+  s->pos[0] = v3(0, 1, 0); s->pos[1] = v3(0, 1, 1); s->pos[2] = v3(1, 1, 0);
+  s->pos[3] = v3(0, 1.5f, 0); s->pos[4] = v3(1, 1.5f, 0); s->pos[5] = v3(0, 1.5f, 1);
+  s->nverts = 6;
+  for (int k = 0; k < 6; k++) s->idx[k] = (uint32_t)k;
+  s->tri_mat[0] = s->tri_mat[1] = 0; s->tri_flags[0] = s->tri_flags[1] = 0; s->ntris = 2;
+  material m = material_default();
+  m.emission = c3(2, 2, 2);
+  CHECK(scene_add_material(s, &m) == 0, "material");
+  light pt = {0};
+  pt.type = LIGHT_POINT; pt.p = v3(3, 3, 3); pt.L = c3(1, 1, 1);
+  CHECK(scene_add_light(s, &pt) == 0, "light");
+  valo_error err;
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  light_sampler ls;
+  CHECK(light_sampler_init(&ls, s) == 0, "init");
+  /* Lights: [0] point, [1] A, [2] B (area lights are added at commit). */
+  int ia = -1, ib = -1;
+  for (uint32_t i = 0; i < s->nlights; i++)
+    if (s->lights[i].type == LIGHT_AREA) { if (s->lights[i].tri == 0) ia = (int)i; else ib = (int)i; }
+  CHECK(ia >= 0 && ib >= 0, "area lights missing");
+  /* A's normal (0,0,1) x (1,0,0) = +y, B's (1,0,0) x (0,0,1) = -y: a point above both is
+   * in front of A and behind B. */
+  vec3 p = v3(0.2f, 1.7f, 0.2f);
+  CHECK(light_select_pmf(&ls, s, (uint32_t)ib, p) == 0, "a light facing away has pmf %g", light_select_pmf(&ls, s, (uint32_t)ib, p));
+  double total = 0, obs[3] = {0}, ex[3];
+  for (uint32_t i = 0; i < s->nlights; i++) total += light_select_pmf(&ls, s, i, p);
+  CHECK(fabs(total - 1) < 1e-5, "pmf sums to %g", total);
+  long n = nsamples() / 10;
+  for (long k = 0; k < n; k++) {
+    sampler sm = sampler_make(3, (uint64_t)k, 0);
+    float pmf;
+    uint32_t li = light_select(&ls, s, p, sampler_1d(&sm), &pmf);
+    CHECK(li < s->nlights, "no light picked");
+    CHECK(fabsf(pmf - light_select_pmf(&ls, s, li, p)) < 1e-6f, "pmf mismatch");
+    obs[li]++;
+  }
+  for (uint32_t i = 0; i < 3; i++) ex[i] = n * light_select_pmf(&ls, s, i, p);
+  CHECK(obs[ib] == 0, "the light facing away was picked %g times", obs[ib]);
+  double o2[2] = {obs[0], obs[ia]}, e2[2] = {ex[0], ex[ia]};
+  int rc = chi2_check("light selection at a point (one light facing away)", o2, e2, 2);
+  light_sampler_free(&ls);
+  scene_free(s);
+  return rc;
+}
+
 /* ---- the Sobol sampler (core/rng.h): a pixel's first 2^k samples are stratified in
  * every dimension (1D: one per interval of 2^-k; 2D: one in every elementary interval of
  * area 2^-k, a (0,k,2)-net), and across pixels each sample is uniformly distributed (so
@@ -556,6 +607,7 @@ int main(int argc, char **argv) {
                                     {"microfacet_furnace", microfacet_furnace},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness},
                                     {"sobol_sampler", sobol_sampler},
+                                    {"light_selection_facing", light_selection_facing},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

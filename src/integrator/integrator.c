@@ -118,9 +118,9 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
                   thread_stats *ts, int mis, direct_sample *out) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
-  if (c->ls.table.n == 0) return 0;
   float pmf;
-  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
+  uint32_t li = light_select(&c->ls, c->s, it->p, ul, &pmf);
+  if (li == UINT32_MAX) return 0;
   const light *l = &c->s->lights[li];
   light_li ls;
   if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return 0;
@@ -184,8 +184,8 @@ int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_sta
 static float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
   if (st->specular) return 1;
   const scene *s = c->s;
-  if (env) return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)c->ls.env_index) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
-  return power_heuristic(st->prev_pdf, light_select_pmf(c, (uint32_t)lid) * light_pdf_area(s, &s->lights[lid], st->prev_p, it->p, it->ng));
+  if (env) return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)c->ls.env_index, st->prev_p) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
+  return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)lid, st->prev_p) * light_pdf_area(s, &s->lights[lid], st->prev_p, it->p, it->ng));
 }
 
 int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {

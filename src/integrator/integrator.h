@@ -81,10 +81,8 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
 /* Shading frame at it for viewer direction wo, faced for opaque BSDFs (geometric normal
  * too); returns the frame and updates it->ng. */
 frame shading_frame(isect *it, const bsdf *b, vec3 wo);
-/* Probability that estimate_direct picks light index li. */
-static inline float light_select_pmf(const render_ctx *c, uint32_t li) {
-  return c->ls.table.n ? alias_pmf(&c->ls.table, li) : 0;
-}
+/* Probability that estimate_direct picks light index li at shading point p. */
+static inline float ctx_light_pmf(const render_ctx *c, uint32_t li, vec3 p) { return light_select_pmf(&c->ls, c->s, li, p); }
 
 /* The common start of a vertex of the recursive integrators (whitted, distribution):
  * traces r, puts the emission it finds in *L (if count_emission), and, when it hit a

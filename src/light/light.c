@@ -27,7 +27,7 @@ float light_power(const scene *s, const light *l) {
 }
 
 int light_sampler_init(light_sampler *ls, const scene *s) {
-  ls->table.bins = NULL; ls->table.n = 0; ls->env_index = -1;
+  ls->table.bins = NULL; ls->table.n = 0; ls->env_index = -1; ls->power = NULL; ls->n = 0; ls->local = 0;
   if (s->nlights == 0) return 0;
   float *w = malloc(s->nlights * sizeof *w);
   if (!w) return -1;
@@ -37,11 +37,47 @@ int light_sampler_init(light_sampler *ls, const scene *s) {
     if (s->lights[i].type == LIGHT_ENV) ls->env_index = (int)i;
   }
   int rc = alias_build(&ls->table, w, s->nlights);
-  free(w);
-  if (rc) { ls->table.bins = NULL; ls->table.n = 0; } /* all lights black: nothing to sample */
+  if (rc) { ls->table.bins = NULL; ls->table.n = 0; free(w); return 0; } /* all lights black: nothing to sample */
+  ls->power = w;
+  ls->n = s->nlights;
+  ls->local = s->nlights <= LIGHT_LOCAL_MAX;
   return 0;
 }
-void light_sampler_free(light_sampler *ls) { alias_free(&ls->table); }
+void light_sampler_free(light_sampler *ls) { alias_free(&ls->table); free(ls->power); ls->power = NULL; }
+
+/* Can light l send anything to p? Only one-sided area lights can be turned away. */
+static int light_faces(const scene *s, const light *l, vec3 p) {
+  if (l->type != LIGHT_AREA || l->two_sided) return 1;
+  const uint32_t *ix = &s->idx[3 * l->tri];
+  return v3_dot(scene_tri_ng(s, l->tri), v3_sub(p, s->pos[ix[0]])) > 0;
+}
+
+uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf) {
+  if (ls->table.n == 0) return UINT32_MAX;
+  if (!ls->local) return alias_sample(&ls->table, u, pmf);
+  float w[LIGHT_LOCAL_MAX], total = 0;
+  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(s, &s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
+  if (!(total > 0)) return UINT32_MAX;
+  float target = u * total, acc = 0;
+  uint32_t last = UINT32_MAX;
+  for (uint32_t i = 0; i < ls->n; i++) {
+    if (w[i] <= 0) continue;
+    last = i;
+    acc += w[i];
+    if (target < acc) break;
+  }
+  *pmf = w[last] / total;
+  return last;
+}
+
+float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
+  if (ls->table.n == 0) return 0;
+  if (!ls->local) return alias_pmf(&ls->table, li);
+  if (!light_faces(s, &s->lights[li], p)) return 0;
+  float total = 0;
+  for (uint32_t i = 0; i < ls->n; i++) total += light_faces(s, &s->lights[i], p) ? ls->power[i] : 0;
+  return total > 0 ? ls->power[li] / total : 0;
+}
 
 static float spot_falloff(const light *l, float cos_t) {
   if (cos_t >= l->cos_inner) return 1;

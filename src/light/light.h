@@ -9,10 +9,22 @@
 #include "scene/scene.h"
 #include "core/alias.h"
 
-typedef struct light_sampler { alias_table table; int env_index; } light_sampler;
+/* Light selection for next-event estimation. By power (alias table), except that in
+ * scenes with at most LIGHT_LOCAL_MAX lights the choice is made per shading point: one-
+ * sided area lights the point is behind (or level with) get weight 0, the rest keep
+ * their power, so no sample is spent on a light that cannot reach the point. Above
+ * that count the O(n) pass per sample costs more than it saves (a light tree would be
+ * the way; not built). light_select and light_select_pmf make the same choice. */
+#define LIGHT_LOCAL_MAX 64
+typedef struct light_sampler { alias_table table; int env_index; float *power; uint32_t n; int local; } light_sampler;
 
 int light_sampler_init(light_sampler *ls, const scene *s);
 void light_sampler_free(light_sampler *ls);
+/* Picks a light for shading point p with u in [0,1); returns its index and *pmf, or
+ * UINT32_MAX when no light can reach p. */
+uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf);
+/* The probability light_select picks light li at p. */
+float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p);
 
 typedef struct light_li {
   vec3 wi;       /* unit direction from the reference point towards the light */
