@@ -150,8 +150,49 @@ static int veach_mis_tungsten(void) {
   return 0;
 }
 
+/* Adaptive sampling pays where noise is uneven (issue 9.4): on CornellBox-Mirror (mirror
+ * caustics) its relMSE against the Cycles reference at the same sample count is at most
+ * 2/3 of uniform sampling's, and on CornellBox-Original (even noise) no worse than 10 %
+ * above it. (Equal time is what docs/performance.md reports; equal samples is what a test
+ * can check without timing.) */
+static double relmse_of(const char *obj_rel, const char *ref_rel, int spp, int adaptive) {
+  const char *obj = shared_file(obj_rel), *refp = shared_file(ref_rel);
+  if (!obj || !refp) return -1;
+  char json[4096];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"film\": {\"width\": 256, \"height\": 256}, \"render\": {\"spp\": %d, \"seed\": 11},\n"
+           "  \"shapes\": [ {\"file\": \"%s\"} ] }\n", spp, obj);
+  valo_options o;
+  valo_options_init(&o);
+  o.adaptive = adaptive ? VALO_ADAPTIVE_ERROR : 0;
+  int w, h;
+  float *img = render_json_text(json, &o, &w, &h);
+  image ref;
+  valo_error err;
+  if (!img || image_read(refp, &ref, &err)) { free(img); return -2; }
+  double e = 0;
+  for (int i = 0; i < w * h * 3; i++) e += (img[i] - ref.rgb[i]) * (img[i] - ref.rgb[i]) / (ref.rgb[i] * ref.rgb[i] + 0.01);
+  free(img);
+  image_free(&ref);
+  return e / (w * h * 3);
+}
+static int adaptive_pays(void) {
+  double mu = relmse_of("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", 64, 0);
+  if (mu == -1) return TEST_SKIP;
+  double ma = relmse_of("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", 64, 1);
+  double ou = relmse_of("scenes/cornell/CornellBox-Original.obj", "references/cornell-original.exr", 64, 0);
+  double oa = relmse_of("scenes/cornell/CornellBox-Original.obj", "references/cornell-original.exr", 64, 1);
+  fprintf(stderr, "relMSE at 64 spp: Mirror uniform %.6f adaptive %.6f (%.2fx); Original uniform %.6f adaptive %.6f (%.2fx)\n", mu, ma,
+          ma / mu, ou, oa, oa / ou);
+  CHECK(mu > 0 && ma > 0 && ou > 0 && oa > 0, "renders failed");
+  CHECK(ma < mu / 1.5, "adaptive on CornellBox-Mirror: %.6f, not 1.5x below uniform %.6f", ma, mu);
+  CHECK(oa < 1.1 * ou, "adaptive on CornellBox-Original: %.6f, more than 10 %% above uniform %.6f", oa, ou);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"cornell_original", cornell_original}, {"cornell_mirror", cornell_mirror},
-                                    {"veach_mis_tungsten", veach_mis_tungsten}, {NULL, NULL}};
+                                    {"veach_mis_tungsten", veach_mis_tungsten}, {"adaptive_pays", adaptive_pays}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -59,8 +59,10 @@ typedef struct valo_options {
                              or "independent" (a hash per sample and dimension) */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
                              valo_render_write can then write; VALO_UNSET = no */
-  int adaptive;           /* non-zero: adaptive sampling (docs/integrators.md): spp is then
-                             the average budget per pixel; VALO_UNSET = no */
+  int adaptive;           /* adaptive sampling (docs/integrators.md): spp is then the average
+                             budget per pixel. VALO_ADAPTIVE_ERROR (1, default rule) or
+                             VALO_ADAPTIVE_DIGEST (2, the digest's priority); 0 or
+                             VALO_UNSET = no */
   double noise_threshold; /* adaptive: stop when every pixel's relative standard error is
                              below this (e.g. 0.01); VALO_UNSET or <= 0: use the budget */
   int spectral;           /* non-zero: spectral rendering (path integrator only): hero
@@ -71,6 +73,9 @@ typedef struct valo_options {
                              VALO_UNSET = the scene's (file cameras: autofocus on the
                              surface at the image centre) */
 } valo_options;
+
+#define VALO_ADAPTIVE_ERROR 1
+#define VALO_ADAPTIVE_DIGEST 2
 
 /* Sets every field of `o` to "unset". */
 VALO_API void valo_options_init(valo_options *o);

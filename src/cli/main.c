@@ -78,6 +78,8 @@ static void usage_render(FILE *f) {
           "  --spectral             spectral rendering (path): 4 wavelengths per path, dispersion\n"
           "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
           "                         noisiest pixels get more (spp:FILE writes the count map)\n"
+          "  --adaptive-rule R      error (default: relative error, neighbourhood-aware) or\n"
+          "                         digest (the design digest's priority); implies --adaptive\n"
           "  --noise-threshold X    adaptive sampling that stops once every pixel's relative\n"
           "                         standard error is below X (e.g. 0.01); implies --adaptive\n"
           "  --exposure STOPS       PNG exposure (default 0)\n"
@@ -247,7 +249,11 @@ static int cmd_render(int argc, char **argv) {
     } else if (!strcmp(a, "--spectral")) {
       opt.spectral = 1;
     } else if (!strcmp(a, "--adaptive")) {
-      opt.adaptive = 1;
+      opt.adaptive = VALO_ADAPTIVE_ERROR;
+    } else if (!strcmp(a, "--adaptive-rule")) {
+      NEED_VALUE();
+      if (strcmp(val, "error") && strcmp(val, "digest")) BAD_VALUE("error or digest");
+      opt.adaptive = !strcmp(val, "digest") ? VALO_ADAPTIVE_DIGEST : VALO_ADAPTIVE_ERROR;
     } else if (!strcmp(a, "--noise-threshold")) {
       NEED_VALUE();
       if (parse_double(val, 1e-6, 10, &dv)) BAD_VALUE("a relative error, 1e-6..10");
@@ -275,8 +281,8 @@ static int cmd_render(int argc, char **argv) {
     else { fprintf(stderr, "valo: more than one scene given (\"%s\" and \"%s\")\n", scene_path, a); return EXIT_USAGE; }
   }
   if (!scene_path) { fprintf(stderr, "valo: no scene given\n"); usage_render(stderr); return EXIT_USAGE; }
-  if (opt.noise_threshold != VALO_UNSET && opt.adaptive != 1) {
-    opt.adaptive = 1;
+  if (opt.noise_threshold != VALO_UNSET && !(opt.adaptive > 0)) {
+    opt.adaptive = VALO_ADAPTIVE_ERROR;
     if (!quiet) fprintf(stderr, "valo: note: --noise-threshold turns on adaptive sampling (--adaptive)\n");
   }
   char default_out[1024];

@@ -362,19 +362,31 @@ static void render_tile(void *user, int64_t item, int thread) {
     for (int x = x0; x < x1; x++) sample_pixel(r, x, y, j->s0, j->s1, ts);
 }
 
-/* ---- adaptive sampling (digest 000): after a uniform first pass, rounds give
- * ADAPT_BATCH more samples to the 1/ADAPT_FRACTION of pixels whose mean has the largest
- * relative variance, (N sum s^2 / (sum s)^2 - 1) / N in luminance — the digest's
- * priority N sum s^2/(sum s)^2, minus 1 and over N so that it falls as a pixel gets
- * samples. Selection happens between rounds from deterministic sums, ties by index. */
+/* ---- adaptive sampling (docs/integrators.md). A uniform first pass takes half the
+ * budget (half the samples, or half the time with --time); then rounds give ADAPT_BATCH
+ * more samples to the 1/ADAPT_FRACTION of pixels with the highest priority. The
+ * priority ("error", the default) is the pixel mean's estimated squared error relative
+ * to its brightness, var(L)/N / (mean^2 + 0.01) in luminance (the relMSE that
+ * time-to-error is measured in), taken as the larger of the pixel's own and its 3x3
+ * neighbourhood's mean: a pixel's few samples miss rare bright paths, which show as one
+ * firefly among quiet pixels. "digest" is the digest's priority N sum s^2/(sum s)^2,
+ * minus 1 and over N so that it falls as a pixel gets samples, on the pixel alone.
+ * Measured (docs/performance.md): the old rule gave 5 % at equal time because with
+ * --time the uniform pass took the whole budget; a first pass of an eighth of the budget
+ * starved quiet pixels on CornellBox-Original. Selection happens between rounds from
+ * deterministic sums (quickselect, ties by index): identical for any thread count. */
 #define ADAPT_BATCH 8
 #define ADAPT_FRACTION 8
+#define ADAPT_UNIFORM 0.5
+#define ADAPT_EPS 0.01
 
 static double pixel_priority(const valo_render *r, size_t i) {
   double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
-  if (n < 2 || !(s > 0)) return 0;
-  double rel = (n * s2 / (s * s) - 1) / n;
-  return rel > 0 ? rel : 0;
+  if (n < 2) return 0;
+  double mean = s / n, var = (s2 - s * s / n) / (n - 1);
+  if (!(var > 0)) return 0;
+  if (r->opt.adaptive == VALO_ADAPTIVE_DIGEST) { if (!(s > 0)) return 0; double rel = (n * s2 / (s * s) - 1) / n; return rel > 0 ? rel : 0; }
+  return var / n / (mean * mean + ADAPT_EPS);
 }
 
 typedef struct prio { double p; uint32_t i; } prio;
@@ -382,6 +394,27 @@ static int prio_cmp(const void *a, const void *b) {
   const prio *x = a, *y = b;
   if (x->p != y->p) return x->p < y->p ? 1 : -1;
   return x->i < y->i ? -1 : (x->i > y->i);
+}
+
+/* Partially orders a so that its first k entries are the k first by prio_cmp (a total
+ * order: ties go by pixel index), in O(n) expected time: quickselect with Lomuto
+ * partitions around a median-of-three pivot; deterministic. */
+static void prio_select(prio *a, size_t n, size_t k) {
+  size_t lo = 0, hi = n;
+  while (hi - lo > 1) {
+    size_t m = lo + (hi - lo) / 2, l = hi - 1, piv;
+    /* index of the median of a[lo], a[m], a[l] */
+    if (prio_cmp(&a[lo], &a[m]) < 0) piv = prio_cmp(&a[m], &a[l]) < 0 ? m : (prio_cmp(&a[lo], &a[l]) < 0 ? l : lo);
+    else piv = prio_cmp(&a[lo], &a[l]) < 0 ? lo : (prio_cmp(&a[m], &a[l]) < 0 ? l : m);
+    prio t = a[piv]; a[piv] = a[l]; a[l] = t;
+    size_t store = lo;
+    for (size_t i = lo; i < l; i++)
+      if (prio_cmp(&a[i], &a[l]) < 0) { t = a[i]; a[i] = a[store]; a[store] = t; store++; }
+    t = a[store]; a[store] = a[l]; a[l] = t;
+    if (store == k) return;
+    if (store > k) hi = store;
+    else lo = store + 1;
+  }
 }
 
 typedef struct adapt_job { valo_render *r; const prio *sel; int64_t n; thread_stats *ts; } adapt_job;
@@ -409,7 +442,7 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
   valo_status st = VALO_OK;
   int uniform_spp = r->opt.spp;
   if (r->opt.adaptive) {
-    uniform_spp = r->opt.spp / 8;
+    uniform_spp = (int)(r->opt.spp * ADAPT_UNIFORM);
     if (uniform_spp < 4) uniform_spp = r->opt.spp < 4 ? r->opt.spp : 4;
   }
   /* Passes grow until one takes about a second, so progress stays lively. */
@@ -434,8 +467,14 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
     if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done); break; }
     if (budget > 0 && el >= budget) break;
+    /* Adaptive with a time budget: the uniform first pass gets an eighth of the time (at
+     * least 4 spp), as it gets an eighth of a sample budget; before, with --time it took
+     * the whole budget and adaptive sampling never ran. */
+    if (r->opt.adaptive && budget > 0 && el >= budget * ADAPT_UNIFORM && r->spp_done >= 4) break;
     if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
+    if (r->opt.adaptive && budget > 0 && pass_spp * (pt / n) > budget * ADAPT_UNIFORM / 2) pass_spp = pass_spp > 1 ? pass_spp / 2 : 1;
   }
+  if (r->opt.adaptive) uniform_spp = r->spp_done;
   if (r->opt.adaptive && st == VALO_OK && !(budget > 0 && now_seconds() - t0 >= budget)) {
     size_t np = (size_t)r->opt.width * r->opt.height;
     double total = (double)r->opt.spp * (double)np, taken = (double)uniform_spp * (double)np;
@@ -443,13 +482,36 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     if (!pr) { free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
     size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
     double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
+    double *raw = malloc(np * sizeof *raw);
+    if (!raw) { free(pr); free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+    int W = r->opt.width, H = r->opt.height;
     while (taken < total) {
-      for (size_t i = 0; i < np; i++) { pr[i].p = pixel_priority(r, i); pr[i].i = (uint32_t)i; }
-      qsort(pr, np, sizeof *pr, prio_cmp);
-      if (!(pr[0].p > thr2)) break; /* every pixel below the noise threshold */
+      for (size_t i = 0; i < np; i++) raw[i] = pixel_priority(r, i);
+      /* Each pixel's error estimate from a few samples misses rare bright paths (a caustic
+       * shows as one firefly among quiet pixels): take the 3x3 neighbourhood's mean as well,
+       * so a firefly's neighbours are sampled too. */
+      for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+          double acc = 0;
+          int cnt = 0;
+          for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+              int xx = x + dx, yy = y + dy;
+              if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+              acc += raw[(size_t)yy * W + xx];
+              cnt++;
+            }
+          size_t i = (size_t)y * W + x;
+          double nb = acc / cnt;
+          pr[i].p = r->opt.adaptive == VALO_ADAPTIVE_DIGEST ? raw[i] : (raw[i] > nb ? raw[i] : nb);
+          pr[i].i = (uint32_t)i;
+        }
       size_t sel = k;
       if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
       if (sel == 0) break;
+      prio_select(pr, np, sel);
+      qsort(pr, sel, sizeof *pr, prio_cmp);
+      if (!(pr[0].p > thr2)) break; /* every pixel below the noise threshold */
       while (sel > 0 && !(pr[sel - 1].p > thr2)) sel--;
       adapt_job aj = {r, pr, (int64_t)sel, ts};
       parallel_for(threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
@@ -463,6 +525,7 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     }
     r->spp_done = (int)(taken / (double)np);
     free(pr);
+    free(raw);
   }
   r->render_seconds += now_seconds() - t0;
   for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
