@@ -13,6 +13,8 @@
 #       --ref ../shared/references/cornell-original.exr --valo build/valo
 # Options: --spp 64,256,1024  --res 256  --threads 2  --cam px,py,pz,lx,ly,lz  --fov 40
 #          --env FILE.exr [--env-rotation DEG]  --make-ref OUT.exr --ref-spp 4096
+#          --texture FILE.png (every material becomes Lambertian with this sRGB texture:
+#          for meshes without an MTL, such as Keenan Crane's Spot)
 #          --valo-args "..." (extra valo flags)  --label NAME  --seed N (default 12345: not
 #          the shared references' seed 7, whose samples a Cycles render would share)
 #
@@ -35,7 +37,7 @@ from mathutils import Vector
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 opt = {"spp": "64,256,1024", "res": "256", "threads": "2", "cam": "0,1,3.4,0,1,0", "fov": "40", "env": "",
        "env-rotation": "0", "make-ref": "", "ref-spp": "4096", "valo": "build/valo", "valo-args": "", "label": "", "ref": "",
-       "obj": "", "seed": "12345"}
+       "obj": "", "seed": "12345", "texture": "", "bounces": "128"}
 i = 0
 while i < len(argv):
     k = argv[i].lstrip("-")
@@ -71,6 +73,8 @@ def read_mtl(path):
 
 
 def build_material(mat, m, mtl_dir):
+    if opt["texture"]:
+        m = {"Kd": ["1", "1", "1"], "map_Kd": [os.path.abspath(opt["texture"])]}
     mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.clear()
@@ -235,7 +239,7 @@ def setup_cycles():
     c.use_denoising = False
     c.filter_type = "BOX"
     c.filter_width = 1.0
-    c.max_bounces = c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = 128
+    c.max_bounces = c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = c.volume_bounces = c.transparent_max_bounces = int(opt["bounces"])
     c.sample_clamp_direct = c.sample_clamp_indirect = 0
     c.blur_glossy = 0
     c.caustics_reflective = c.caustics_refractive = True
@@ -277,9 +281,12 @@ def valo_render(spp, out):
     scene_json = os.path.join(tempfile.gettempdir(), "valo-side-by-side.json")
     with open(scene_json, "w") as f:
         env = ', "environment": {"type": "map", "file": "%s", "rotation": %s}' % (os.path.abspath(opt["env"]), opt["env-rotation"]) if opt["env"] else ""
+        if opt["texture"]:
+            env += ', "materials": {"tex": {"type": "diffuse", "reflectance": "%s"}}' % os.path.abspath(opt["texture"])
         f.write('{ "camera": {"position": [%g,%g,%g], "look_at": [%g,%g,%g], "up": [0,1,0], "fov": %g},\n'
                 '  "film": {"width": %d, "height": %d}, "render": {"seed": %s},\n'
-                '  "shapes": [{"file": "%s"}]%s }\n' % (*cam, fov, res, res, opt["seed"], os.path.abspath(opt["obj"]), env))
+                '  "shapes": [{"file": "%s"%s}]%s }\n' % (*cam, fov, res, res, opt["seed"], os.path.abspath(opt["obj"]),
+                                                     ', "material": "tex"' if opt["texture"] else "", env))
     cmd = [opt["valo"], "render", scene_json, "--spp", str(spp), "--threads", str(threads), "-o", out] + opt["valo-args"].split()
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode:

@@ -79,6 +79,17 @@ valo_status envmap_load(envmap *e, const char *path, float scale, float rotation
   valo_status st = image_read(path, &im, err);
   if (st) return st;
   if (im.w < 2 || im.h < 1) { image_free(&im); return err_set(err, VALO_ERR_INVALID, "%s: environment map too small", path); }
+  /* Lossy EXR compression (DWAA/DWAB) rings around a bright sun into negative texels;
+   * they carry no light here (envmap_init), which a renderer that keeps them as negative
+   * light would not do: say how much that is. */
+  double neg = 0, pos = 0;
+  for (size_t i = 0; i < (size_t)im.w * im.h * 3; i++) {
+    if (im.rgb[i] < 0) neg -= im.rgb[i];
+    else if (isfinite(im.rgb[i])) pos += im.rgb[i];
+  }
+  if (neg > 1e-3 * pos)
+    log_warning("%s: negative texels (compression ringing?) summing to %.1f %% of the map's energy are taken as 0", path,
+                100 * neg / (pos > 0 ? pos : 1));
   if (envmap_init(e, im.w, im.h, im.rgb, scale, rotation_deg)) { envmap_free(e); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   return VALO_OK;
 }
