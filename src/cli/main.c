@@ -90,6 +90,14 @@ static void usage_render(FILE *f) {
           "  -h, --help             this text\n");
 }
 
+/* Length of an output's AOV prefix ("albedo:", "normal:", "depth:", "spp:"), or 0. */
+static size_t aov_prefix(const char *out) {
+  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "spp:"};
+  for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++)
+    if (!strncmp(out, prefixes[k], strlen(prefixes[k]))) return strlen(prefixes[k]);
+  return 0;
+}
+
 static int parse_int(const char *s, long lo, long hi, long *out) {
   char *end;
   errno = 0;
@@ -295,7 +303,7 @@ static int cmd_render(int argc, char **argv) {
     outputs[nout++] = default_out;
   }
   for (int i = 0; i < nout; i++) {
-    if (!strncmp(outputs[i], "albedo:", 7) || !strncmp(outputs[i], "normal:", 7) || !strncmp(outputs[i], "depth:", 6)) opt.aovs = 1;
+    if (aov_prefix(outputs[i]) && strncmp(outputs[i], "spp:", 4)) opt.aovs = 1;
     const char *dot = strrchr(outputs[i], '.');
     if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
       fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);
@@ -305,9 +313,7 @@ static int cmd_render(int argc, char **argv) {
 
   /* Every output's folder must exist and be writable before hours of rendering. */
   for (int i = 0; i < nout; i++) {
-    const char *file = outputs[i], *colon = strchr(file, ':');
-    if (colon && (!strncmp(file, "albedo:", 7) || !strncmp(file, "normal:", 7) || !strncmp(file, "depth:", 6) || !strncmp(file, "spp:", 4)))
-      file = colon + 1;
+    const char *file = outputs[i] + aov_prefix(outputs[i]);
     char dir[4096];
     const char *slash = strrchr(file, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);

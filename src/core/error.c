@@ -17,27 +17,29 @@ valo_status err_set(valo_error *err, valo_status s, const char *fmt, ...) {
   return s;
 }
 
-void log_warning(const char *fmt, ...) {
+/* Formats a message and sends it to the handler (prefixed by handler_prefix) or to
+ * standard error as "valo: <kind>: ...". */
+static void log_emit(const char *kind, const char *handler_prefix, const char *fmt, va_list ap) {
   char buf[1024];
+  vsnprintf(buf, sizeof buf, fmt, ap);
+  if (!g_warn_fn) { fprintf(stderr, "valo: %s: %s\n", kind, buf); return; }
+  char msg[1100];
+  snprintf(msg, sizeof msg, "%s%s", handler_prefix, buf);
+  g_warn_fn(g_warn_user, msg);
+}
+
+void log_warning(const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  log_emit("warning", "", fmt, ap);
   va_end(ap);
-  if (g_warn_fn) g_warn_fn(g_warn_user, buf);
-  else fprintf(stderr, "valo: warning: %s\n", buf);
 }
 
 void log_note(const char *fmt, ...) {
-  char buf[1024];
   va_list ap;
   va_start(ap, fmt);
-  vsnprintf(buf, sizeof buf, fmt, ap);
+  log_emit("note", "note: ", fmt, ap);
   va_end(ap);
-  if (g_warn_fn) {
-    char nb[1100];
-    snprintf(nb, sizeof nb, "note: %s", buf);
-    g_warn_fn(g_warn_user, nb);
-  } else fprintf(stderr, "valo: note: %s\n", buf);
 }
 
 VALO_API void valo_set_warning_handler(valo_log_fn fn, void *user) { g_warn_fn = fn; g_warn_user = user; }

@@ -52,11 +52,18 @@ static int light_faces(const scene *s, const light *l, vec3 p) {
   return v3_dot(scene_tri_ng(s, l->tri), v3_sub(p, s->pos[ix[0]])) > 0;
 }
 
+/* The local selection weights at p (power, 0 for lights facing away) and their sum, in
+ * one order, so light_select and light_select_pmf agree to the bit. */
+static float facing_weights(const light_sampler *ls, const scene *s, vec3 p, float w[LIGHT_LOCAL_MAX]) {
+  float total = 0;
+  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(s, &s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
+  return total;
+}
+
 uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
   if (!ls->local) return alias_sample(&ls->table, u, pmf);
-  float w[LIGHT_LOCAL_MAX], total = 0;
-  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(s, &s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
+  float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   if (!(total > 0)) return UINT32_MAX;
   float target = u * total, acc = 0;
   uint32_t last = UINT32_MAX;
@@ -73,10 +80,8 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
   if (ls->table.n == 0) return 0;
   if (!ls->local) return alias_pmf(&ls->table, li);
-  if (!light_faces(s, &s->lights[li], p)) return 0;
-  float total = 0;
-  for (uint32_t i = 0; i < ls->n; i++) total += light_faces(s, &s->lights[i], p) ? ls->power[i] : 0;
-  return total > 0 ? ls->power[li] / total : 0;
+  float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
+  return total > 0 ? w[li] / total : 0;
 }
 
 static float spot_falloff(const light *l, float cos_t) {
@@ -116,7 +121,13 @@ static float tri_solid_angle(const scene *s, const light *l, vec3 p, vec3 dir[3]
   float a = spherical_triangle_area(dir[0], dir[1], dir[2]);
   return isfinite(a) ? a : 0;
 }
-static int use_solid_angle(float omega_est) { return omega_est >= SPH_MIN_SOLID_ANGLE; }
+/* The solid angle of area light l from p if it is to be sampled by solid angle (directions
+ * to its vertices in dir), else 0: the one decision light_sample and light_pdf_area share. */
+static float solid_angle_if_used(const scene *s, const light *l, vec3 p, vec3 dir[3]) {
+  if (tri_solid_angle_est(s, l, p) < SPH_MIN_SOLID_ANGLE) return 0;
+  float omega = tri_solid_angle(s, l, p, dir);
+  return omega > 0 && omega <= SPH_MAX_SOLID_ANGLE ? omega : 0;
+}
 
 int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *o) {
   o->delta = 0;
@@ -126,10 +137,10 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
     vec3 n = v3_norm(scene_tri_ng(s, l->tri));
     vec3 dir[3];
-    float omega = 0;
+    float omega = solid_angle_if_used(s, l, p, dir);
     float b0, b1;
     vec3 pl;
-    if (use_solid_angle(tri_solid_angle_est(s, l, p)) && (omega = tri_solid_angle(s, l, p, dir)) > 0 && omega <= SPH_MAX_SOLID_ANGLE) {
+    if (omega > 0) {
       /* Solid angle: a direction, then the point where it meets the triangle's plane. */
       vec3 w;
       if (!sample_spherical_triangle(dir[0], dir[1], dir[2], u1, u2, &w)) return 0;
@@ -205,9 +216,8 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
 
 float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 pl, vec3 nl) {
   vec3 dir[3];
-  float omega;
-  if (use_solid_angle(tri_solid_angle_est(s, l, p)) && (omega = tri_solid_angle(s, l, p, dir)) > 0 && omega <= SPH_MAX_SOLID_ANGLE)
-    return 1 / omega;
+  float omega = solid_angle_if_used(s, l, p, dir);
+  if (omega > 0) return 1 / omega;
   vec3 d = v3_sub(pl, p);
   float d2 = v3_len2(d);
   float cos_l = fabsf(v3_dot(nl, v3_scale(d, 1 / sqrtf(d2))));

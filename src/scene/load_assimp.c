@@ -87,6 +87,16 @@ static float ai_float(const struct aiMaterial *m, const char *key, unsigned type
   return def;
 }
 
+/* A texture file named in a material (relative to the mesh file's folder dir, or
+ * absolute; backslashes taken as slashes); its index or -1 after a warning. */
+static int texture_in(scene *s, const char *dir, const char *p, int srgb) {
+  char full[2048];
+  if (p[0] == '/') snprintf(full, sizeof full, "%s", p);
+  else snprintf(full, sizeof full, "%s%s", dir, p);
+  for (char *q = full; *q; q++) if (*q == '\\') *q = '/';
+  return scene_texture_file(s, full, srgb);
+}
+
 /* Loads texture slot `type` of am into the scene: a file beside the mesh, or an image
  * embedded in the file ("*N"). Returns the texture index or -1. */
 static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type,
@@ -106,11 +116,7 @@ static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMa
     snprintf(key, sizeof key, "%s%s", dir, p);
     return scene_texture_memory(s, key, (const unsigned char *)t->pcData, t->mWidth, srgb);
   }
-  char full[2048];
-  if (p[0] == '/') snprintf(full, sizeof full, "%s", p);
-  else snprintf(full, sizeof full, "%s%s", dir, p);
-  for (char *q = full; *q; q++) if (*q == '\\') *q = '/';
-  return scene_texture_file(s, full, srgb);
+  return texture_in(s, dir, p, srgb);
 }
 
 /* The texture of a material slot (-1 if none or unreadable), with the slot's wrap mode
@@ -186,16 +192,8 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
                              const obj_check *oc) {
   int wrap = 0;
   const mtl_pbr *pb = oc ? obj_check_pbr(oc, m->name) : NULL;
-  if (pb && pb->map_pr[0]) {
-    char full[2048];
-    snprintf(full, sizeof full, "%s%s", pb->map_pr[0] == '/' ? "" : dir, pb->map_pr);
-    m->tex_rough = scene_texture_file(s, full, 0);
-  }
-  if (pb && pb->map_pm[0]) {
-    char full[2048];
-    snprintf(full, sizeof full, "%s%s", pb->map_pm[0] == '/' ? "" : dir, pb->map_pm);
-    m->tex_metal = scene_texture_file(s, full, 0);
-  }
+  if (pb && pb->map_pr[0]) m->tex_rough = texture_in(s, dir, pb->map_pr, 0);
+  if (pb && pb->map_pm[0]) m->tex_metal = texture_in(s, dir, pb->map_pm, 0);
   m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);

@@ -96,6 +96,13 @@ static int tokens(const char *s, const char *e, const char **tb, const char **te
   return n;
 }
 
+/* The end of the rest of a line from token b (names such as "newmtl My Material" run to
+ * the line's end, as Assimp reads them), trailing blanks dropped. */
+static const char *rest_end(const char *b, const char *e) {
+  while (e > b && isspace((unsigned char)e[-1])) e--;
+  return e;
+}
+
 static int tok_is(const char *b, const char *e, const char *word) {
   size_t n = strlen(word);
   return (size_t)(e - b) == n && !strncmp(b, word, n);
@@ -156,8 +163,7 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
       cur = &oc->pbr[oc->npbr++];
       memset(cur, 0, sizeof *cur);
       /* The name runs to the end of the line, as Assimp reads it. */
-      const char *ne = e;
-      while (ne > tb[1] && isspace((unsigned char)ne[-1])) ne--;
+      const char *ne = rest_end(tb[1], e);
       snprintf(cur->name, sizeof cur->name, "%.*s", (int)(ne - tb[1]), tb[1]);
       ob_put(&o, s, (size_t)(next - s));
       continue;
@@ -268,8 +274,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
     else if (tok_is(tb[0], te[0], "vt")) total[1]++;
     else if (tok_is(tb[0], te[0], "vn")) total[2]++;
     else if (tok_is(tb[0], te[0], "mtllib") && nt >= 2) {
-      const char *ne = e;
-      while (ne > tb[1] && isspace((unsigned char)ne[-1])) ne--;
+      const char *ne = rest_end(tb[1], e);
       char mp[2048];
       snprintf(mp, sizeof mp, "%s%.*s", tb[1][0] == '/' ? "" : dir, (int)(ne - tb[1]), tb[1]);
       valo_status st = read_mtl(oc, mp, path, line, err);
@@ -345,8 +350,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
     }
     if (tok_is(tb[0], te[0], "l") || tok_is(tb[0], te[0], "p")) { elements++; continue; }
     if (tok_is(tb[0], te[0], "usemtl")) {
-      const char *ne = e;
-      while (ne > tb[nt > 1 ? 1 : 0] && isspace((unsigned char)ne[-1])) ne--;
+      const char *ne = rest_end(tb[nt > 1 ? 1 : 0], e);
       if (nt >= 2 && !mtl_known(oc, tb[1], ne)) {
         if (bad_usemtl++ < 5)
           log_warning("%s:%d: usemtl %.*s: no material library of this file defines it; those faces are grey diffuse "
