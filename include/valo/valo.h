@@ -54,6 +54,12 @@ typedef struct valo_options {
                              roulette (a safety cap of 1024 bounces applies);
                              VALO_DEPTH_UNSET when not given */
   char integrator[32];    /* "path" (default) */
+  char params[1024];      /* integrator parameters (docs/integrators.md): "name=value"
+                             entries separated by spaces, commas or newlines; a name may
+                             carry its integrator ("photon.count=100000"), entries for
+                             another integrator are ignored. The scene file's come first,
+                             then these (later entries win). Unknown or out-of-range
+                             names make valo_render_create fail, naming them. */
   char accel[16];         /* "kdtree" (default) or "embree" */
   char sampler[16];       /* "sobol" (default: Owen-scrambled Sobol, padded per dimension)
                              or "independent" (a hash per sample and dimension) */
@@ -179,6 +185,10 @@ VALO_API const char *valo_version(void);
 VALO_API const char *valo_status_string(valo_status s);
 /* The names of the registered integrators, NULL-terminated. */
 VALO_API const char *const *valo_integrator_names(void);
+/* Writes integrator `name`'s one-line description and its parameters (name, default,
+ * range, meaning), one per line, into buf (NUL-terminated, cut at n). Returns 0, or -1
+ * for an unknown name. */
+VALO_API int valo_integrator_describe(const char *name, char *buf, size_t n);
 
 #ifdef __cplusplus
 }

@@ -49,6 +49,7 @@ static void usage_render(FILE *f) {
           "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
           "                         repeat for several outputs (default: SCENE-NAME.png);\n"
           "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs,\n"
+          "                         ao:FILE ambient occlusion (ao.distance), bent:FILE the bent normal,\n"
           "                         spp:FILE the samples each pixel received\n"
           "  --spp N                samples per pixel (default 16)\n"
           "  --time SECONDS         time budget: stop after the pass that reaches it\n"
@@ -60,6 +61,8 @@ static void usage_render(FILE *f) {
   for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(f, " %s", *n);
   fprintf(f,
           " (default path)\n"
+          "  --param NAME=VALUE     an integrator parameter (repeatable; NAME or INTEGRATOR.NAME);\n"
+          "                         --help-integrators lists them with defaults\n"
           "  --accel NAME           kdtree (default) or embree\n"
           "  --sampler NAME         sobol (default: Owen-scrambled Sobol) or independent\n"
           "  --max-depth N          maximum path length (default -1: unlimited, Russian roulette\n"
@@ -92,7 +95,7 @@ static void usage_render(FILE *f) {
 
 /* Length of an output's AOV prefix ("albedo:", "normal:", "depth:", "spp:"), or 0. */
 static size_t aov_prefix(const char *out) {
-  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "spp:"};
+  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
   for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++)
     if (!strncmp(out, prefixes[k], strlen(prefixes[k]))) return strlen(prefixes[k]);
   return 0;
@@ -180,6 +183,12 @@ static int cmd_render(int argc, char **argv) {
     return EXIT_USAGE;                                                                              \
   } while (0)
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) { usage_render(stdout); return 0; }
+    if (!strcmp(a, "--help-integrators")) {
+      char buf[8192];
+      for (const char *const *n = valo_integrator_names(); *n; n++)
+        if (!valo_integrator_describe(*n, buf, sizeof buf)) fputs(buf, stdout);
+      return 0;
+    }
     else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
     else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
       NEED_VALUE();
@@ -219,6 +228,12 @@ static int cmd_render(int argc, char **argv) {
         return EXIT_USAGE;
       }
       snprintf(opt.integrator, sizeof opt.integrator, "%s", val);
+    } else if (!strcmp(a, "--param")) {
+      NEED_VALUE();
+      if (!strchr(val, '=')) { fprintf(stderr, "valo: --param: expected NAME=VALUE, got \"%s\"\n", val); return EXIT_USAGE; }
+      size_t used = strlen(opt.params);
+      if (used + strlen(val) + 2 > sizeof opt.params) { fprintf(stderr, "valo: --param: too many parameters\n"); return EXIT_USAGE; }
+      snprintf(opt.params + used, sizeof opt.params - used, "%s%s", used ? " " : "", val);
     } else if (!strcmp(a, "--sampler")) {
       NEED_VALUE();
       if (strcmp(val, "sobol") && strcmp(val, "independent")) BAD_VALUE("sobol or independent");

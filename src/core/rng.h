@@ -104,6 +104,18 @@ static inline void sampler_2d(sampler *s, float *u1, float *u2) {
   *u2 = rng_to_float(rng_reverse_bits(rng_owen_lk(rng_sobol1_rev(idx), sy)));
 }
 
+/* Stream j of n children of s (final-gathering rays): a Sobol sampler's child j of
+ * sample i is point i n + j of a stream keyed apart from s's, so the n rays of one
+ * sample and those of all samples are stratified together; independent: a new hash. */
+static inline sampler sampler_child(const sampler *s, uint32_t j, uint32_t n) {
+  sampler c = *s;
+  c.pixel_key = rng_mix64(s->pixel_key ^ 0xc2b2ae3d27d4eb4fULL);
+  c.key = rng_mix64(s->key + 0x165667b19e3779f9ULL * (uint64_t)(j + 1));
+  c.index = s->index * n + j;
+  c.dim = 0;
+  return c;
+}
+
 /* Dimension layout of the path integrators: one dimension per decision, fixed per bounce. */
 enum {
   SDIM_FILM = 0,        /* 2D: position in the pixel */
@@ -115,7 +127,9 @@ enum {
   SDIM_LOBE = 2,        /*   1D: which BSDF lobe */
   SDIM_BSDF_DIR = 3,    /*   2D: direction */
   SDIM_ROULETTE = 4,    /*   1D: Russian roulette */
-  SDIM_PER_BOUNCE = 5
+  SDIM_PER_BOUNCE = 5,
+  SDIM_AOV = 0x40000000, /* 2D: the ao AOV's direction (beside any integrator) */
+  SDIM_EXTRA = 0x40000100 /* integrator-specific streams start here (ao, photon gathering) */
 };
 static inline uint32_t sdim_bounce(int depth, int what) { return SDIM_BOUNCE0 + (uint32_t)depth * SDIM_PER_BOUNCE + (uint32_t)what; }
 #endif

@@ -14,22 +14,57 @@
 
 typedef struct thread_stats { uint64_t rays; uint64_t bad_samples; char pad[48]; } thread_stats;
 
+/* Parameters an integrator declares (docs/integrators.md lists the same tables): read
+ * from the scene file ("render": {"photon": {"count": 200000}}) and from the command
+ * line (--param count=200000, or photon.count=200000), checked against type and range. */
+typedef enum iparam_type { IPARAM_INT, IPARAM_FLOAT } iparam_type;
+typedef struct integrator_param {
+  const char *name;
+  iparam_type type;
+  double def, lo, hi;
+  const char *doc;      /* one line, with the unit and what the default means */
+} integrator_param;
+#define INTEGRATOR_MAX_PARAMS 16
+
 typedef struct render_ctx {
   const scene *s;
   const accel *acc;
   light_sampler ls;
   int max_depth;           /* -1: unlimited (Russian roulette, capped at PATH_HARD_CAP) */
+  const double *param;     /* the integrator's parameter values, in its table's order */
+  const void *state;       /* what the integrator's create/prepare made (photon maps, points) */
+  uint64_t seed;
+  int threads;
 } render_ctx;
 #define PATH_HARD_CAP 1024
 
+/* Integrators (ARCHITECTURE.md, "Growing the integrator interface"). Per-ray ones give
+ * li() and get the shared tile loop. Those that work on the whole scene before the camera
+ * rays add create (parse nothing: the parameters are already checked; allocate and build
+ * what lasts the whole render), prepare (once before every sample index: shoot this
+ * pass's photons or VPLs into fresh buffers, deterministic for any thread count) and
+ * destroy; li() then reads c->state. The render loop runs one sample per pixel per pass
+ * for integrators with prepare, so each pass's camera samples see one independent set. */
 typedef struct integrator_ops {
   const char *name;
   const char *description;
+  const integrator_param *params; /* table ended by a NULL name, or NULL */
   /* Radiance arriving along camera ray r. */
   rgb (*li)(const render_ctx *c, ray r, sampler *smp, thread_stats *ts);
+  valo_status (*create)(const render_ctx *c, void **state, valo_error *err);
+  valo_status (*prepare)(void *state, const render_ctx *c, int sample_index, valo_error *err);
+  void (*destroy)(void *state);
 } integrator_ops;
 
 const integrator_ops *integrator_find(const char *name);
+/* Fills values[] (one per entry of ops->params) from the defaults, then from `text`:
+ * entries "name=value" or "integrator.name=value" separated by spaces, commas or
+ * newlines (later ones win; entries for another integrator are skipped, and with
+ * prefixed_only so are entries without an integrator name). An unknown name
+ * or a value out of range is an error that names it. */
+valo_status integrator_params_parse(const integrator_ops *ops, const char *text, double *values, int prefixed_only, valo_error *err);
+/* Index of parameter `name` in ops->params, or -1. */
+int integrator_param_index(const integrator_ops *ops, const char *name);
 
 typedef struct isect {
   vec3 p, perr;       /* point and its floating-point error bound */
@@ -115,4 +150,12 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */
 float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp);
+
+/* Ambient occlusion (digest 003, ao.c): one cosine-weighted ray about the normal n
+ * (faced to the viewer) from it, up to length dist. Returns 1 when it escapes (the
+ * direction is then *dir), 0 when something is within dist. */
+int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler *smp, thread_stats *ts, vec3 *dir);
+/* The ao ray length for parameter value d: d itself when > 0, else (automatic) half the
+ * radius of the scene's bounding sphere. */
+float ao_ray_length(const scene *s, double d);
 #endif

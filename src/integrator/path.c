@@ -40,4 +40,4 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
 }
 
 const integrator_ops integrator_path = {
-    "path", "unidirectional path tracing with next-event estimation, MIS and Russian roulette", path_li};
+    "path", "unidirectional path tracing with next-event estimation, MIS and Russian roulette", NULL, path_li, NULL, NULL, NULL};

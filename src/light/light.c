@@ -229,3 +229,68 @@ float light_pdf_env(const scene *s, const light *l, vec3 wi) {
   return s->env_map ? envmap_pdf(s->env_map, wi) : uniform_sphere_pdf();
 }
 rgb light_env_radiance(const scene *s, const light *l, vec3 wi) { return s->env_map ? envmap_eval(s->env_map, wi) : l->L; }
+
+int light_sample_emit(const scene *s, const light *l, const float u[4], light_emit *o) {
+  o->n = v3(0, 0, 0);
+  switch (l->type) {
+  case LIGHT_AREA: {
+    const uint32_t *ix = &s->idx[3 * l->tri];
+    vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+    float b0, b1;
+    sample_uniform_triangle(u[0], u[1], &b0, &b1);
+    o->o = v3_add(v3_add(v3_scale(a, b0), v3_scale(b, b1)), v3_scale(c, 1 - b0 - b1));
+    vec3 n = v3_norm(scene_tri_ng(s, l->tri));
+    float uu = u[2], side = 1;
+    if (l->two_sided) { side = uu < 0.5f ? 1.0f : -1.0f; uu = uu < 0.5f ? 2 * uu : 2 * uu - 1; }
+    vec3 nn = v3_scale(n, side);
+    frame f = frame_from_n(nn);
+    o->d = frame_to_world(&f, sample_cosine_hemisphere(uu, u[3]));
+    o->n = nn;
+    float tu, tv;
+    scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+    rgb Le = light_area_radiance(s, l, n, o->d, tu, tv);
+    /* Le cos / ((1/A) (cos/pi) (1/2 if two-sided)) */
+    o->beta = c3_scale(Le, PI_F * l->area * (l->two_sided ? 2.0f : 1.0f));
+    break;
+  }
+  case LIGHT_POINT:
+    o->o = l->p;
+    o->d = sample_uniform_sphere(u[0], u[1]);
+    o->beta = c3_scale(l->L, 4 * PI_F);
+    break;
+  case LIGHT_SPOT: {
+    o->o = l->p;
+    frame f = frame_from_n(l->dir);
+    o->d = frame_to_world(&f, sample_uniform_cone(u[0], u[1], l->cos_outer));
+    o->beta = c3_scale(l->L, spot_falloff(l, v3_dot(o->d, l->dir)) * 2 * PI_F * (1 - l->cos_outer));
+    break;
+  }
+  case LIGHT_DIRECTIONAL:
+  case LIGHT_ENV: {
+    vec3 wi; /* towards the light */
+    rgb L;
+    float pdf = 1;
+    if (l->type == LIGHT_DIRECTIONAL) {
+      wi = v3_neg(l->dir);
+      L = l->L;
+    } else if (s->env_map) {
+      if (!envmap_sample(s->env_map, u[0], u[1], &wi, &pdf)) return 0;
+      L = envmap_eval(s->env_map, wi);
+    } else {
+      wi = sample_uniform_sphere(u[0], u[1]);
+      pdf = uniform_sphere_pdf();
+      L = l->L;
+    }
+    float R = s->radius > 0 ? s->radius : 1;
+    frame f = frame_from_n(wi);
+    float dx, dy;
+    sample_concentric_disk(u[2], u[3], &dx, &dy);
+    vec3 disc = frame_to_world(&f, v3(dx * R, dy * R, 0));
+    o->o = v3_add(v3_add(s->center, disc), v3_scale(wi, 2 * R));
+    o->d = v3_neg(wi);
+    o->beta = c3_scale(L, PI_F * R * R / pdf);
+    break;
+  }
+  }
+  return c3_finite(o->beta) && !c3_black(o->beta);
+}

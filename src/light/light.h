@@ -52,4 +52,14 @@ static inline rgb light_area_emitted(const light *l, vec3 ng, vec3 w) {
 /* The same with the emitter's emission map (if any) applied at surface UV (u, v). */
 rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v);
 float light_power(const scene *s, const light *l);
+
+/* A ray of light leaving light l (photon and VPL tracing): origin, unit direction and
+ * beta = Le cos / (pdf_position pdf_direction), the flux this one sample stands for.
+ * Area lights: uniform point, cosine-weighted direction about the emitting side (a side
+ * picked at random when two-sided); point: uniform sphere; spot: uniform cone to
+ * cos_outer; directional and environment: a direction (the map's importance sampling)
+ * and a uniform point on the disc of the scene's bounding-sphere radius across it.
+ * u: four uniform numbers. Returns 0 when the sample carries nothing. */
+typedef struct light_emit { vec3 o, d, n; rgb beta; } light_emit;
+int light_sample_emit(const scene *s, const light *l, const float u[4], light_emit *out);
 #endif

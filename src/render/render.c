@@ -22,12 +22,13 @@
 #include <stdio.h>
 
 #define TILE 16
+#define AOV_FLOATS 11
 #define MAX_RES 16384
 #define MAX_SPP 1048576
 #define MAX_PIXEL_SAMPLES 4.0e12
 
 struct valo_scene { scene *s; };
-extern const integrator_ops integrator_path_spectral;
+extern const integrator_ops integrator_path_spectral, integrator_ao;
 
 struct valo_render {
   const scene *s;
@@ -38,7 +39,11 @@ struct valo_render {
   accel *acc;
   accel_filter alpha_filter;
   double *sum;            /* 3 doubles per pixel */
-  float *aov;             /* 7 floats per pixel (albedo rgb, normal xyz, depth) summed, or NULL */
+  float *aov;             /* AOV_FLOATS per pixel (albedo rgb, normal xyz, depth, ao, bent
+                             normal xyz) summed, or NULL */
+  double param[INTEGRATOR_MAX_PARAMS];
+  void *istate;           /* the integrator's create() result */
+  float ao_dist;          /* ray length of the ao AOV */
   uint32_t *count;        /* samples per pixel */
   double *lum;            /* adaptive: per pixel sum of luminance and of its square */
   int spp_done;
@@ -167,6 +172,11 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->seed != VALO_UNSET) dst->seed = o->seed;
     if (o->max_depth != VALO_DEPTH_UNSET) dst->max_depth = o->max_depth;
     if (o->integrator[0]) memcpy(dst->integrator, o->integrator, sizeof dst->integrator);
+    if (o->params[0]) {
+      /* file first, then the caller's: later entries win */
+      size_t used = strlen(dst->params);
+      snprintf(dst->params + used, sizeof dst->params - used, "%s%s", used ? " " : "", o->params);
+    }
     if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
     if (o->sampler[0]) memcpy(dst->sampler, o->sampler, sizeof dst->sampler);
     if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
@@ -221,15 +231,24 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     if (strcmp(o.integrator, "path")) return err_set(err, VALO_ERR_UNSUPPORTED, "spectral mode works with the path integrator only");
     integ = &integrator_path_spectral;
   }
+  double param[INTEGRATOR_MAX_PARAMS] = {0}, ao_param[INTEGRATOR_MAX_PARAMS] = {0};
+  valo_status pst = integrator_params_parse(integ, o.params, param, 0, err);
+  if (pst) return pst;
+  /* The ao AOV takes the ao integrator's ray length ("ao.distance=..."). */
+  pst = integrator_params_parse(&integrator_ao, o.params, ao_param, !strcmp(integ->name, "ao") ? 0 : 1, err);
+  if (pst) return pst;
+  if (o.adaptive && integ->prepare)
+    return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with the %s integrator (each pass shares one light-path set)", integ->name);
   valo_render *r = calloc(1, sizeof *r);
   if (!r) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   r->s = s;
   r->opt = o;
   r->integ = integ;
+  memcpy(r->param, param, sizeof param);
   r->sampler_kind = strcmp(o.sampler, "independent") ? SAMPLER_SOBOL : SAMPLER_INDEPENDENT;
   atomic_init(&r->cancel, 0);
   r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
-  if (o.aovs) r->aov = calloc((size_t)o.width * o.height * 7, sizeof(float));
+  if (o.aovs) r->aov = calloc((size_t)o.width * o.height * AOV_FLOATS, sizeof(float));
   r->count = calloc((size_t)o.width * o.height, sizeof(uint32_t));
   if (o.adaptive) r->lum = calloc((size_t)o.width * o.height * 2, sizeof(double));
   if (!r->sum || (o.aovs && !r->aov) || !r->count || (o.adaptive && !r->lum)) {
@@ -250,6 +269,10 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->ctx.s = s;
   r->ctx.acc = r->acc;
   r->ctx.max_depth = o.max_depth;
+  r->ctx.param = r->param;
+  r->ctx.seed = (uint64_t)o.seed;
+  r->ctx.threads = o.threads;
+  r->ao_dist = ao_ray_length(s, ao_param[0]);
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
   camera fitted = scene_camera_fit(s, (float)o.width / (float)o.height);
   const camera *c = &fitted;
@@ -272,6 +295,11 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     hit h;
     r->focus = accel_intersect(r->acc, &cr, &h) ? h.t : v3_len(v3_sub(c->look_at, c->pos));
     if (!(r->focus > 0)) r->focus = 1;
+  }
+  if (integ->create) {
+    valo_status cst = integ->create(&r->ctx, &r->istate, err);
+    if (cst) { valo_render_destroy(r); return cst; }
+    r->ctx.state = r->istate;
   }
   *out = r;
   return VALO_OK;
@@ -304,8 +332,10 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   return ry;
 }
 
-/* AOVs of one camera ray: albedo, shading normal facing the ray, hit distance. */
-static void record_aovs(const valo_render *r, ray ry, float *acc, thread_stats *ts) {
+/* AOVs of one camera ray: albedo, shading normal facing the ray, hit distance, and one
+ * ambient-occlusion ray (unoccluded fraction and the unoccluded direction, whose mean is
+ * the bent normal). */
+static void record_aovs(const valo_render *r, ray ry, float *acc, sampler *smp, thread_stats *ts) {
   hit h;
   if (!ctx_intersect(&r->ctx, &ry, &h, ts)) return;
   isect it;
@@ -319,6 +349,12 @@ static void record_aovs(const valo_render *r, ray ry, float *acc, thread_stats *
   acc[0] += a.r; acc[1] += a.g; acc[2] += a.b;
   acc[3] += n.x; acc[4] += n.y; acc[5] += n.z;
   acc[6] += h.t * v3_len(ry.d);
+  vec3 dir;
+  sampler_set_dim(smp, SDIM_AOV);
+  if (ao_sample(&r->ctx, &it, n, r->ao_dist, smp, ts, &dir)) {
+    acc[7] += 1;
+    acc[8] += dir.x; acc[9] += dir.y; acc[10] += dir.z;
+  }
 }
 
 typedef struct pass_job {
@@ -336,7 +372,7 @@ static void sample_pixel(valo_render *r, int x, int y, int s0, int s1, thread_st
     sampler smp = sampler_make_kind((uint64_t)r->opt.seed, pix, (uint64_t)si, r->sampler_kind);
     ray ry = camera_ray(r, x, y, &smp);
     ts->rays++;
-    if (r->aov) record_aovs(r, ry, &r->aov[7 * pix], ts);
+    if (r->aov) record_aovs(r, ry, &r->aov[AOV_FLOATS * pix], &smp, ts);
     rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
     r->count[pix]++;
     if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
@@ -449,6 +485,12 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
   while (r->spp_done < uniform_spp) {
     int n = pass_spp;
     if (r->spp_done + n > uniform_spp) n = uniform_spp - r->spp_done;
+    if (r->integ->prepare) {
+      /* one sample index per pass: its light paths are shot first */
+      n = 1;
+      valo_status pst = r->integ->prepare(r->istate, &r->ctx, r->spp_done, err);
+      if (pst) { st = pst; break; }
+    }
     pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
     double p0 = now_seconds();
     parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
@@ -593,8 +635,8 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
     free(px);
     return st;
   }
-  static const char *const aov_names[3] = {"albedo:", "normal:", "depth:"};
-  for (int k = 0; k < 3; k++) {
+  static const char *const aov_names[5] = {"albedo:", "normal:", "depth:", "ao:", "bent:"};
+  for (int k = 0; k < 5; k++) {
     size_t n = strlen(aov_names[k]);
     if (strncmp(path, aov_names[k], n)) continue;
     if (!r->aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", path);
@@ -602,14 +644,23 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
     float *px = malloc(np * 3 * sizeof(float));
     if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < np; i++) {
+      const float *a = &r->aov[AOV_FLOATS * i];
       float inv = r->count[i] > 0 ? 1.0f / (float)r->count[i] : 0;
-      for (int c = 0; c < 3; c++) px[3 * i + c] = (k == 2 ? r->aov[7 * i + 6] : r->aov[7 * i + 3 * k + c]) * inv;
+      if (k == 4) {
+        /* bent normal: the mean unoccluded direction, normalised (0 where all occluded) */
+        vec3 b = v3(a[8], a[9], a[10]);
+        float l = v3_len(b);
+        b = l > 0 ? v3_scale(b, 1 / l) : v3(0, 0, 0);
+        px[3 * i] = b.x; px[3 * i + 1] = b.y; px[3 * i + 2] = b.z;
+        continue;
+      }
+      for (int c = 0; c < 3; c++) px[3 * i + c] = (k == 2 ? a[6] : k == 3 ? a[7] : a[3 * k + c]) * inv;
     }
-    int png = ends_with(path, ".png");
-    if (png && k > 0) png_data_map(px, np, k == 1 ? 0 : 1);
+    int png = ends_with(path, ".png"), data = k == 1 || k == 2 || k == 4;
+    if (png && data) png_data_map(px, np, k == 2 ? 1 : 0);
     valo_output_options raw;
     valo_output_options_init(&raw);
-    valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, png && k > 0 ? &raw : o, err);
+    valo_status st = image_write(path + n, r->opt.width, r->opt.height, px, png && data ? &raw : o, err);
     free(px);
     return st;
   }
@@ -627,6 +678,7 @@ VALO_API void valo_render_destroy(valo_render *r) {
   if (!r) return;
   accel_destroy(r->acc);
   light_sampler_free(&r->ctx.ls);
+  if (r->integ && r->integ->destroy && r->istate) r->integ->destroy(r->istate);
   free(r->sum);
   free(r->aov);
   free(r->count);

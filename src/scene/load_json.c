@@ -163,9 +163,36 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
 }
 
 static valo_status parse_render(jctx *c, const cJSON *o) {
-  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", NULL};
-  TRY(check_keys(c, o, "render", keys));
   valo_options *op = &c->s->file_opts;
+  if (!cJSON_IsObject(o)) return bad(c, "render", "must be an object");
+  /* An object under "render" holds an integrator's parameters ("photon": {"count":
+   * 100000}); they become the options' parameter text "photon.count=100000", checked
+   * against that integrator's table (and its name against the registry) when rendering. */
+  for (const cJSON *it = o->child; it; it = it->next) {
+    if (!cJSON_IsObject(it)) continue;
+    char w[96];
+    snprintf(w, sizeof w, "render.%s", it->string);
+    for (const cJSON *p = it->child; p; p = p->next) {
+      char w2[160];
+      snprintf(w2, sizeof w2, "%s.%s", w, p->string);
+      if (!cJSON_IsNumber(p) && !cJSON_IsBool(p)) return bad(c, w2, "must be a number");
+      double v = cJSON_IsBool(p) ? (cJSON_IsTrue(p) ? 1 : 0) : p->valuedouble;
+      size_t used = strlen(op->params);
+      int n = snprintf(op->params + used, sizeof op->params - used, "%s%s.%s=%.17g", used ? " " : "", it->string, p->string, v);
+      if (n < 0 || (size_t)n >= sizeof op->params - used) return bad(c, w, "too many parameters");
+    }
+  }
+  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", NULL};
+  for (const cJSON *it = o->child; it; it = it->next) {
+    int ok = cJSON_IsObject(it);
+    for (const char *const *a = keys; *a && !ok; a++) ok = !strcmp(it->string, *a);
+    if (!ok) {
+      char msg[400];
+      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed: integrator spp seed max_depth accel time sampler, or an "
+                                "integrator's name with an object of its parameters)", it->string);
+      return bad(c, "render", msg);
+    }
+  }
   const char *s = NULL;
   TRY(get_str(c, o, "integrator", "render", &s));
   if (s) snprintf(op->integrator, sizeof op->integrator, "%s", s);
@@ -356,11 +383,36 @@ static void resolve_path(const jctx *c, const char *rel, char *out, size_t n) {
   else snprintf(out, n, "%s/%s", c->dir, rel);
 }
 
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend);
 static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfirst, uint32_t mend) {
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
-  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth", NULL};
+  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
+                                     "proximity", NULL};
   TRY(check_keys(c, o, where, keys));
+  uint32_t first = c->s->ntris;
+  valo_status st = parse_shape_geometry(c, o, where, mfirst, mend);
+  if (st) return st;
+  const cJSON *px = cJSON_GetObjectItemCaseSensitive(o, "proximity");
+  if (!px) return VALO_OK;
+  char w2[96];
+  snprintf(w2, sizeof w2, "%s.proximity", where);
+  if (!cJSON_IsObject(px)) return bad(c, w2, "must be an object with spacing, radius, strength");
+  static const char *const pkeys[] = {"spacing", "radius", "strength", NULL};
+  TRY(check_keys(c, px, w2, pkeys));
+  double sp = 0, rad = 0, m = 0;
+  TRY(get_num(c, px, "spacing", w2, 1e-9, 1e9, &sp));
+  TRY(get_num(c, px, "radius", w2, 1e-9, 1e9, &rad));
+  TRY(get_num(c, px, "strength", w2, 0, 1e9, &m));
+  shape_ao *na = realloc(c->s->shape_ao, (c->s->nshape_ao + 1) * sizeof *na);
+  if (!na) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->shape_ao = na;
+  shape_ao sa = {first, c->s->ntris, (float)sp, (float)rad, (float)m};
+  na[c->s->nshape_ao++] = sa;
+  return VALO_OK;
+}
+
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend) {
   const char *type = "mesh", *file = NULL, *mname = NULL;
   TRY(get_str(c, o, "type", where, &type));
   TRY(get_str(c, o, "file", where, &file));

@@ -64,6 +64,10 @@ typedef struct camera {
 /* Triangle flags. */
 enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
 
+/* Proximity-AO settings of one JSON shape (its triangles [first, end)); a value <= 0
+ * takes the proximity-ao integrator's parameter. */
+typedef struct shape_ao { uint32_t first, end; float spacing, radius, strength; } shape_ao;
+
 typedef struct scene {
   char path[1024];
   /* geometry */
@@ -91,6 +95,8 @@ typedef struct scene {
   int up_z;                /* automatic framing: the model's up axis is +z (else +y) */
   int cam_auto;            /* the camera was framed automatically (scene_camera_fit) */
   valo_options file_opts;
+  shape_ao *shape_ao;      /* per-shape proximity-AO settings (JSON "proximity"), sorted by first */
+  uint32_t nshape_ao;
   bbox bounds;
   vec3 center;
   float radius;

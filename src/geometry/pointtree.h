@@ -1,0 +1,33 @@
+/* pointtree.h — owns the point kd-tree shared by the photon maps and proximity-AO's
+ * splatted points (ARCHITECTURE.md: "one point kd-tree"): a balanced, implicit kd-tree
+ * (Jensen's photon-map tree: the median of each range is its node, split on the range's
+ * widest axis; no child pointers), with k-nearest and fixed-radius queries. The k-nearest
+ * query can measure distance squeezed along a normal (d^2 + f (d.n)^2), the disc variant
+ * against leaks through corners and thin walls. Built once, then read by any number of
+ * threads. */
+#ifndef VALO_POINTTREE_H
+#define VALO_POINTTREE_H
+#include "core/vec.h"
+#include <stdint.h>
+
+typedef struct point_tree {
+  vec3 *p;          /* the points in tree order */
+  uint32_t *id;     /* id[i]: the caller's index of point i */
+  uint8_t *axis;    /* split axis of the node at i */
+  uint32_t n;
+} point_tree;
+
+/* Builds the tree over pts[0..n) (copied). Returns 0, or -1 when out of memory. */
+int point_tree_build(point_tree *t, const vec3 *pts, uint32_t n);
+void point_tree_free(point_tree *t);
+
+typedef struct point_near { float d2; uint32_t i; } point_near; /* i: tree order */
+/* Up to k nearest points to q with (squeezed) squared distance < r2max, in out[] (any
+ * order); returns how many. n_squeeze (unit) and squeeze f >= 0 give the metric
+ * |v|^2 + f (v.n)^2 (f = 0: Euclidean). k <= POINT_KNN_MAX. */
+#define POINT_KNN_MAX 1024
+int point_tree_knn(const point_tree *t, vec3 q, int k, float r2max, vec3 n_squeeze, float f, point_near *out);
+/* Calls fn for every point with |p - q|^2 < r2 (i in tree order). */
+typedef void (*point_visit_fn)(void *user, uint32_t i, float d2);
+void point_tree_radius(const point_tree *t, vec3 q, float r2, point_visit_fn fn, void *user);
+#endif

@@ -1,0 +1,461 @@
+/* photon.c — owns the `photon` integrator: Jensen's photon mapping (digest 003; Jensen
+ * 1996/2001, as pbrt-v2's PhotonIntegrator), progressive by passes.
+ *  - prepare (before every sample index): photon paths leave the lights, each light
+ *    picked in proportion to its power and the flux split evenly among the paths (the
+ *    emission sample drawn from an Owen-scrambled Sobol sequence over the path index);
+ *    BSDF sampling carries them on (adjoint: no 1/eta^2 radiance scale, Veach's shading-
+ *    normal correction), Russian roulette by the throughput's change keeps photon powers
+ *    near constant. Every hit on a surface with a non-delta lobe stores a photon
+ *    (position, power, incoming direction octahedron-packed: 28 bytes) in the global
+ *    map; a second emission keeps only L S+ D photons (those that reached a diffuse
+ *    surface through specular ones), in the caustic map. Emission runs in rounds sized
+ *    from the rate seen so far until each map holds its target; rounds are split into
+ *    fixed chunks whose photons are concatenated in chunk order, so the maps are the same
+ *    for any thread count. Both maps live in the shared point kd-tree.
+ *  - li: camera rays follow delta lobes (counting emission); at the first surface with a
+ *    non-delta lobe, L = direct light by NEE + the caustic map's estimate + indirect
+ *    light by final gathering: `gather` BSDF-sampled rays whose hits take the global
+ *    map's estimate of outgoing radiance (after up to 4 delta bounces; emission found by
+ *    gather rays is left to NEE and the caustic map).
+ *  - radiance estimate: L = sum f(wo, wp) Phi_p / (pi r^2) over the k nearest photons
+ *    within the maximum radius, distance measured in a disc squeezed along the surface
+ *    normal (|v|^2 + 16 (v.n)^2) against leaks at corners and through thin walls.
+ * Biased (blur of the density estimate), consistent as the photon counts grow. */
+#include "integrator/integrator.h"
+#include "geometry/pointtree.h"
+#include "core/threadpool.h"
+#include "core/error.h"
+#include "core/sampling.h"
+#include <stdlib.h>
+#include <string.h>
+
+enum { P_GLOBAL, P_CAUSTIC, P_K, P_RADIUS, P_GATHER, P_CAUSTIC_RADIUS };
+static const integrator_param photon_params[] = {
+    {"global", IPARAM_INT, 100000, 0, 1e8, "photons stored in the global map per pass (pbrt-v2's default count)"},
+    {"caustic", IPARAM_INT, 20000, 0, 1e8, "photons stored in the caustic map per pass"},
+    {"k", IPARAM_INT, 50, 1, POINT_KNN_MAX, "nearest photons per radiance estimate"},
+    {"radius", IPARAM_FLOAT, 0, 0, 1e30, "largest search radius, global map; 0 = automatic, 1/10 of the scene's bounding-sphere radius"},
+    {"gather", IPARAM_INT, 32, 0, 4096, "final-gathering rays per camera sample (0: use the global map at the first hit)"},
+    {"caustic_radius", IPARAM_FLOAT, 0, 0, 1e30, "largest search radius, caustic map; 0 = automatic, 1/40 of the bounding-sphere radius"},
+    {NULL, IPARAM_INT, 0, 0, 0, NULL}};
+
+#define SQUEEZE 16.0f
+#define CHUNK 1024
+#define MAX_BOUNCES 64
+#define MAX_EMIT_FACTOR 64    /* a map gives up after emitting 64x its target in paths */
+
+/* A stored photon: 28 bytes that every estimate reads, plus the surface normal and
+ * diffuse reflectance where it landed, which only the radiance-photon precomputation
+ * reads (kept beside it rather than in a second pass over the scene). */
+typedef struct photon { vec3 p; rgb power; uint32_t dir; uint32_t nrm; rgb rho; } photon; /* dir, nrm: octahedral 2x16 bits */
+
+static uint32_t oct_pack(vec3 d) {
+  float s = fabsf(d.x) + fabsf(d.y) + fabsf(d.z);
+  float x = d.x / s, y = d.y / s;
+  if (d.z < 0) {
+    float ox = (1 - fabsf(y)) * (x >= 0 ? 1.0f : -1.0f), oy = (1 - fabsf(x)) * (y >= 0 ? 1.0f : -1.0f);
+    x = ox; y = oy;
+  }
+  uint32_t ux = (uint32_t)lrintf((clampf(x, -1, 1) * 0.5f + 0.5f) * 65535.0f);
+  uint32_t uy = (uint32_t)lrintf((clampf(y, -1, 1) * 0.5f + 0.5f) * 65535.0f);
+  return ux | (uy << 16);
+}
+static vec3 oct_unpack(uint32_t u) {
+  float x = (float)(u & 0xffff) / 65535.0f * 2 - 1, y = (float)(u >> 16) / 65535.0f * 2 - 1;
+  float z = 1 - fabsf(x) - fabsf(y);
+  if (z < 0) {
+    float ox = (1 - fabsf(y)) * (x >= 0 ? 1.0f : -1.0f), oy = (1 - fabsf(x)) * (y >= 0 ? 1.0f : -1.0f);
+    x = ox; y = oy;
+  }
+  return v3_norm(v3(x, y, z));
+}
+
+typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; uint64_t emitted; } photon_map;
+/* Radiance photons (Christensen 1999): every RAD_STRIDE-th global photon with its
+ * precomputed outgoing radiance rho E / pi, found by gather rays with one nearest lookup
+ * instead of a k-nearest estimate. */
+#define RAD_STRIDE 4
+typedef struct rad_map { point_tree tree; vec3 *n; rgb *Lo; uint32_t n_pts; } rad_map;
+
+typedef struct photon_state {
+  photon_map global, caustic;
+  rad_map rad;
+  int has_specular;        /* any delta lobe in the scene: else no caustic map */
+  float r2_global, r2_caustic;
+} photon_state;
+
+static void map_free(photon_map *m) {
+  point_tree_free(&m->tree);
+  free(m->ph);
+  memset(m, 0, sizeof *m);
+}
+
+static void rad_free(rad_map *r) {
+  point_tree_free(&r->tree);
+  free(r->n); free(r->Lo);
+  memset(r, 0, sizeof *r);
+}
+
+static void photon_destroy(void *st) {
+  photon_state *ps = st;
+  if (!ps) return;
+  rad_free(&ps->rad);
+  map_free(&ps->global);
+  map_free(&ps->caustic);
+  free(ps);
+}
+
+static valo_status photon_create(const render_ctx *c, void **out, valo_error *err) {
+  photon_state *ps = calloc(1, sizeof *ps);
+  if (!ps) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  for (uint32_t i = 0; i < c->s->nmats && !ps->has_specular; i++) {
+    bsdf b = bsdf_from_material(&c->s->mats[i]);
+    ps->has_specular = b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR;
+  }
+  float rg = c->param[P_RADIUS] > 0 ? (float)c->param[P_RADIUS] : 0.1f * c->s->radius;
+  float rc = c->param[P_CAUSTIC_RADIUS] > 0 ? (float)c->param[P_CAUSTIC_RADIUS] : 0.025f * c->s->radius;
+  ps->r2_global = rg * rg;
+  ps->r2_caustic = rc * rc;
+  *out = ps;
+  return VALO_OK;
+}
+
+/* What the surface reflects of uniform incident light, hemispherical-hemispherical, for
+ * the radiance photons' Lo = rho E / pi (pbrt-v2's diffuse approximation): the
+ * directional albedo at normal incidence, by the BSDF's own sampling (16 stratified
+ * samples; deterministic). */
+static rgb diffuse_reflectance(const bsdf *b, const isect *it, const frame *fr) {
+  (void)it; (void)fr;
+  rgb sum = c3(0, 0, 0);
+  vec3 wo = v3(0, 0, 1);
+  for (int i = 0; i < 16; i++) {
+    bsdf_sample bs;
+    float u1 = ((float)(i % 4) + 0.5f) / 4, u2 = ((float)(i / 4) + 0.5f) / 4;
+    if (bsdf_sample_dir(b, wo, ((float)i + 0.5f) / 16, u1, u2, &bs) && !bs.delta && bs.wi.z > 0) sum = c3_add(sum, bs.weight);
+  }
+  return c3_scale(sum, 1.0f / 16);
+}
+
+/* ---- shooting ---- */
+typedef struct chunk_buf { photon *ph; uint32_t n, cap; int oom; } chunk_buf;
+typedef struct shoot_job {
+  const render_ctx *c;
+  int caustic;             /* 1: keep only L S+ D photons */
+  uint64_t first;          /* index of the round's first path */
+  uint64_t key;            /* per pass and map */
+  chunk_buf *bufs;         /* one per chunk of the round */
+  thread_stats *ts;
+} shoot_job;
+
+static void store(chunk_buf *b, vec3 p, rgb power, vec3 d, vec3 n, rgb rho) {
+  if (b->oom) return;
+  if (b->n == b->cap) {
+    uint32_t cap = b->cap ? 2 * b->cap : 256;
+    photon *np = realloc(b->ph, cap * sizeof *np);
+    if (!np) { b->oom = 1; return; }
+    b->ph = np;
+    b->cap = cap;
+  }
+  photon ph = {p, power, oct_pack(d), oct_pack(n), rho};
+  b->ph[b->n++] = ph;
+}
+
+static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, thread_stats *ts) {
+  const render_ctx *c = j->c;
+  const scene *s = c->s;
+  sampler smp = sampler_make_kind(j->key, 0, index, SAMPLER_SOBOL);
+  float ul = sampler_1d(&smp), u[4];
+  sampler_2d(&smp, &u[0], &u[1]);
+  sampler_2d(&smp, &u[2], &u[3]);
+  float pmf;
+  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
+  light_emit e;
+  if (!(pmf > 0) || !light_sample_emit(s, &s->lights[li], u, &e)) return;
+  rgb beta = c3_scale(e.beta, 1 / pmf);
+  ray r = {e.o, e.d, INFINITY};
+  if (s->lights[li].type == LIGHT_AREA) r.o = offset_origin(e.o, v3(0, 0, 0), e.n, e.d);
+  int specular_path = 1;
+  for (int depth = 0; depth < MAX_BOUNCES; depth++) {
+    hit h;
+    if (!ctx_intersect(c, &r, &h, ts)) return;
+    isect it;
+    isect_from_hit(s, &r, &h, &it);
+    bsdf b = bsdf_at(s, &it);
+    vec3 wo = v3_neg(r.d);
+    frame fr = shading_frame(&it, &b, wo);
+    if (bsdf_has_smooth(&b)) {
+      rgb rho = diffuse_reflectance(&b, &it, &fr);
+      if (!j->caustic) store(out, it.p, beta, r.d, fr.n, rho);
+      else if (specular_path && depth > 0) store(out, it.p, beta, r.d, fr.n, rho);
+    }
+    path_state st = path_state_start(r.o);
+    rgb w;
+    ray next;
+    float eta_before = st.eta_acc;
+    if (!path_continue(&it, &b, &fr, wo, &smp, &st, &w, &next)) return;
+    if (j->caustic && !st.specular) return; /* no caustic can follow a diffuse bounce */
+    specular_path = specular_path && st.specular;
+    /* adjoint transport: undo the radiance scale across refraction, and correct for
+     * shading normals (Veach 1997, 5.3.2) */
+    w = c3_scale(w, st.eta_acc / eta_before);
+    vec3 wi = next.d;
+    float den = fabsf(v3_dot(wo, it.ng)) * fabsf(v3_dot(wi, fr.n));
+    float corr = den > 0 ? fabsf(v3_dot(wo, fr.n)) * fabsf(v3_dot(wi, it.ng)) / den : 0;
+    if (!st.specular || bsdf_transmits(&b)) w = c3_scale(w, fminf(corr, 10.0f));
+    rgb nb = c3_mul(beta, w);
+    float q = fminf(1.0f, c3_max(nb) / fmaxf(c3_max(beta), 1e-30f));
+    if (!(q > 0) || sampler_1d(&smp) >= q) return;
+    beta = c3_scale(nb, 1 / q);
+    if (!c3_finite(beta)) return;
+    r = next;
+  }
+}
+
+static void shoot_chunk(void *user, int64_t item, int thread) {
+  shoot_job *j = user;
+  chunk_buf *b = &j->bufs[item];
+  uint64_t lo = j->first + (uint64_t)item * CHUNK;
+  for (uint64_t i = lo; i < lo + CHUNK; i++) shoot_path(j, i, b, &j->ts[thread]);
+}
+
+/* Emits rounds of paths until map m holds `target` photons (or the emission cap). */
+static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, uint64_t target, uint64_t key, valo_error *err) {
+  map_free(m);
+  if (target == 0 || c->ls.table.n == 0) return VALO_OK;
+  thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
+  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  uint64_t emitted = 0, cap = target * MAX_EMIT_FACTOR;
+  if (cap < 65536) cap = 65536;
+  uint32_t n = 0, mcap = 0;
+  photon *all = NULL;
+  valo_status st = VALO_OK;
+  uint64_t round = 4 * CHUNK;
+  while (n < target && emitted < cap) {
+    int64_t chunks = (int64_t)((round + CHUNK - 1) / CHUNK);
+    chunk_buf *bufs = calloc((size_t)chunks, sizeof *bufs);
+    if (!bufs) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); break; }
+    shoot_job j = {c, caustic, emitted, key, bufs, ts};
+    parallel_for(c->threads, chunks, shoot_chunk, &j);
+    for (int64_t k = 0; k < chunks && st == VALO_OK; k++) {
+      if (bufs[k].oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for photons"); break; }
+      if (n + (uint64_t)bufs[k].n > mcap) {
+        uint64_t nc = mcap ? 2 * (uint64_t)mcap : 4096;
+        while (nc < n + (uint64_t)bufs[k].n) nc *= 2;
+        if (nc > UINT32_MAX / 2) { st = err_set(err, VALO_ERR_NOMEM, "too many photons"); break; }
+        photon *np = realloc(all, nc * sizeof *np);
+        if (!np) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for photons"); break; }
+        all = np;
+        mcap = (uint32_t)nc;
+      }
+      if (bufs[k].n) memcpy(all + n, bufs[k].ph, bufs[k].n * sizeof *all);
+      n += bufs[k].n;
+    }
+    for (int64_t k = 0; k < chunks; k++) free(bufs[k].ph);
+    free(bufs);
+    emitted += (uint64_t)chunks * CHUNK;
+    if (st) break;
+    /* next round: what the rate so far says reaches the target */
+    double rate = (double)n / (double)emitted;
+    double need = rate > 0 ? (double)(target - (n < target ? n : target)) / rate : (double)emitted * 4;
+    round = (uint64_t)need + CHUNK;
+    if (round > cap - (emitted < cap ? emitted : cap)) round = cap > emitted ? cap - emitted : CHUNK;
+  }
+  free(ts);
+  if (st) { free(all); return st; }
+  /* flux per path: beta / paths emitted */
+  float inv = 1.0f / (float)emitted;
+  for (uint32_t i = 0; i < n; i++) all[i].power = c3_scale(all[i].power, inv);
+  vec3 *pos = malloc((size_t)(n ? n : 1) * sizeof *pos);
+  if (!pos) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (uint32_t i = 0; i < n; i++) pos[i] = all[i].p;
+  int rc = point_tree_build(&m->tree, pos, n);
+  free(pos);
+  if (rc) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  /* photons in tree order */
+  m->ph = malloc((size_t)(n ? n : 1) * sizeof *m->ph);
+  if (!m->ph) { free(all); map_free(m); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (uint32_t i = 0; i < n; i++) m->ph[i] = all[m->tree.id[i]];
+  free(all);
+  m->n = n;
+  m->emitted = emitted;
+  return VALO_OK;
+}
+
+/* Irradiance at a radiance photon from its k nearest global photons on the same side. */
+typedef struct rad_job { const photon_state *ps; rad_map *rm; const uint32_t *src; int k; float r2max; } rad_job;
+static void rad_chunk(void *user, int64_t item, int thread) {
+  (void)thread;
+  rad_job *j = user;
+  const photon_map *m = &j->ps->global;
+  uint32_t lo = (uint32_t)item * 256, hi = lo + 256 < j->rm->n_pts ? lo + 256 : j->rm->n_pts;
+  point_near nb[POINT_KNN_MAX];
+  for (uint32_t i = lo; i < hi; i++) {
+    const photon *p = &m->ph[j->src[i]];
+    vec3 n = oct_unpack(p->nrm);
+    int cnt = point_tree_knn(&m->tree, p->p, j->k, j->r2max, n, SQUEEZE, nb);
+    float r2 = 0;
+    rgb E = c3(0, 0, 0);
+    for (int q = 0; q < cnt; q++) {
+      r2 = fmaxf(r2, nb[q].d2);
+      const photon *o = &m->ph[nb[q].i];
+      if (v3_dot(oct_unpack(o->dir), n) < 0) E = c3_add(E, o->power); /* arrived on the front side */
+    }
+    if (cnt < j->k) r2 = j->r2max;
+    j->rm->Lo[i] = r2 > 0 ? c3_scale(c3_mul(p->rho, E), 1 / (PI_F * PI_F * r2)) : c3(0, 0, 0);
+  }
+}
+
+static valo_status build_radiance_photons(photon_state *ps, const render_ctx *c, valo_error *err) {
+  rad_free(&ps->rad);
+  const photon_map *m = &ps->global;
+  uint32_t n = (m->n + RAD_STRIDE - 1) / RAD_STRIDE;
+  if (n == 0) return VALO_OK;
+  rad_map *rm = &ps->rad;
+  uint32_t *src = malloc(n * sizeof *src);
+  vec3 *pos = malloc(n * sizeof *pos);
+  rm->n = malloc(n * sizeof *rm->n);
+  rm->Lo = malloc(n * sizeof *rm->Lo);
+  if (!src || !pos || !rm->n || !rm->Lo) { free(src); free(pos); rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (uint32_t i = 0; i < n; i++) { src[i] = i * RAD_STRIDE; pos[i] = m->ph[src[i]].p; }
+  rm->n_pts = n;
+  rad_job j = {ps, rm, src, (int)c->param[P_K], ps->r2_global};
+  parallel_for(c->threads, (n + 255) / 256, rad_chunk, &j);
+  /* into tree order */
+  int rc = point_tree_build(&rm->tree, pos, n);
+  vec3 *nn = malloc(n * sizeof *nn);
+  rgb *lo = malloc(n * sizeof *lo);
+  if (rc || !nn || !lo) { free(src); free(pos); free(nn); free(lo); rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (uint32_t i = 0; i < n; i++) { nn[i] = oct_unpack(m->ph[src[rm->tree.id[i]]].nrm); lo[i] = rm->Lo[rm->tree.id[i]]; }
+  free(rm->n); free(rm->Lo);
+  rm->n = nn; rm->Lo = lo;
+  free(src); free(pos);
+  return VALO_OK;
+}
+
+/* The radiance photon nearest to p whose normal agrees with n. */
+static rgb radiance_lookup(const rad_map *rm, vec3 p, vec3 n, float r2max) {
+  if (rm->n_pts == 0) return c3(0, 0, 0);
+  point_near nb[8];
+  int cnt = point_tree_knn(&rm->tree, p, 8, r2max, n, SQUEEZE, nb);
+  int best = -1;
+  for (int i = 0; i < cnt; i++)
+    if (v3_dot(rm->n[nb[i].i], n) > 0.5f && (best < 0 || nb[i].d2 < nb[best].d2)) best = i;
+  return best < 0 ? c3(0, 0, 0) : rm->Lo[nb[best].i];
+}
+
+static valo_status photon_prepare(void *state, const render_ctx *c, int sample_index, valo_error *err) {
+  photon_state *ps = state;
+  uint64_t k = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + 0x70686f746f6eULL);
+  valo_status st = shoot_map(c, &ps->global, 0, (uint64_t)c->param[P_GLOBAL], k, err);
+  if (st) return st;
+  st = build_radiance_photons(ps, c, err);
+  if (st) return st;
+  if (!ps->has_specular) { map_free(&ps->caustic); return VALO_OK; }
+  return shoot_map(c, &ps->caustic, 1, (uint64_t)c->param[P_CAUSTIC], rng_mix64(k + 1), err);
+}
+
+/* ---- radiance estimate ---- */
+static rgb estimate(const photon_map *m, float r2max, int k, const isect *it, const bsdf *b, const frame *fr, vec3 wo) {
+  if (m->n == 0) return c3(0, 0, 0);
+  point_near nb[POINT_KNN_MAX];
+  int cnt = point_tree_knn(&m->tree, it->p, k, r2max, fr->n, SQUEEZE, nb);
+  if (cnt == 0) return c3(0, 0, 0);
+  float r2 = 0;
+  for (int i = 0; i < cnt; i++) r2 = fmaxf(r2, nb[i].d2);
+  if (cnt < k) r2 = r2max; /* fewer than k in the largest disc: its area */
+  vec3 wo_l = frame_to_local(fr, wo);
+  rgb sum = c3(0, 0, 0);
+  for (int i = 0; i < cnt; i++) {
+    const photon *ph = &m->ph[nb[i].i];
+    vec3 wi = v3_neg(oct_unpack(ph->dir));
+    /* photons that arrived at the other side of the (geometric) surface are not ours */
+    if (!bsdf_transmits(b) && v3_dot(wi, it->ng) <= 0) continue;
+    rgb f = bsdf_eval(b, wo_l, frame_to_local(fr, wi));
+    sum = c3_add(sum, c3_mul(f, ph->power));
+  }
+  return c3_scale(sum, 1 / (PI_F * r2));
+}
+
+/* Outgoing radiance at the hit of gather ray r from the global map, after up to 4 delta
+ * bounces. */
+static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, sampler *smp, thread_stats *ts) {
+  rgb beta = c3(1, 1, 1);
+  for (int depth = 0; depth < 5; depth++) {
+    hit h;
+    if (!ctx_intersect(c, &r, &h, ts)) return c3(0, 0, 0);
+    isect it;
+    isect_from_hit(c->s, &r, &h, &it);
+    bsdf b = bsdf_at(c->s, &it);
+    vec3 wo = v3_neg(r.d);
+    frame fr = shading_frame(&it, &b, wo);
+    if (bsdf_has_smooth(&b)) return c3_mul(beta, radiance_lookup(&ps->rad, it.p, fr.n, ps->r2_global));
+    path_state st = path_state_start(r.o);
+    rgb w;
+    if (!path_continue(&it, &b, &fr, wo, smp, &st, &w, &r)) return c3(0, 0, 0);
+    beta = c3_mul(beta, w);
+  }
+  return c3(0, 0, 0);
+}
+
+static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
+  const photon_state *ps = c->state;
+  const scene *s = c->s;
+  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
+  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
+  for (int depth = 0;; depth++) {
+    isect it;
+    rgb Le;
+    float w;
+    path_state st0 = path_state_start(r.o); /* emission along a delta chain counts fully */
+    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
+    L = c3_add(L, c3_mul(beta, Le));
+    if (!surface || depth >= max_depth) break;
+    vec3 wo = v3_neg(r.d);
+    bsdf b = bsdf_at(s, &it);
+    frame fr = shading_frame(&it, &b, wo);
+    if (bsdf_has_smooth(&b)) {
+      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
+      int n = (int)c->param[P_GATHER];
+      rgb Lx;
+      if (n == 0) {
+        /* no gathering (a quick preview): the global map's estimate of everything the
+         * surface reflects here, direct light and caustics included */
+        Lx = estimate(&ps->global, ps->r2_global, (int)c->param[P_K], &it, &b, &fr, wo);
+      } else {
+        rgb G = c3(0, 0, 0);
+        vec3 wo_l = frame_to_local(&fr, wo);
+        for (int g = 0; g < n; g++) {
+          /* gather ray g of sample i is point i n + g of one stratified stream */
+          sampler gs = sampler_child(smp, (uint32_t)g, (uint32_t)n);
+          bsdf_sample bs;
+          float ul = sampler_1d(&gs), u1, u2;
+          sampler_2d(&gs, &u1, &u2);
+          if (!bsdf_sample_dir(&b, wo_l, ul, u1, u2, &bs) || bs.delta) continue; /* delta lobes: the camera chain */
+          vec3 wi = v3_norm(frame_to_world(&fr, bs.wi));
+          int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it.ng) > 0) == (v3_dot(wo, it.ng) > 0);
+          if (refl_l != refl_g) continue;
+          rgb Li = gather_radiance(c, ps, spawn_ray(&it, wi), &gs, ts);
+          G = c3_add(G, c3_mul(bs.weight, Li));
+        }
+        Lx = estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts);
+        if (ps->caustic.n) Lx = c3_add(Lx, estimate(&ps->caustic, ps->r2_caustic, (int)c->param[P_K], &it, &b, &fr, wo));
+        Lx = c3_add(Lx, c3_scale(G, 1.0f / (float)n));
+      }
+      L = c3_add(L, c3_mul(beta, Lx));
+    }
+    /* delta lobes carry the camera path on; a non-delta sample ends it (its part is the
+     * estimate above) */
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
+    path_state st = path_state_start(r.o);
+    rgb wgt;
+    if (!path_continue(&it, &b, &fr, wo, smp, &st, &wgt, &r) || !st.specular) break;
+    beta = c3_mul(beta, wgt);
+    if (c3_black(beta) || !c3_finite(beta)) break;
+  }
+  return L;
+}
+
+const integrator_ops integrator_photon = {
+    "photon",
+    "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass",
+    photon_params, photon_li, photon_create, photon_prepare, photon_destroy};
