@@ -370,10 +370,54 @@ static int camera_rays_kdtree(void) {
   return rc ? 1 : skipped ? TEST_SKIP : 0;
 }
 
+/* Large triangles near a corner: a floor and a wall of 2 10^4 units meeting at x = 0;
+ * upward rays from floor points 0.005..0.1 from the wall hit the wall iff they head
+ * towards it, at t = x / |d.x|. Float's bound on t (10^-2 at these coordinates) used to
+ * reject 15 % of those hits as "maybe t <= 0"; the test now decides them in double. */
+static int large_triangles_corner(void) {
+  const float B = 10000;
+  vec3 pos[8] = {{0, 0, -B}, {B, 0, -B}, {B, 0, B}, {0, 0, B}, {0, -B, -B}, {0, -B, B}, {0, B, B}, {0, B, -B}};
+  uint32_t idx[12] = {0, 1, 2, 0, 2, 3, 4, 5, 6, 4, 6, 7};
+  const char *kinds[2] = {"kdtree", "embree"};
+  for (int k = 0; k < 2; k++) {
+    accel *a;
+    valo_error e;
+    if (accel_create(kinds[k], pos, idx, 4, 1, NULL, &a, &e)) {
+      CHECK(k == 1, "%s", e.message); /* embree is optional */
+      continue;
+    }
+    int bad = 0, hits = 0;
+    for (int i = 0; i < 100000; i++) {
+      sampler smp = sampler_make(5, 0, (uint64_t)i);
+      float u1, u2, ux = sampler_1d(&smp);
+      sampler_2d(&smp, &u1, &u2);
+      vec3 d = sample_cosine_hemisphere(u1, u2);
+      float x0 = 0.005f + 0.095f * ux;
+      ray r = {v3(x0, 1e-3f, 0), v3(d.x, d.z, d.y), INFINITY};
+      hit h;
+      int f = accel_intersect(a, &r, &h);
+      float tw = x0 / fabsf(r.d.x);
+      int want = r.d.x < 0 && fabsf(r.o.y + tw * r.d.y) < 0.999f * B && fabsf(tw * r.d.z) < 0.999f * B;
+      if (r.d.x < 0 && !want && (fabsf(r.o.y + tw * r.d.y) < 1.001f * B && fabsf(tw * r.d.z) < 1.001f * B)) continue; /* at the rim */
+      hits += f;
+      /* t itself carries float's error at 10^4 units: 2^-22 10^4 = 2.4e-3 */
+      if (f != want || (f && fabsf(h.t - tw) > 5e-3f)) {
+        if (bad++ < 5) fprintf(stderr, "%s: ray from x %g dir (%g %g %g): found %d t %g, expected %d t %g\n", kinds[k], x0, r.d.x, r.d.y,
+                               r.d.z, f, f ? h.t : 0, want, tw);
+      }
+    }
+    fprintf(stderr, "%s: %d of 100000 rays hit the wall, %d wrong\n", kinds[k], hits, bad);
+    accel_destroy(a);
+    CHECK(bad == 0, "%s: %d wrong", kinds[k], bad);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"bunny_kdtree", bunny_kdtree}, {"cornell_kdtree", cornell_kdtree},
                                     {"cornell_sphere_kdtree", cornell_sphere_kdtree}, {"suzanne_kdtree", suzanne_kdtree},
                                     {"axis_rays_kdtree", axis_rays_kdtree}, {"camera_rays_kdtree", camera_rays_kdtree},
-                                    {"bunny_embree", bunny_embree}, {"cornell_embree", cornell_embree}, {NULL, NULL}};
+                                    {"bunny_embree", bunny_embree}, {"cornell_embree", cornell_embree},
+                                    {"large_triangles_corner", large_triangles_corner}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

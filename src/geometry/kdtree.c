@@ -474,33 +474,47 @@ static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, uint32_t 
   if (!_mm_movemask_ps(hitm)) return 0;
   az = _mm_mul_ps(az, sz); bz = _mm_mul_ps(bz, sz); cz = _mm_mul_ps(cz, sz);
   __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)), _mm_mul_ps(w, cz));
-  /* det > 0: hit iff 0 < T <= tmax*det; det < 0: iff tmax*det <= T < 0. */
-  __m128 tdet = _mm_mul_ps(_mm_set1_ps(tmax), det);
-  __m128 dpos = _mm_cmpgt_ps(det, zero);
-  __m128 okp = _mm_and_ps(_mm_cmpgt_ps(T, zero), _mm_cmple_ps(T, tdet));
-  __m128 okn = _mm_and_ps(_mm_cmplt_ps(T, zero), _mm_cmpge_ps(T, tdet));
-  hitm = _mm_and_ps(hitm, _mm_or_ps(_mm_and_ps(dpos, okp), _mm_andnot_ps(dpos, okn)));
+  float dts[4];
+  /* t's error bound dt as tri_resolve_t computes it (same operations, lane-wise), so that
+   * lanes certainly behind the origin (t < -dt) or certainly beyond the nearest hit so far
+   * (t > dt and t >= tmax) are dropped here; the rest are decided lane by lane. */
+  {
+    __m128 absm = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+    __m128 inv4 = _mm_div_ps(_mm_set1_ps(1.0f), det), t4 = _mm_mul_ps(T, inv4);
+    __m128 mz = _mm_max_ps(_mm_max_ps(_mm_and_ps(az, absm), _mm_and_ps(bz, absm)), _mm_and_ps(cz, absm));
+    __m128 mx = _mm_max_ps(_mm_max_ps(_mm_and_ps(ax, absm), _mm_and_ps(bx, absm)), _mm_and_ps(cx, absm));
+    __m128 my = _mm_max_ps(_mm_max_ps(_mm_and_ps(ay, absm), _mm_and_ps(by, absm)), _mm_and_ps(cy, absm));
+    __m128 g2 = _mm_set1_ps(fp_gamma(2)), g3 = _mm_set1_ps(fp_gamma(3)), g5 = _mm_set1_ps(fp_gamma(5));
+    __m128 dz = _mm_mul_ps(g3, mz), dx = _mm_mul_ps(g5, _mm_add_ps(mx, mz)), dy = _mm_mul_ps(g5, _mm_add_ps(my, mz));
+    __m128 de = _mm_mul_ps(_mm_set1_ps(2), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g2, mx), my), _mm_mul_ps(dy, mx)), _mm_mul_ps(dx, my)));
+    __m128 me = _mm_max_ps(_mm_max_ps(_mm_and_ps(u, absm), _mm_and_ps(v, absm)), _mm_and_ps(w, absm));
+    __m128 dt = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(3), _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_mul_ps(g3, me), mz), _mm_mul_ps(de, mz)),
+                                                                  _mm_mul_ps(dz, me))),
+                           _mm_and_ps(inv4, absm));
+    __m128 behind = _mm_cmplt_ps(t4, _mm_sub_ps(_mm_setzero_ps(), dt));
+    __m128 beyond = _mm_and_ps(_mm_cmpgt_ps(t4, dt), _mm_cmpge_ps(t4, _mm_set1_ps(tmax)));
+    hitm = _mm_andnot_ps(_mm_or_ps(behind, beyond), hitm);
+    _mm_storeu_ps(dts, dt);
+  }
   int mask = _mm_movemask_ps(hitm);
   if (!mask) return 0;
   float Us[4], Vs[4], Ws[4], Ts[4], dets[4];
   _mm_storeu_ps(Us, u); _mm_storeu_ps(Vs, v); _mm_storeu_ps(Ws, w); _mm_storeu_ps(Ts, T); _mm_storeu_ps(dets, det);
-  float axs[4], ays[4], azs[4], bxs[4], bys[4], bzs[4], cxs[4], cys[4], czs[4];
-  _mm_storeu_ps(axs, ax); _mm_storeu_ps(ays, ay); _mm_storeu_ps(azs, az);
-  _mm_storeu_ps(bxs, bx); _mm_storeu_ps(bys, by); _mm_storeu_ps(bzs, bz);
-  _mm_storeu_ps(cxs, cx); _mm_storeu_ps(cys, cy); _mm_storeu_ps(czs, cz);
   int found = 0;
   for (int k = 0; k < 4; k++) {
     if (!(mask & (1 << k))) continue;
     float inv = 1.0f / dets[k];
     float t = Ts[k] * inv;
-    if (!(t < tmax) || !(t > 0)) continue;
-    /* Conservative t > 0, as in tri_intersect. */
-    float max_z = max3_abs(azs[k], bzs[k], czs[k]), max_x = max3_abs(axs[k], bxs[k], cxs[k]), max_y = max3_abs(ays[k], bys[k], cys[k]);
-    float dz = fp_gamma(3) * max_z, dx = fp_gamma(5) * (max_x + max_z), dy = fp_gamma(5) * (max_y + max_z);
-    float de = 2 * (fp_gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
-    float max_e = max3_abs(Us[k], Vs[k], Ws[k]);
-    float dt = 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
-    if (t <= dt) continue;
+    /* Conservative t > 0 exactly as tri_intersect decides it (double when float cannot
+     * tell), before comparing with the nearest hit so far: order-independent. */
+    if (!(t > dts[k])) {
+      if (t < -dts[k]) continue;
+      float tv[9];
+      for (int vtx = 0; vtx < 3; vtx++)
+        for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
+      if (!tri_t_double(s, tv, INFINITY, &t)) continue;
+    }
+    if (!(t < tmax)) continue;
     tmax = t;
     *t_out = t; *b1_out = Vs[k] * inv; *b2_out = Ws[k] * inv; *lane_out = k;
     found = 1;
@@ -568,7 +582,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
     uint32_t gi = n->prim_offset;
     const kd_tri4 *g = &kd->prims[gi];
     for (uint32_t i = 0; i < cnt; i += 4, g++, gi++) {
-      float t, b1, b2;
+      float t = 0, b1 = 0, b2 = 0;
       int lane;
       if (kd->has_filter && kd->gfilt[gi]) {
         /* Alpha-tested triangles: lane by lane, each hit through the filter. */
