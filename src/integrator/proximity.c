@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PROX_K 0.9f            /* fitted: see the comment at the top */
+#define PROX_K 0.79f           /* fitted: see the comment at the top (0.9 x 0.88) */
 #define PROX_MAX_POINTS 50000000u
 
 enum { P_SPACING, P_RADIUS, P_STRENGTH };
@@ -135,6 +135,8 @@ static void split(splat_ctx *c, vec3 a, vec3 b, vec3 t, vec3 n, float d, int dep
     split(c, m, b, t, n, d, depth + 1);
     return;
   }
+  float ratio = sqrtf(lab) / (2 * d);
+  if (ratio > c->sp->max_edge_ratio) c->sp->max_edge_ratio = ratio;
   place(c, v3_scale(v3_add(v3_add(a, b), t), 1.0f / 3.0f), n, d);
 }
 
@@ -224,7 +226,7 @@ static float prox_occlusion(const render_ctx *c, vec3 x, vec3 n, uint32_t tri) {
   const prox_state *ps = c->state;
   const shape_ao *sa = shape_ao_of(c->s, tri);
   float r = sa && sa->radius > 0 ? sa->radius : prox_radius(c);
-  float M = sa && sa->strength > 0 ? sa->strength : (float)c->param[P_STRENGTH];
+  float M = sa && sa->strength >= 0 ? sa->strength : (float)c->param[P_STRENGTH];
   prox_q q = {ps, x, n, 1 / (r * r), 1e-3f * r, 0};
   point_tree_radius(&ps->tree, x, r * r, prox_visit, &q);
   return M * PROX_K * q.T;

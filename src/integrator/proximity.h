@@ -8,6 +8,7 @@ typedef struct splat_points {
   vec3 *p, *n;      /* position and unit geometric normal (points stand for both sides) */
   float *area;      /* spacing^2 of the shape the point came from: its share of surface */
   uint32_t n_pts, cap;
+  float max_edge_ratio;  /* longest edge of a final (unsplit) triangle over its 2d: < 1 */
 } splat_points;
 
 /* Places points at spacing d(tri) on every triangle (deterministically, in triangle

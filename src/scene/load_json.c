@@ -400,7 +400,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   if (!cJSON_IsObject(px)) return bad(c, w2, "must be an object with spacing, radius, strength");
   static const char *const pkeys[] = {"spacing", "radius", "strength", NULL};
   TRY(check_keys(c, px, w2, pkeys));
-  double sp = 0, rad = 0, m = 0;
+  double sp = -1, rad = -1, m = -1; /* -1: not given, the integrator's parameter applies */
   TRY(get_num(c, px, "spacing", w2, 1e-9, 1e9, &sp));
   TRY(get_num(c, px, "radius", w2, 1e-9, 1e9, &rad));
   TRY(get_num(c, px, "strength", w2, 0, 1e9, &m));

@@ -64,8 +64,8 @@ typedef struct camera {
 /* Triangle flags. */
 enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
 
-/* Proximity-AO settings of one JSON shape (its triangles [first, end)); a value <= 0
- * takes the proximity-ao integrator's parameter. */
+/* Proximity-AO settings of one JSON shape (its triangles [first, end)); a negative
+ * value (not given) takes the proximity-ao integrator's parameter. */
 typedef struct shape_ao { uint32_t first, end; float spacing, radius, strength; } shape_ao;
 
 typedef struct scene {
