@@ -338,6 +338,30 @@ static int bad_options(void) {
   EXPECT_FAIL(2, "render", obj, "--focus", "0");
   SAID("--focus");
   EXPECT_FAIL(2, "dance");
+  /* integrator parameters: unknown, out of range, malformed, for no integrator */
+  EXPECT_FAIL(2, "render", obj, "--integrator", "photon", "--param", "globl=5", "--res", "4x4");
+  SAID("unknown parameter \"globl\" for the photon integrator"); SAID("global");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "photon", "--param", "k=0", "--res", "4x4");
+  SAID("photon.k=0");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "ao", "--param", "distance=far", "--res", "4x4");
+  SAID("ao.distance=far");
+  EXPECT_FAIL(2, "render", obj, "--param", "photn.k=3", "--res", "4x4");
+  SAID("no integrator \"photn\"");
+  EXPECT_FAIL(2, "render", obj, "--param", "k", "--res", "4x4");
+  SAID("NAME=VALUE");
+  /* in a scene file: an integrator's object of parameters, checked when rendering */
+  {
+    char json[512];
+    snprintf(json, sizeof json, "{ \"render\": {\"integrator\": \"photon\", \"photon\": {\"globl\": 3}}, \"shapes\": [{\"file\": \"ok.obj\"}] }");
+    EXPECT_FAIL(1, "render", write_file("params.json", json), "--res", "4x4");
+    SAID("unknown parameter \"globl\" for the photon integrator");
+    snprintf(json, sizeof json, "{ \"render\": {\"photon\": 5}, \"shapes\": [{\"file\": \"ok.obj\"}] }");
+    EXPECT_FAIL(1, "render", write_file("params2.json", json), "--res", "4x4");
+    SAID("unknown key \"photon\"");
+  }
+  /* a parameter for another integrator is ignored; a good one renders */
+  EXPECT_FAIL(0, "render", obj, "--integrator", "ao", "--param", "photon.k=3", "--param", "distance=0.5", "--res", "4x4", "--spp", "1", "-q",
+              "-o", write_file("p.png", ""));
   { const char *const none[] = {NULL}; CHECK(run_valo(none) == 2, "no arguments should be a usage error"); }
   return 0;
 }

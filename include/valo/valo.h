@@ -189,6 +189,10 @@ VALO_API const char *const *valo_integrator_names(void);
  * range, meaning), one per line, into buf (NUL-terminated, cut at n). Returns 0, or -1
  * for an unknown name. */
 VALO_API int valo_integrator_describe(const char *name, char *buf, size_t n);
+/* Checks parameter text (valo_options.params syntax) against integrator `name`'s table:
+ * VALO_OK, or VALO_ERR_INVALID with a message naming the entry (unknown integrator,
+ * unknown parameter, value not a number or out of range). Thread-safe. */
+VALO_API valo_status valo_integrator_check_params(const char *name, const char *params, valo_error *err);
 
 #ifdef __cplusplus
 }

@@ -351,6 +351,17 @@ static int cmd_render(int argc, char **argv) {
   if (opt.time_budget != VALO_UNSET && opt.spp == VALO_UNSET) opt.spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
   double load_s = now_seconds() - t0;
   valo_render *r = NULL;
+  if (opt.params[0]) {
+    /* --param entries are checked here, so that a mistyped one is a usage error */
+    valo_options fo;
+    valo_scene_file_options(sc, &fo);
+    const char *integ = opt.integrator[0] ? opt.integrator : fo.integrator[0] ? fo.integrator : "path";
+    if (valo_integrator_check_params(integ, opt.params, &err)) {
+      fprintf(stderr, "valo: --param: %s (valo render --help-integrators lists them)\n", err.message);
+      valo_scene_destroy(sc);
+      return EXIT_USAGE;
+    }
+  }
   if (valo_render_create(sc, &opt, &r, &err)) {
     fprintf(stderr, "valo: error: %s\n", err.message);
     valo_scene_destroy(sc);

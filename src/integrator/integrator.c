@@ -338,3 +338,11 @@ int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler 
 }
 
 float ao_ray_length(const scene *s, double d) { return d > 0 ? (float)d : 0.5f * s->radius; }
+
+VALO_API valo_status valo_integrator_check_params(const char *name, const char *params, valo_error *err) {
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  const integrator_ops *ops = integrator_find(name);
+  if (!ops) return err_set(err, VALO_ERR_INVALID, "unknown integrator \"%s\"", name);
+  double v[INTEGRATOR_MAX_PARAMS];
+  return integrator_params_parse(ops, params, v, 0, err);
+}
