@@ -366,6 +366,36 @@ static int bad_options(void) {
   return 0;
 }
 
+/* Every integrator parameter appears in docs/integrators.md (the docs list the same
+ * tables the code declares). */
+static int integrator_docs(void) {
+  FILE *f = fopen(VALO_SOURCE_DIR "/docs/integrators.md", "rb");
+  CHECK(f, "docs/integrators.md");
+  static char doc[200000];
+  size_t n = fread(doc, 1, sizeof doc - 1, f);
+  fclose(f);
+  doc[n] = 0;
+  int checked = 0;
+  for (const char *const *name = valo_integrator_names(); *name; name++) {
+    char buf[8192], heading[64];
+    CHECK(valo_integrator_describe(*name, buf, sizeof buf) == 0, "describe %s", *name);
+    snprintf(heading, sizeof heading, "## %s", *name);
+    CHECK(strstr(doc, heading), "docs/integrators.md has no section \"%s\"", heading);
+    /* lines "    integ.param = default ..." */
+    for (char *line = strtok(buf, "\n"); line; line = strtok(NULL, "\n")) {
+      char *dot = strchr(line, '.'), *eq = strstr(line, " = ");
+      if (strncmp(line, "    ", 4) || !dot || !eq || dot > eq) continue;
+      char want[96];
+      snprintf(want, sizeof want, "| `%.*s` |", (int)(eq - dot - 1), dot + 1);
+      CHECK(strstr(doc, want), "docs/integrators.md does not list %s's parameter %s", *name, want);
+      checked++;
+    }
+  }
+  fprintf(stderr, "%d parameters documented\n", checked);
+  CHECK(checked >= 10, "only %d parameters", checked);
+  return 0;
+}
+
 static int help_and_version(void) {
   EXPECT_FAIL(0, "--help");
   SAID("valo render SCENE");
@@ -430,7 +460,7 @@ int main(int argc, char **argv) {
                                     {"absurd_resolution", absurd_resolution},
                                     {"absurd_sample_count", absurd_sample_count},
                                     {"bad_options", bad_options},
-                                    {"help_and_version", help_and_version},
+                                    {"help_and_version", help_and_version}, {"integrator_docs", integrator_docs},
                                     {"unwritable_output", unwritable_output},
                                     {"render_ok", render_ok},
                                     {"sigint_writes_image", sigint_writes_image},

@@ -1,0 +1,240 @@
+/* bench_seed003.c — seed 003's methods measured side by side (docs/performance.md):
+ *  1. the seed's table: proximity-ao (splatting, kd-tree build, search, shading timed
+ *     apart) against ray-traced ao with 256 rays per pixel, on CornellBox-Original with
+ *     the Stanford bunny, Sponza and the dragon; each one's error against a converged ao
+ *     image (ao at 4096 rays; 1024 with --quick);
+ *  2. photon against path at equal time on CornellBox-Original (the Cycles reference) and
+ *     on scenes/caustic.json (tests/data/caustic-path.exr): relMSE against time.
+ * Usage: bench_seed003 [--quick] [--only ao|photon] */
+#include "valo/valo.h"
+#include "scene/scene.h"
+#include "geometry/accel.h"
+#include "geometry/pointtree.h"
+#include "integrator/proximity.h"
+#include "image/image_io.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#ifndef VALO_SHARED_DIR
+#define VALO_SHARED_DIR "../shared"
+#endif
+#ifndef VALO_SOURCE_DIR
+#define VALO_SOURCE_DIR "."
+#endif
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static const char *shared(void) { const char *r = getenv("VALO_SHARED"); return r && *r ? r : VALO_SHARED_DIR; }
+
+/* Renders scene file `path` with the integrator and spp; returns pixels and the
+ * wall-clock seconds of create + run. */
+static float *render(const char *path, const char *integ, int spp, const char *params, int w, int h, double *secs) {
+  valo_error err;
+  valo_scene *sc;
+  if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
+  valo_options o;
+  valo_options_init(&o);
+  snprintf(o.integrator, sizeof o.integrator, "%s", integ);
+  if (params) snprintf(o.params, sizeof o.params, "%s", params);
+  o.spp = spp;
+  o.width = w; o.height = h;
+  o.threads = 2;
+  o.seed = 5;
+  valo_render *r;
+  double t0 = now();
+  if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
+  *secs = now() - t0;
+  float *px = malloc((size_t)w * h * 3 * sizeof *px);
+  valo_render_pixels(r, px);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return px;
+}
+
+static double rmse(const float *a, const float *b, int n) {
+  double e = 0;
+  for (int i = 0; i < n; i++) e += (a[3 * i + 1] - b[3 * i + 1]) * (a[3 * i + 1] - b[3 * i + 1]);
+  return sqrt(e / n);
+}
+static double corr(const float *a, const float *b, int n) {
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
+  for (int i = 0; i < n; i++) {
+    double x = a[3 * i + 1], y = b[3 * i + 1];
+    sa += x; sb += y; saa += x * x; sbb += y * y; sab += x * y;
+  }
+  return (sab / n - sa / n * sb / n) / sqrt((saa / n - sa * sa / n / n) * (sbb / n - sb * sb / n / n));
+}
+
+typedef struct visit_count { uint64_t n; } visit_count;
+static void count_visit(void *u, uint32_t i, float d2) { (void)i; (void)d2; ((visit_count *)u)->n++; }
+
+/* The proximity-ao breakdown: splatting, tree build, camera rays and the range searches
+ * alone at the camera hits (the integrator's defaults: r = half the bounding radius,
+ * d = r / 8). */
+static void breakdown(const char *json_path, int w, int h, double *t_splat, double *t_build, double *t_search, uint32_t *npts, double *per_query) {
+  valo_error err;
+  scene *s = scene_new(json_path);
+  if (load_json(s, json_path, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return; }
+  float r = 0.5f * s->radius, d = r / 8;
+  splat_points sp;
+  double t0 = now();
+  splat_scene(s, d, 50000000, &sp);
+  *t_splat = now() - t0;
+  point_tree t;
+  t0 = now();
+  point_tree_build(&t, sp.p, sp.n_pts);
+  *t_build = now() - t0;
+  *npts = sp.n_pts;
+  accel *acc;
+  accel_create("kdtree", s->pos, s->idx, s->ntris, 2, NULL, &acc, &err);
+  camera c = scene_camera_fit(s, (float)w / (float)h);
+  vec3 fwd = v3_norm(v3_sub(c.look_at, c.pos)), right = v3_norm(v3_cross(fwd, c.up)), up = v3_cross(right, fwd);
+  float th = tanf(0.5f * c.fov_deg * 3.14159265f / 180), asp = (float)w / (float)h;
+  vec3 *hits = malloc((size_t)w * h * sizeof *hits);
+  int nh = 0;
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float sx = (2 * (x + 0.5f) / w - 1) * th * asp, sy = (1 - 2 * (y + 0.5f) / h) * th;
+      ray ry = {c.pos, v3_norm(v3_add(fwd, v3_add(v3_scale(right, sx), v3_scale(up, sy)))), INFINITY};
+      hit hh;
+      if (accel_intersect(acc, &ry, &hh)) hits[nh++] = v3_add(ry.o, v3_scale(ry.d, hh.t));
+    }
+  visit_count vc = {0};
+  t0 = now();
+  for (int i = 0; i < nh; i++) point_tree_radius(&t, hits[i], r * r, count_visit, &vc);
+  *t_search = now() - t0; /* one thread: the render uses two */
+  *per_query = nh ? (double)vc.n / nh : 0;
+  free(hits);
+  accel_destroy(acc);
+  point_tree_free(&t);
+  splat_free(&sp);
+  scene_free(s);
+}
+
+static int bench_ao(int quick) {
+  char cb[4096], sp[4096], dr[4096];
+  snprintf(cb, sizeof cb,
+           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"},\n"
+           "    {\"file\": \"%s/scenes/models/stanford-bunny.obj\", \"transform\": {\"scale\": [4, 4, 4], \"translate\": [0.1, -0.13, 0.2]}} ] }",
+           shared(), shared());
+  snprintf(sp, sizeof sp,
+           "{ \"camera\": {\"position\": [2.25067, 8.24132, -0.0492483], \"look_at\": [3.15037, 7.8048, -0.0501832], \"up\": [0.436514, 0.899693, -0.00291584], \"fov\": 70},\n"
+           "  \"shapes\": [ {\"file\": \"%s/scenes/sponza/sponza.obj\"} ] }", shared());
+  snprintf(dr, sizeof dr, "{ \"shapes\": [ {\"file\": \"%s/scenes/dragon/dragon_vrip.ply\"}, {\"file\": \"%s/floor.obj\"} ] }", shared(), ".");
+  FILE *f = fopen("floor.obj", "w");
+  if (!f) return 1;
+  /* the dragon's ground: a quad under it (the PLY's y runs 0.05 .. 0.2) */
+  fprintf(f, "v -0.3 0.0526 -0.2\nv 0.3 0.0526 -0.2\nv 0.3 0.0526 0.2\nv -0.3 0.0526 0.2\nf 1 4 3 2\n");
+  fclose(f);
+  const char *names[3] = {"CornellBox-Original + bunny", "Sponza", "dragon on a floor"};
+  const char *jsons[3] = {cb, sp, dr};
+  const int res[3][2] = {{256, 256}, {256, 144}, {256, 192}};
+  int conv = quick ? 1024 : 4096;
+  printf("## proximity-ao against ao (256 rays), 2 threads\n\n");
+  printf("| scene | points | splat s | build s | search s (1 thread) | points per search | proximity-ao s (1 spp, all) | ao 256 s | ao/proximity time | proximity RMSE | ao-256 RMSE | proximity correlation |\n");
+  printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (int i = 0; i < 3; i++) {
+    char path[64];
+    snprintf(path, sizeof path, "bench-ao-%d-%ld.json", i, (long)getpid());
+    f = fopen(path, "w");
+    if (!f) return 1;
+    fputs(jsons[i], f);
+    fclose(f);
+    int w = res[i][0], h = res[i][1];
+    double ts = 0, tb = 0, tq = 0, ppq = 0, t_prox = 0, t_ao = 0, t_ref = 0;
+    uint32_t np = 0;
+    breakdown(path, w, h, &ts, &tb, &tq, &np, &ppq);
+    float *px = render(path, "proximity-ao", 1, NULL, w, h, &t_prox);
+    float *ao = render(path, "ao", 256, NULL, w, h, &t_ao);
+    float *ref = render(path, "ao", conv, NULL, w, h, &t_ref);
+    remove(path);
+    if (!px || !ao || !ref) return 1;
+    printf("| %s | %u | %.3f | %.3f | %.3f | %.0f | %.3f | %.2f | %.1f | %.4f | %.4f | %.3f |\n", names[i], np, ts, tb, tq, ppq, t_prox, t_ao,
+           t_ao / t_prox, rmse(px, ref, w * h), rmse(ao, ref, w * h), corr(px, ref, w * h));
+    fflush(stdout);
+    free(px); free(ao); free(ref);
+  }
+  remove("floor.obj");
+  printf("\n(RMSE and correlation against ao at %d rays per pixel; proximity-ao's time includes splatting and the tree build.)\n\n", conv);
+  return 0;
+}
+
+static double relmse(const float *a, const float *b, int n) {
+  double e = 0;
+  for (int i = 0; i < 3 * n; i++) e += (a[i] - b[i]) * (a[i] - b[i]) / (b[i] * b[i] + 0.01);
+  return e / (3.0 * n);
+}
+
+static int bench_photon(int quick) {
+  char cb[2048];
+  snprintf(cb, sizeof cb,
+           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
+  char path[64];
+  snprintf(path, sizeof path, "bench-ph-%ld.json", (long)getpid());
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  fputs(cb, f);
+  fclose(f);
+  char refp[2048];
+  snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", shared());
+  const char *scenes[2] = {path, VALO_SOURCE_DIR "/scenes/caustic.json"};
+  const char *refs[2] = {refp, VALO_SOURCE_DIR "/tests/data/caustic-path.exr"};
+  const char *names[2] = {"CornellBox-Original 256x256", "caustic.json 128x128"};
+  const int wh[2] = {256, 128};
+  printf("## photon against path: relMSE against time, 2 threads\n\n");
+  for (int k = 0; k < 2; k++) {
+    image ref;
+    valo_error err;
+    if (image_read(refs[k], &ref, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
+    printf("### %s\n\n| integrator | spp | seconds | relMSE |\n|---|---|---|---|\n", names[k]);
+    const int pspp[4] = {4, 16, 64, 256}, fspp[4] = {1, 2, 4, 8};
+    double pt[4], pe[4], ft[4], fe[4];
+    int n = quick ? 3 : 4;
+    for (int i = 0; i < n; i++) {
+      float *px = render(scenes[k], "path", pspp[i], NULL, wh[k], wh[k], &pt[i]);
+      if (!px) return 1;
+      pe[i] = relmse(px, ref.rgb, wh[k] * wh[k]);
+      printf("| path | %d | %.2f | %.5f |\n", pspp[i], pt[i], pe[i]);
+      fflush(stdout);
+      free(px);
+    }
+    for (int i = 0; i < n; i++) {
+      float *px = render(scenes[k], "photon", fspp[i], NULL, wh[k], wh[k], &ft[i]);
+      if (!px) return 1;
+      fe[i] = relmse(px, ref.rgb, wh[k] * wh[k]);
+      printf("| photon | %d | %.2f | %.5f |\n", fspp[i], ft[i], fe[i]);
+      fflush(stdout);
+      free(px);
+    }
+    /* path is unbiased: relMSE ~ c / t; its error at photon's last time */
+    double c = pe[n - 1] * pt[n - 1], at = c / ft[n - 1];
+    printf("\nAt photon's %.1f s: path's relMSE (extrapolated as c/t) %.5f, photon %.5f: photon/path error %.2f.\n\n", ft[n - 1], at, fe[n - 1],
+           fe[n - 1] / at);
+    image_free(&ref);
+  }
+  remove(path);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  int quick = 0;
+  const char *only = NULL;
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--quick")) quick = 1;
+    else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else { fprintf(stderr, "usage: bench_seed003 [--quick] [--only ao|photon]\n"); return 2; }
+  }
+  if ((!only || !strcmp(only, "ao")) && bench_ao(quick)) return 1;
+  if ((!only || !strcmp(only, "photon")) && bench_photon(quick)) return 1;
+  return 0;
+}
