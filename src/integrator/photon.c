@@ -23,6 +23,7 @@
  * Biased (blur of the density estimate), consistent as the photon counts grow. */
 #include "integrator/integrator.h"
 #include "geometry/pointtree.h"
+#include "integrator/lightpath.h"
 #include "core/threadpool.h"
 #include "core/error.h"
 #include "core/sampling.h"
@@ -40,9 +41,6 @@ static const integrator_param photon_params[] = {
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 #define SQUEEZE 16.0f
-#define CHUNK 1024
-#define MAX_BOUNCES 64
-#define MAX_EMIT_FACTOR 64    /* a map gives up after emitting 64x its target in paths */
 
 /* A stored photon: 28 bytes that every estimate reads, plus the surface normal and
  * diffuse reflectance where it landed, which only the radiance-photon precomputation
@@ -136,134 +134,28 @@ static rgb diffuse_reflectance(const bsdf *b, const isect *it, const frame *fr) 
   return c3_scale(sum, 1.0f / 16);
 }
 
-/* ---- shooting ---- */
-typedef struct chunk_buf { photon *ph; uint32_t n, cap; int oom; } chunk_buf;
-typedef struct shoot_job {
-  const render_ctx *c;
-  int caustic;             /* 1: keep only L S+ D photons */
-  uint64_t first;          /* index of the round's first path */
-  uint64_t key;            /* per pass and map */
-  chunk_buf *bufs;         /* one per chunk of the round */
-  thread_stats *ts;
-} shoot_job;
-
-static void store(chunk_buf *b, vec3 p, rgb power, vec3 d, vec3 n, rgb rho) {
-  if (b->oom) return;
-  if (b->n == b->cap) {
-    uint32_t cap = b->cap ? 2 * b->cap : 256;
-    photon *np = realloc(b->ph, cap * sizeof *np);
-    if (!np) { b->oom = 1; return; }
-    b->ph = np;
-    b->cap = cap;
-  }
-  photon ph = {p, power, oct_pack(d), oct_pack(n), rho};
-  b->ph[b->n++] = ph;
+/* ---- shooting (lightpath.c) ---- */
+static int visit_global(void *user, const lp_vertex *v, void *rec) {
+  (void)user;
+  photon ph = {v->it->p, v->power, oct_pack(v->d), oct_pack(v->fr->n), diffuse_reflectance(v->b, v->it, v->fr)};
+  memcpy(rec, &ph, sizeof ph);
+  return 1;
+}
+static int visit_caustic(void *user, const lp_vertex *v, void *rec) {
+  if (!v->specular_path || v->depth == 0) return 0; /* L S+ D only */
+  return visit_global(user, v, rec);
 }
 
-static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, thread_stats *ts) {
-  const render_ctx *c = j->c;
-  const scene *s = c->s;
-  sampler smp = sampler_make_kind(j->key, 0, index, SAMPLER_SOBOL);
-  float ul = sampler_1d(&smp), u[4];
-  sampler_2d(&smp, &u[0], &u[1]);
-  sampler_2d(&smp, &u[2], &u[3]);
-  float pmf;
-  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
-  light_emit e;
-  if (!(pmf > 0) || !light_sample_emit(s, &s->lights[li], u, &e)) return;
-  rgb beta = c3_scale(e.beta, 1 / pmf);
-  ray r = {e.o, e.d, INFINITY};
-  if (s->lights[li].type == LIGHT_AREA) r.o = offset_origin(e.o, v3(0, 0, 0), e.n, e.d);
-  int specular_path = 1;
-  for (int depth = 0; depth < MAX_BOUNCES; depth++) {
-    hit h;
-    if (!ctx_intersect(c, &r, &h, ts)) return;
-    isect it;
-    isect_from_hit(s, &r, &h, &it);
-    bsdf b = bsdf_at(s, &it);
-    vec3 wo = v3_neg(r.d);
-    frame fr = shading_frame(&it, &b, wo);
-    if (bsdf_has_smooth(&b)) {
-      rgb rho = diffuse_reflectance(&b, &it, &fr);
-      if (!j->caustic) store(out, it.p, beta, r.d, fr.n, rho);
-      else if (specular_path && depth > 0) store(out, it.p, beta, r.d, fr.n, rho);
-    }
-    path_state st = path_state_start(r.o);
-    rgb w;
-    ray next;
-    float eta_before = st.eta_acc;
-    if (!path_continue(&it, &b, &fr, wo, &smp, &st, &w, &next)) return;
-    if (j->caustic && !st.specular) return; /* no caustic can follow a diffuse bounce */
-    specular_path = specular_path && st.specular;
-    /* adjoint transport: undo the radiance scale across refraction, and correct for
-     * shading normals (Veach 1997, 5.3.2) */
-    w = c3_scale(w, st.eta_acc / eta_before);
-    vec3 wi = next.d;
-    float den = fabsf(v3_dot(wo, it.ng)) * fabsf(v3_dot(wi, fr.n));
-    float corr = den > 0 ? fabsf(v3_dot(wo, fr.n)) * fabsf(v3_dot(wi, it.ng)) / den : 0;
-    if (!st.specular || bsdf_transmits(&b)) w = c3_scale(w, fminf(corr, 10.0f));
-    rgb nb = c3_mul(beta, w);
-    float q = fminf(1.0f, c3_max(nb) / fmaxf(c3_max(beta), 1e-30f));
-    if (!(q > 0) || sampler_1d(&smp) >= q) return;
-    beta = c3_scale(nb, 1 / q);
-    if (!c3_finite(beta)) return;
-    r = next;
-  }
-}
-
-static void shoot_chunk(void *user, int64_t item, int thread) {
-  shoot_job *j = user;
-  chunk_buf *b = &j->bufs[item];
-  uint64_t lo = j->first + (uint64_t)item * CHUNK;
-  for (uint64_t i = lo; i < lo + CHUNK; i++) shoot_path(j, i, b, &j->ts[thread]);
-}
-
-/* Emits rounds of paths until map m holds `target` photons (or the emission cap). */
+/* Shoots map m: `target` photons stored, powers divided by the paths emitted, the kd-tree
+ * built and the photons put in tree order. */
 static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, uint64_t target, uint64_t key, valo_error *err) {
   map_free(m);
-  if (target == 0 || c->ls.table.n == 0) return VALO_OK;
-  thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
-  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  uint64_t emitted = 0, cap = target * MAX_EMIT_FACTOR;
-  if (cap < 65536) cap = 65536;
-  uint32_t n = 0, mcap = 0;
-  photon *all = NULL;
-  valo_status st = VALO_OK;
-  uint64_t round = 4 * CHUNK;
-  while (n < target && emitted < cap) {
-    int64_t chunks = (int64_t)((round + CHUNK - 1) / CHUNK);
-    chunk_buf *bufs = calloc((size_t)chunks, sizeof *bufs);
-    if (!bufs) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); break; }
-    shoot_job j = {c, caustic, emitted, key, bufs, ts};
-    parallel_for(c->threads, chunks, shoot_chunk, &j);
-    for (int64_t k = 0; k < chunks && st == VALO_OK; k++) {
-      if (bufs[k].oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for photons"); break; }
-      if (n + (uint64_t)bufs[k].n > mcap) {
-        uint64_t nc = mcap ? 2 * (uint64_t)mcap : 4096;
-        while (nc < n + (uint64_t)bufs[k].n) nc *= 2;
-        if (nc > UINT32_MAX / 2) { st = err_set(err, VALO_ERR_NOMEM, "too many photons"); break; }
-        photon *np = realloc(all, nc * sizeof *np);
-        if (!np) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for photons"); break; }
-        all = np;
-        mcap = (uint32_t)nc;
-      }
-      if (bufs[k].n) memcpy(all + n, bufs[k].ph, bufs[k].n * sizeof *all);
-      n += bufs[k].n;
-    }
-    for (int64_t k = 0; k < chunks; k++) free(bufs[k].ph);
-    free(bufs);
-    emitted += (uint64_t)chunks * CHUNK;
-    if (st) break;
-    /* next round: what the rate so far says reaches the target */
-    double rate = (double)n / (double)emitted;
-    double need = rate > 0 ? (double)(target - (n < target ? n : target)) / rate : (double)emitted * 4;
-    round = (uint64_t)need + CHUNK;
-    if (round > cap - (emitted < cap ? emitted : cap)) round = cap > emitted ? cap - emitted : CHUNK;
-  }
-  free(ts);
-  if (st) { free(all); return st; }
-  /* flux per path: beta / paths emitted */
-  float inv = 1.0f / (float)emitted;
+  lp_set set;
+  valo_status st = lightpath_shoot(c, key, target, sizeof(photon), caustic, caustic ? visit_caustic : visit_global, NULL, &set, err);
+  if (st) return st;
+  photon *all = (photon *)set.rec;
+  uint32_t n = set.n;
+  float inv = set.emitted ? 1.0f / (float)set.emitted : 0;
   for (uint32_t i = 0; i < n; i++) all[i].power = c3_scale(all[i].power, inv);
   vec3 *pos = malloc((size_t)(n ? n : 1) * sizeof *pos);
   if (!pos) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
@@ -271,13 +163,12 @@ static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, ui
   int rc = point_tree_build(&m->tree, pos, n);
   free(pos);
   if (rc) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  /* photons in tree order */
   m->ph = malloc((size_t)(n ? n : 1) * sizeof *m->ph);
   if (!m->ph) { free(all); map_free(m); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   for (uint32_t i = 0; i < n; i++) m->ph[i] = all[m->tree.id[i]];
   free(all);
   m->n = n;
-  m->emitted = emitted;
+  m->emitted = set.emitted;
   return VALO_OK;
 }
 
