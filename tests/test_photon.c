@@ -127,7 +127,7 @@ static int photon_caustic(void) {
     if (lum[i] > 3 * med) { sa += img[3 * i + 1]; sb += ref.rgb[3 * i + 1]; n++; }
   fprintf(stderr, "caustic: %d pixels above 3x the median %.3f; photon %.4f, path reference %.4f (ratio %.3f)\n", n, med, sa / n, sb / n, sa / sb);
   CHECK(n > 100, "caustic region of %d pixels", n);
-  CHECK(fabs(sa / sb - 1) < 0.10, "caustic brightness off by %.1f%%", 100 * fabs(sa / sb - 1));
+  CHECK(fabs(sa / sb - 1) < 0.05, "caustic brightness off by %.1f%%", 100 * fabs(sa / sb - 1));
   free(lum); free(sorted); free(img);
   image_free(&ref);
   return 0;

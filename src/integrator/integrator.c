@@ -10,10 +10,10 @@
 #include <math.h>
 
 extern const integrator_ops integrator_path, integrator_whitted, integrator_distribution, integrator_ao,
-    integrator_proximity_ao, integrator_photon;
+    integrator_proximity_ao, integrator_photon, integrator_vpl, integrator_vsl;
 static const integrator_ops *const registry[] = {&integrator_path, &integrator_whitted, &integrator_distribution, &integrator_photon,
-                                                 &integrator_ao, &integrator_proximity_ao, NULL};
-static const char *const names[] = {"path", "whitted", "distribution", "photon", "ao", "proximity-ao", NULL};
+                                                 &integrator_vpl, &integrator_vsl, &integrator_ao, &integrator_proximity_ao, NULL};
+static const char *const names[] = {"path", "whitted", "distribution", "photon", "vpl", "vsl", "ao", "proximity-ao", NULL};
 
 const integrator_ops *integrator_find(const char *name) {
   for (int i = 0; registry[i]; i++)

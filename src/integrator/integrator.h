@@ -151,6 +151,11 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
  * survival, 0 to end the path. */
 float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp);
 
+/* The path tracer's estimate (path.c) of the radiance arriving along r; without
+ * count_first_emission, the emission of the surface r hits first is left out (what that
+ * surface reflects: bias compensation in vpl.c). */
+rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission);
+
 /* Ambient occlusion (digest 003, ao.c): one cosine-weighted ray about the normal n
  * (faced to the viewer) from it, up to length dist. Returns 1 when it escapes (the
  * direction is then *dir), 0 when something is within dist. */

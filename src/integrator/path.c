@@ -7,7 +7,7 @@
 #include "integrator/integrator.h"
 #include "core/sampling.h"
 
-static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
+rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
   const scene *s = c->s;
   rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
   path_state st = path_state_start(r.o); /* camera rays count emission fully */
@@ -17,7 +17,7 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
     rgb Le;
     float w;
     int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
-    if (!c3_black(Le)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
+    if (!c3_black(Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
     if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
 
@@ -38,6 +38,8 @@ static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   }
   return L;
 }
+
+static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return path_radiance(c, r, smp, ts, 1); }
 
 const integrator_ops integrator_path = {
     "path", "unidirectional path tracing with next-event estimation, MIS and Russian roulette", NULL, path_li, NULL, NULL, NULL};
