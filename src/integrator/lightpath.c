@@ -13,7 +13,7 @@
 typedef struct chunk_buf { unsigned char *rec; uint32_t n, cap; int oom; } chunk_buf;
 typedef struct shoot_job {
   const render_ctx *c;
-  uint64_t first, key;
+  uint64_t first, end, key;
   size_t rec_size;
   int only_specular;
   lp_visit_fn visit;
@@ -88,8 +88,37 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
 static void shoot_chunk(void *user, int64_t item, int thread) {
   shoot_job *j = user;
   chunk_buf *b = &j->bufs[item];
-  uint64_t lo = j->first + (uint64_t)item * CHUNK;
-  for (uint64_t i = lo; i < lo + CHUNK; i++) shoot_path(j, i, b, &j->ts[thread]);
+  uint64_t lo = j->first + (uint64_t)item * CHUNK, hi = lo + CHUNK < j->end ? lo + CHUNK : j->end;
+  for (uint64_t i = lo; i < hi; i++) shoot_path(j, i, b, &j->ts[thread]);
+}
+
+/* Shoots paths [first, first + npaths) and appends their records to *all (n of cap). */
+static valo_status shoot_round(const render_ctx *c, uint64_t key, uint64_t first, uint64_t npaths, size_t rec_size, int only_specular,
+                               lp_visit_fn visit, void *user, thread_stats *ts, unsigned char **all, uint64_t *n, uint64_t *mcap,
+                               valo_error *err) {
+  int64_t chunks = (int64_t)((npaths + CHUNK - 1) / CHUNK);
+  chunk_buf *bufs = calloc((size_t)(chunks ? chunks : 1), sizeof *bufs);
+  if (!bufs) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  shoot_job j = {c, first, first + npaths, key, rec_size, only_specular, visit, user, bufs, ts};
+  parallel_for(c->threads, chunks, shoot_chunk, &j);
+  valo_status st = VALO_OK;
+  for (int64_t k = 0; k < chunks && st == VALO_OK; k++) {
+    if (bufs[k].oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for light paths"); break; }
+    if (*n + bufs[k].n > *mcap) {
+      uint64_t nc = *mcap ? 2 * *mcap : 4096;
+      while (nc < *n + bufs[k].n) nc *= 2;
+      if (nc > UINT32_MAX / 2) { st = err_set(err, VALO_ERR_NOMEM, "too many light-path records"); break; }
+      unsigned char *np = realloc(*all, nc * rec_size);
+      if (!np) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for light paths"); break; }
+      *all = np;
+      *mcap = nc;
+    }
+    if (bufs[k].n) memcpy(*all + *n * rec_size, bufs[k].rec, (size_t)bufs[k].n * rec_size);
+    *n += bufs[k].n;
+  }
+  for (int64_t k = 0; k < chunks; k++) free(bufs[k].rec);
+  free(bufs);
+  return st;
 }
 
 valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
@@ -105,28 +134,9 @@ valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, 
   valo_status st = VALO_OK;
   uint64_t round = 4 * CHUNK;
   while (n < target && emitted < cap) {
-    int64_t chunks = (int64_t)((round + CHUNK - 1) / CHUNK);
-    chunk_buf *bufs = calloc((size_t)chunks, sizeof *bufs);
-    if (!bufs) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); break; }
-    shoot_job j = {c, emitted, key, rec_size, only_specular, visit, user, bufs, ts};
-    parallel_for(c->threads, chunks, shoot_chunk, &j);
-    for (int64_t k = 0; k < chunks && st == VALO_OK; k++) {
-      if (bufs[k].oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for light paths"); break; }
-      if (n + bufs[k].n > mcap) {
-        uint64_t nc = mcap ? 2 * mcap : 4096;
-        while (nc < n + bufs[k].n) nc *= 2;
-        if (nc > UINT32_MAX / 2) { st = err_set(err, VALO_ERR_NOMEM, "too many light-path records"); break; }
-        unsigned char *np = realloc(all, nc * rec_size);
-        if (!np) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for light paths"); break; }
-        all = np;
-        mcap = nc;
-      }
-      if (bufs[k].n) memcpy(all + n * rec_size, bufs[k].rec, (size_t)bufs[k].n * rec_size);
-      n += bufs[k].n;
-    }
-    for (int64_t k = 0; k < chunks; k++) free(bufs[k].rec);
-    free(bufs);
-    emitted += (uint64_t)chunks * CHUNK;
+    round = (round + CHUNK - 1) / CHUNK * CHUNK;
+    st = shoot_round(c, key, emitted, round, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
+    emitted += round;
     if (st) break;
     /* next round: what the rate so far says reaches the target */
     double rate = (double)n / (double)emitted;
@@ -139,5 +149,22 @@ valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, 
   out->rec = all;
   out->n = (uint32_t)n;
   out->emitted = emitted;
+  return VALO_OK;
+}
+
+valo_status lightpath_shoot_paths(const render_ctx *c, uint64_t key, uint64_t npaths, size_t rec_size, lp_visit_fn visit, void *user,
+                                  lp_set *out, valo_error *err) {
+  memset(out, 0, sizeof *out);
+  if (npaths == 0 || c->ls.table.n == 0) return VALO_OK;
+  thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
+  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  uint64_t n = 0, mcap = 0;
+  unsigned char *all = NULL;
+  valo_status st = shoot_round(c, key, 0, npaths, rec_size, 0, visit, user, ts, &all, &n, &mcap, err);
+  free(ts);
+  if (st) { free(all); return st; }
+  out->rec = all;
+  out->n = (uint32_t)n;
+  out->emitted = npaths;
   return VALO_OK;
 }

@@ -2,9 +2,10 @@
  * (photon mapping, instant radiosity): paths leave the lights in proportion to power,
  * driven by an Owen-scrambled Sobol sequence over the path index, and are carried on by
  * BSDF sampling in adjoint form with Russian roulette; at every surface with a non-delta
- * lobe the caller's visit function may store a record. Paths are shot in rounds of fixed
- * chunks until `target` records are stored (or 64x target paths were tried), each chunk's
- * records concatenated in chunk order: the same set for any thread count. */
+ * lobe the caller's visit function may store a record. Paths are shot in fixed chunks,
+ * each chunk's records concatenated in chunk order: the same set for any thread count;
+ * either in rounds until `target` records are stored (or 64x target paths were tried:
+ * photon maps), or exactly a given number of paths (virtual point lights). */
 #ifndef VALO_LIGHTPATH_H
 #define VALO_LIGHTPATH_H
 #include "integrator/integrator.h"
@@ -29,4 +30,8 @@ typedef struct lp_set { unsigned char *rec; uint32_t n; uint64_t emitted; } lp_s
  * out->emitted. out->rec is malloc'd (free it). */
 valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
                             void *user, lp_set *out, valo_error *err);
+/* Shoots exactly npaths paths (all their records kept): for estimators that must stay
+ * unbiased, where a stopping rule on the records stored would not. */
+valo_status lightpath_shoot_paths(const render_ctx *c, uint64_t key, uint64_t npaths, size_t rec_size, lp_visit_fn visit, void *user,
+                                  lp_set *out, valo_error *err);
 #endif

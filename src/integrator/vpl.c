@@ -41,7 +41,7 @@ typedef struct vpl {
   float radius;     /* vsl: the sphere's radius */
 } vpl;
 
-typedef struct vpl_state { vpl *v; uint32_t n; int spherical; float c; } vpl_state;
+typedef struct vpl_state { vpl *v; uint32_t n; int spherical; float c; uint64_t paths; } vpl_state;
 
 enum { P_COUNT, P_CLAMP, P_COMPENSATE };
 static const integrator_param vpl_params[] = {
@@ -103,7 +103,17 @@ static valo_status vpl_prepare(void *state, const render_ctx *c, int sample_inde
   vs->n = 0;
   uint64_t key = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + 0x76706c73ULL);
   lp_set set;
-  valo_status st = lightpath_shoot(c, key, (uint64_t)c->param[0], sizeof(vpl), 0, visit, NULL, &set, err);
+  if (vs->paths == 0) {
+    /* How many paths give `count` lights: measured once on a pilot set of its own (so the
+     * number of paths does not depend on the paths used: the estimate stays unbiased). */
+    valo_status st = lightpath_shoot_paths(c, rng_mix64(c->seed + 0x70696c6f74ULL), 16384, sizeof(vpl), visit, NULL, &set, err);
+    if (st) return st;
+    free(set.rec);
+    double per_path = set.emitted ? (double)set.n / (double)set.emitted : 0;
+    vs->paths = per_path > 0 ? (uint64_t)ceil(c->param[0] / per_path) : (uint64_t)c->param[0];
+    if (vs->paths < 1) vs->paths = 1;
+  }
+  valo_status st = lightpath_shoot_paths(c, key, vs->paths, sizeof(vpl), visit, NULL, &set, err);
   if (st) return st;
   vs->v = (vpl *)set.rec;
   vs->n = set.n;
