@@ -43,16 +43,18 @@ typedef struct vpl {
 
 typedef struct vpl_state { vpl *v; uint32_t n; int spherical; float c; uint64_t paths; } vpl_state;
 
-enum { P_COUNT, P_CLAMP, P_COMPENSATE };
+enum { P_COUNT, P_DIRECT, P_CLAMP, P_COMPENSATE };
 static const integrator_param vpl_params[] = {
     {"count", IPARAM_INT, 1024, 1, 1e6, "virtual point lights per pass (each costs one shadow ray per camera sample)"},
+    {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample (cheap beside the lights' shadow rays)"},
     {"clamp", IPARAM_FLOAT, 0.1, 0, 10,
      "clamping distance as a fraction of the scene's bounding-sphere radius R: G f_r is limited to 1 / (clamp R)^2; 0 = no clamping"},
     {"compensate", IPARAM_INT, 0, 0, 1, "1: add back what clamping removed by path tracing (Kollig & Keller 2004): unbiased"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
-enum { S_COUNT, S_RADIUS, S_K, S_CONE };
+enum { S_COUNT, S_DIRECT, S_RADIUS, S_K, S_CONE };
 static const integrator_param vsl_params[] = {
     {"count", IPARAM_INT, 1024, 1, 1e6, "virtual spherical lights per pass"},
+    {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample"},
     {"radius", IPARAM_FLOAT, 0, 0, 1e30, "sphere radius in scene units; 0 = automatic, the distance to the k-th nearest light"},
     {"k", IPARAM_INT, 10, 1, 256, "which nearest light sets the automatic radius"},
     {"cone_samples", IPARAM_INT, 1, 1, 64, "directions sampled in the cone per light and camera sample"},
@@ -214,6 +216,7 @@ static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, con
 static rgb compensate(const render_ctx *c, const vpl_state *vs, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                       thread_stats *ts) {
   sampler cs = sampler_child(smp, 0, 1);
+  sampler_set_dim(&cs, SDIM_EXTRA);
   bsdf_sample bs;
   vec3 wo_l = frame_to_local(fr, wo);
   float ul = sampler_1d(&cs), u1, u2;
@@ -258,8 +261,16 @@ static rgb vpl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
     bsdf b = bsdf_at(s, &it);
     frame fr = shading_frame(&it, &b, wo);
     if (bsdf_has_smooth(&b)) {
-      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-      rgb Lx = estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts);
+      /* direct light: `direct` next-event samples, stratified together across the
+       * pixel's samples (the same parameter index in both tables) */
+      int nd = (int)c->param[P_DIRECT];
+      rgb Lx = c3(0, 0, 0);
+      for (int k = 0; k < nd; k++) {
+        sampler ds = sampler_child(smp, (uint32_t)k, (uint32_t)nd);
+        sampler_set_dim(&ds, sdim_bounce(depth, SDIM_LIGHT_PICK));
+        Lx = c3_add(Lx, estimate_direct_nomis(c, &it, &b, &fr, wo, &ds, ts));
+      }
+      Lx = c3_scale(Lx, 1.0f / (float)nd);
       Lx = c3_add(Lx, gather(c, vs, &it, &b, &fr, wo, smp, ts));
       if (!vs->spherical && vs->c > 0 && c->param[P_COMPENSATE] > 0) Lx = c3_add(Lx, compensate(c, vs, &it, &b, &fr, wo, smp, ts));
       L = c3_add(L, c3_mul(beta, Lx));

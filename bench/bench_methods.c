@@ -1,11 +1,14 @@
-/* bench_seed003.c — seed 003's methods measured side by side (docs/performance.md):
+/* bench_methods.c — the seeds' methods measured side by side (docs/performance.md):
  *  1. the seed's table: proximity-ao (splatting, kd-tree build, search, shading timed
  *     apart) against ray-traced ao with 256 rays per pixel, on CornellBox-Original with
  *     the Stanford bunny, Sponza and the dragon; each one's error against a converged ao
  *     image (ao at 4096 rays; 1024 with --quick);
  *  2. photon against path at equal time on CornellBox-Original (the Cycles reference) and
- *     on scenes/caustic.json (tests/data/caustic-path.exr): relMSE against time.
- * Usage: bench_seed003 [--quick] [--only ao|photon] */
+ *     on scenes/caustic.json (tests/data/caustic-path.exr): relMSE against time;
+ *  3. seed 002's many-light methods: path, vpl (clamped; compensated) and vsl with equal
+ *     time budgets on CornellBox-Original and scenes/cornell-glossy.json
+ *     (tests/data/cornell-glossy-path.exr, 64x64), relMSE at each budget.
+ * Usage: bench_methods [--quick] [--only ao|photon|manylight] */
 #include "valo/valo.h"
 #include "scene/scene.h"
 #include "geometry/accel.h"
@@ -36,7 +39,7 @@ static const char *shared(void) { const char *r = getenv("VALO_SHARED"); return 
 
 /* Renders scene file `path` with the integrator and spp; returns pixels and the
  * wall-clock seconds of create + run. */
-static float *render(const char *path, const char *integ, int spp, const char *params, int w, int h, double *secs) {
+static float *render_budget(const char *path, const char *integ, int spp, double budget, const char *params, int w, int h, double *secs) {
   valo_error err;
   valo_scene *sc;
   if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
@@ -45,6 +48,7 @@ static float *render(const char *path, const char *integ, int spp, const char *p
   snprintf(o.integrator, sizeof o.integrator, "%s", integ);
   if (params) snprintf(o.params, sizeof o.params, "%s", params);
   o.spp = spp;
+  if (budget > 0) o.time_budget = budget;
   o.width = w; o.height = h;
   o.threads = 2;
   o.seed = 5;
@@ -57,6 +61,10 @@ static float *render(const char *path, const char *integ, int spp, const char *p
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   return px;
+}
+
+static float *render(const char *path, const char *integ, int spp, const char *params, int w, int h, double *secs) {
+  return render_budget(path, integ, spp, 0, params, w, h, secs);
 }
 
 static double rmse(const float *a, const float *b, int n) {
@@ -226,15 +234,70 @@ static int bench_photon(int quick) {
   return 0;
 }
 
+static int bench_manylight(int quick) {
+  char cb[2048];
+  snprintf(cb, sizeof cb,
+           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+           "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
+  char path[64];
+  snprintf(path, sizeof path, "bench-ml-%ld.json", (long)getpid());
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  fputs(cb, f);
+  fclose(f);
+  char refp[2048];
+  snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", shared());
+  const char *scenes[2] = {path, VALO_SOURCE_DIR "/scenes/cornell-glossy.json"};
+  const char *refs[2] = {refp, VALO_SOURCE_DIR "/tests/data/cornell-glossy-path.exr"};
+  const char *names[2] = {"CornellBox-Original 256x256", "cornell-glossy.json 64x64"};
+  const int wh[2] = {256, 64};
+  const struct { const char *integ, *params, *label; } m[5] = {
+      {"path", "", "path"},
+      {"vpl", "count=64 direct=8", "vpl (clamp 0.1)"},
+      {"vpl", "count=64 direct=8 clamp=0.3", "vpl (clamp 0.3)"},
+      {"vpl", "count=64 direct=8 clamp=0.3 compensate=1", "vpl (clamp 0.3, compensated)"},
+      {"vsl", "count=64 direct=8", "vsl"}};
+  const double budgets[3] = {2.5, 10, 40};
+  int nb = quick ? 2 : 3;
+  printf("## Many-light methods against path at equal time (2 threads; relMSE against the reference)\n\n");
+  for (int k = 0; k < 2; k++) {
+    image ref;
+    valo_error err;
+    if (image_read(refs[k], &ref, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
+    printf("### %s\n\n| method |", names[k]);
+    for (int b = 0; b < nb; b++) printf(" %.1f s |", budgets[b]);
+    printf("\n|---|");
+    for (int b = 0; b < nb; b++) printf("---|");
+    printf("\n");
+    for (int i = 0; i < 5; i++) {
+      printf("| %s |", m[i].label);
+      for (int b = 0; b < nb; b++) {
+        double t;
+        float *px = render_budget(scenes[k], m[i].integ, 1000000, budgets[b], m[i].params, wh[k], wh[k], &t);
+        if (!px) return 1;
+        printf(" %.5f |", relmse(px, ref.rgb, wh[k] * wh[k]));
+        fflush(stdout);
+        free(px);
+      }
+      printf("\n");
+    }
+    printf("\n");
+    image_free(&ref);
+  }
+  remove(path);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   int quick = 0;
   const char *only = NULL;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else { fprintf(stderr, "usage: bench_seed003 [--quick] [--only ao|photon]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_methods [--quick] [--only ao|photon|manylight]\n"); return 2; }
   }
   if ((!only || !strcmp(only, "ao")) && bench_ao(quick)) return 1;
   if ((!only || !strcmp(only, "photon")) && bench_photon(quick)) return 1;
+  if ((!only || !strcmp(only, "manylight")) && bench_manylight(quick)) return 1;
   return 0;
 }
