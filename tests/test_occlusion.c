@@ -153,7 +153,7 @@ static int proximity_splatting(void) {
   CHECK(point_tree_build(&t, a.p, a.n_pts) == 0, "tree");
   int close = 0;
   for (uint32_t i = 0; i < t.n; i++) {
-    float sp = sqrtf(a.area[t.id[i]]);
+    float sp = a.spacing[t.id[i]];
     near_acc acc = {i, 0};
     point_tree_radius(&t, t.p[i], 0.25f * sp * sp * 0.999f, near_visit, &acc);
     close += acc.close;

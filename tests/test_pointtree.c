@@ -21,6 +21,18 @@ static void rad_visit(void *user, uint32_t i, float d2) {
   a->id_sum += a->t->id[i];
 }
 
+/* half-space visits: the callback filters to the points in front (as proximity-ao does) */
+static const vec3 *g_hs_pts;
+static vec3 g_hs_q, g_hs_n;
+static float g_hs_eps;
+static void hs_visit(void *user, uint32_t i, float d2) {
+  rad_acc *a = user;
+  vec3 v = v3_sub(a->t->p[i], g_hs_q);
+  if (!(v3_dot(v, g_hs_n) > g_hs_eps)) return;
+  (void)g_hs_pts;
+  rad_visit(user, i, d2);
+}
+
 static float metric(vec3 p, vec3 q, vec3 n, float f) {
   vec3 v = v3_sub(p, q);
   float dn = v3_dot(v, n);
@@ -52,7 +64,8 @@ static int queries_match_brute_force(void) {
   free(seen);
   float *bd = malloc(NP * sizeof *bd), got[64], want[64];
   point_near out[64];
-  int bad_knn = 0, bad_rad = 0;
+  int bad_knn = 0, bad_rad = 0, bad_hs = 0;
+  g_hs_pts = pts;
   for (int qi = 0; qi < NQ; qi++) {
     vec3 q = v3(rnd(&s) * 1.2f - 0.1f, rnd(&s) * 1.2f - 0.1f, rnd(&s) * 1.2f - 0.1f);
     int k = 1 + (int)(rnd(&s) * 40);
@@ -85,10 +98,22 @@ static int queries_match_brute_force(void) {
     for (int i = 0; i < NP; i++)
       if (v3_len2(v3_sub(pts[i], q)) < rr) { bc++; bid += (uint64_t)i; }
     if (bc != a.count || bid != a.id_sum) bad_rad++;
+    /* the same in front of a plane through q */
+    float eps = qi % 3 == 0 ? 0 : 1e-3f;
+    rad_acc hsa = {0, 0, &t, 0};
+    g_hs_q = q; g_hs_n = n; g_hs_eps = eps;
+    point_tree_radius_halfspace(&t, q, rr, n, eps, hs_visit, &hsa);
+    bc = 0; bid = 0;
+    for (int i = 0; i < NP; i++) {
+      vec3 v = v3_sub(pts[i], q);
+      if (v3_len2(v) < rr && v3_dot(v, n) > eps) { bc++; bid += (uint64_t)i; }
+    }
+    /* the visitor gets the sphere's points of unpruned subtrees: count those in front */
+    if (bc != hsa.count || bid != hsa.id_sum) bad_hs++;
   }
   free(bd);
-  fprintf(stderr, "%d queries: %d k-nearest and %d radius mismatches\n", NQ, bad_knn, bad_rad);
-  CHECK(bad_knn == 0 && bad_rad == 0, "mismatches");
+  fprintf(stderr, "%d queries: %d k-nearest, %d radius and %d half-space radius mismatches\n", NQ, bad_knn, bad_rad, bad_hs);
+  CHECK(bad_knn == 0 && bad_rad == 0 && bad_hs == 0, "mismatches");
   point_tree_free(&t);
   /* an empty tree answers nothing */
   CHECK(point_tree_build(&t, pts, 0) == 0, "empty build");

@@ -52,6 +52,8 @@ int point_tree_build(point_tree *t, const vec3 *pts, uint32_t n) {
   if (n) memcpy(t->p, pts, (size_t)n * sizeof *pts);
   for (uint32_t i = 0; i < n; i++) t->id[i] = i;
   t->n = n;
+  t->bounds = bbox_empty();
+  for (uint32_t i = 0; i < n; i++) t->bounds = bbox_add(t->bounds, pts[i]);
   build(t, 0, n);
   return 0;
 }
@@ -136,4 +138,37 @@ static void rad_rec(const point_tree *t, const rad_q *s, uint32_t lo, uint32_t h
 void point_tree_radius(const point_tree *t, vec3 q, float r2, point_visit_fn fn, void *user) {
   rad_q s = {q, r2, fn, user};
   rad_rec(t, &s, 0, t->n);
+}
+
+/* The radius query restricted to the half-space (p - q).n > eps, pruning subtrees by
+ * their boxes (kept from the split planes on the way down): outside the sphere, or all
+ * on or behind the plane. Proximity-AO's points on the shaded surface itself (coplanar:
+ * most of what a plain radius query finds on a wall) are never visited. */
+typedef struct hs_q { vec3 q, n; float r2, eps; point_visit_fn fn; void *user; } hs_q;
+static void hs_rec(const point_tree *t, const hs_q *s, uint32_t lo, uint32_t hi, const float bmin[3], const float bmax[3]) {
+  if (hi <= lo) return;
+  const float q[3] = {s->q.x, s->q.y, s->q.z}, n[3] = {s->n.x, s->n.y, s->n.z};
+  float d2box = 0, hmax = 0;
+  for (int k = 0; k < 3; k++) {
+    float e = bmin[k] - q[k] > 0 ? bmin[k] - q[k] : (q[k] - bmax[k] > 0 ? q[k] - bmax[k] : 0);
+    d2box += e * e;
+    hmax += n[k] * (n[k] > 0 ? bmax[k] - q[k] : bmin[k] - q[k]);
+  }
+  if (d2box >= s->r2 || hmax <= s->eps) return;
+  uint32_t m = lo + (hi - lo) / 2;
+  float d2 = v3_len2(v3_sub(t->p[m], s->q));
+  if (d2 < s->r2) s->fn(s->user, m, d2);
+  int a = t->axis[m];
+  float split = coord(t->p[m], a);
+  float lmax[3] = {bmax[0], bmax[1], bmax[2]}, rmin[3] = {bmin[0], bmin[1], bmin[2]};
+  lmax[a] = split;
+  rmin[a] = split;
+  hs_rec(t, s, lo, m, bmin, lmax);
+  hs_rec(t, s, m + 1, hi, rmin, bmax);
+}
+
+void point_tree_radius_halfspace(const point_tree *t, vec3 q, float r2, vec3 n, float eps, point_visit_fn fn, void *user) {
+  hs_q s = {q, n, r2, eps, fn, user};
+  const float bmin[3] = {t->bounds.lo.x, t->bounds.lo.y, t->bounds.lo.z}, bmax[3] = {t->bounds.hi.x, t->bounds.hi.y, t->bounds.hi.z};
+  hs_rec(t, &s, 0, t->n, bmin, bmax);
 }

@@ -15,6 +15,7 @@ typedef struct point_tree {
   uint32_t *id;     /* id[i]: the caller's index of point i */
   uint8_t *axis;    /* split axis of the node at i */
   uint32_t n;
+  bbox bounds;      /* of all points */
 } point_tree;
 
 /* Builds the tree over pts[0..n) (copied). Returns 0, or -1 when out of memory. */
@@ -30,4 +31,7 @@ int point_tree_knn(const point_tree *t, vec3 q, int k, float r2max, vec3 n_squee
 /* Calls fn for every point with |p - q|^2 < r2 (i in tree order). */
 typedef void (*point_visit_fn)(void *user, uint32_t i, float d2);
 void point_tree_radius(const point_tree *t, vec3 q, float r2, point_visit_fn fn, void *user);
+/* Calls fn for every point with |p - q|^2 < r2 and (p - q).n > eps (n unit), skipping
+ * whole subtrees outside the sphere or behind the plane. */
+void point_tree_radius_halfspace(const point_tree *t, vec3 q, float r2, vec3 n, float eps, point_visit_fn fn, void *user);
 #endif

@@ -8,7 +8,9 @@
 
 static const integrator_param ao_params[] = {
     {"distance", IPARAM_FLOAT, 0, 0, 1e30,
-     "length of the occlusion rays in scene units; 0 = automatic, half the radius of the scene's bounding sphere"},
+     "length of the occlusion rays in scene units; 0 = automatic, 1/10 of the radius of the scene's bounding sphere"},
+    {"shading_normals", IPARAM_INT, 1, 0, 1,
+     "1: rays about the shading normal (normal and bump maps show); 0: about the geometric normal (as proximity-ao sees surfaces)"},
     {NULL, IPARAM_FLOAT, 0, 0, 0, NULL}};
 
 static rgb ao_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
@@ -16,7 +18,7 @@ static rgb ao_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   if (!ctx_intersect(c, &r, &h, ts)) return c3(0, 0, 0);
   isect it;
   isect_from_hit(c->s, &r, &h, &it);
-  vec3 n = v3_faceforward(it.ns, v3_neg(r.d));
+  vec3 n = v3_faceforward(c->param[1] > 0 ? it.ns : it.ng, v3_neg(r.d));
   vec3 dir;
   sampler_set_dim(smp, SDIM_EXTRA);
   float v = (float)ao_sample(c, &it, n, ao_ray_length(c->s, c->param[0]), smp, ts, &dir);

@@ -285,17 +285,22 @@ int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, t
   return 1;
 }
 
-int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r) {
-  bsdf_sample bs;
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, bsdf_sample *bs, vec3 *wi) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
   vec3 wo_l = frame_to_local(fr, wo);
-  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, &bs)) return 0;
-  vec3 wi = v3_norm(frame_to_world(fr, bs.wi));
+  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, bs)) return 0;
+  *wi = v3_norm(frame_to_world(fr, bs->wi));
   /* The sampled direction must agree with the geometric normal about reflection vs
    * transmission, or shading normals would leak light. */
-  int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g) return 0;
+  int refl_l = (bs->wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(*wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  return refl_l == refl_g;
+}
+
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r) {
+  bsdf_sample bs;
+  vec3 wi;
+  if (!sample_bsdf_world(it, b, fr, wo, smp, &bs, &wi)) return 0;
   *weight = bs.weight;
   st->specular = bs.delta;
   st->prev_pdf = bs.pdf;
@@ -303,6 +308,32 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
   st->eta_acc /= bs.eta_scale;
   *r = spawn_ray(it, wi);
   return 1;
+}
+
+rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, surface_shade_fn shade) {
+  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
+  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
+  for (int depth = 0;; depth++) {
+    isect it;
+    rgb Le;
+    float w;
+    path_state st0 = path_state_start(r.o); /* emission along a delta chain counts fully */
+    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
+    L = c3_add(L, c3_mul(beta, Le));
+    if (!surface || depth >= max_depth) break;
+    vec3 wo = v3_neg(r.d);
+    bsdf b = bsdf_at(c->s, &it);
+    frame fr = shading_frame(&it, &b, wo);
+    if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, shade(c, &it, &b, &fr, wo, depth, smp, ts)));
+    /* delta lobes carry the camera path on; a non-delta sample ends it */
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
+    path_state st = path_state_start(r.o);
+    rgb wgt;
+    if (!path_continue(&it, &b, &fr, wo, smp, &st, &wgt, &r) || !st.specular) break;
+    beta = c3_mul(beta, wgt);
+    if (c3_black(beta) || !c3_finite(beta)) break;
+  }
+  return L;
 }
 
 float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp) {
@@ -337,7 +368,7 @@ int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler 
   return 1;
 }
 
-float ao_ray_length(const scene *s, double d) { return d > 0 ? (float)d : 0.5f * s->radius; }
+float ao_ray_length(const scene *s, double d) { return d > 0 ? (float)d : 0.1f * s->radius; }
 
 VALO_API valo_status valo_integrator_check_params(const char *name, const char *params, valo_error *err) {
   if (err) { err->status = VALO_OK; err->message[0] = 0; }

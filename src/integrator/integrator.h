@@ -146,6 +146,17 @@ int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, t
  * f |cos| / pdf in *weight, the state updated and *r the next ray. 0 ends the path
  * (no direction, or one on which shading and geometric normals disagree). */
 int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r);
+/* Samples the BSDF at it for viewer direction wo (the sampler's next 1D and 2D values):
+ * returns 1 with *bs and the world direction *wi, or 0 when no direction came out or it
+ * disagrees with the geometric normal about reflection vs transmission. */
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, bsdf_sample *bs, vec3 *wi);
+/* The camera side of the integrators that shade a surface their own way (photon, vpl,
+ * vsl): follows delta lobes from r, counting the emission found, and adds beta *
+ * shade(...) at each surface with a non-delta lobe; a sampled non-delta lobe ends the
+ * path there (shade's estimate stands for it). */
+typedef rgb (*surface_shade_fn)(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
+                                thread_stats *ts);
+rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, surface_shade_fn shade);
 /* Russian roulette (pbrt-v4) after depth 2: survive with probability
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */
@@ -160,7 +171,8 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
  * (faced to the viewer) from it, up to length dist. Returns 1 when it escapes (the
  * direction is then *dir), 0 when something is within dist. */
 int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler *smp, thread_stats *ts, vec3 *dir);
-/* The ao ray length for parameter value d: d itself when > 0, else (automatic) half the
- * radius of the scene's bounding sphere. */
+/* The ao ray length for parameter value d: d itself when > 0, else (automatic) a tenth
+ * of the radius of the scene's bounding sphere (contact shadows and corners; the whole
+ * radius would leave an interior black). */
 float ao_ray_length(const scene *s, double d);
 #endif

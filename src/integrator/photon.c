@@ -288,63 +288,31 @@ static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, s
   return c3(0, 0, 0);
 }
 
-static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
+/* At a camera path's first non-delta surface: direct light by NEE, the caustic map, and
+ * final gathering over the radiance photons (or, with gather = 0, the global map). */
+static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
+                        thread_stats *ts) {
   const photon_state *ps = c->state;
-  const scene *s = c->s;
-  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
-  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
-  for (int depth = 0;; depth++) {
-    isect it;
-    rgb Le;
-    float w;
-    path_state st0 = path_state_start(r.o); /* emission along a delta chain counts fully */
-    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
-    L = c3_add(L, c3_mul(beta, Le));
-    if (!surface || depth >= max_depth) break;
-    vec3 wo = v3_neg(r.d);
-    bsdf b = bsdf_at(s, &it);
-    frame fr = shading_frame(&it, &b, wo);
-    if (bsdf_has_smooth(&b)) {
-      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-      int n = (int)c->param[P_GATHER];
-      rgb Lx;
-      if (n == 0) {
-        /* no gathering (a quick preview): the global map's estimate of everything the
-         * surface reflects here, direct light and caustics included */
-        Lx = estimate(&ps->global, ps->r2_global, (int)c->param[P_K], &it, &b, &fr, wo);
-      } else {
-        rgb G = c3(0, 0, 0);
-        vec3 wo_l = frame_to_local(&fr, wo);
-        for (int g = 0; g < n; g++) {
-          /* gather ray g of sample i is point i n + g of one stratified stream */
-          sampler gs = sampler_child(smp, (uint32_t)g, (uint32_t)n);
-          bsdf_sample bs;
-          float ul = sampler_1d(&gs), u1, u2;
-          sampler_2d(&gs, &u1, &u2);
-          if (!bsdf_sample_dir(&b, wo_l, ul, u1, u2, &bs) || bs.delta) continue; /* delta lobes: the camera chain */
-          vec3 wi = v3_norm(frame_to_world(&fr, bs.wi));
-          int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it.ng) > 0) == (v3_dot(wo, it.ng) > 0);
-          if (refl_l != refl_g) continue;
-          rgb Li = gather_radiance(c, ps, spawn_ray(&it, wi), &gs, ts);
-          G = c3_add(G, c3_mul(bs.weight, Li));
-        }
-        Lx = estimate_direct_nomis(c, &it, &b, &fr, wo, smp, ts);
-        if (ps->caustic.n) Lx = c3_add(Lx, estimate(&ps->caustic, ps->r2_caustic, (int)c->param[P_K], &it, &b, &fr, wo));
-        Lx = c3_add(Lx, c3_scale(G, 1.0f / (float)n));
-      }
-      L = c3_add(L, c3_mul(beta, Lx));
-    }
-    /* delta lobes carry the camera path on; a non-delta sample ends it (its part is the
-     * estimate above) */
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    path_state st = path_state_start(r.o);
-    rgb wgt;
-    if (!path_continue(&it, &b, &fr, wo, smp, &st, &wgt, &r) || !st.specular) break;
-    beta = c3_mul(beta, wgt);
-    if (c3_black(beta) || !c3_finite(beta)) break;
+  int n = (int)c->param[P_GATHER], k = (int)c->param[P_K];
+  /* no gathering (a quick preview): the global map's estimate of everything the surface
+   * reflects here, direct light and caustics included */
+  if (n == 0) return estimate(&ps->global, ps->r2_global, k, it, b, fr, wo);
+  rgb G = c3(0, 0, 0);
+  for (int g = 0; g < n; g++) {
+    /* gather ray g of sample i is point i n + g of one stratified stream */
+    sampler gs = sampler_child(smp, (uint32_t)g, (uint32_t)n);
+    bsdf_sample bs;
+    vec3 wi;
+    if (!sample_bsdf_world(it, b, fr, wo, &gs, &bs, &wi) || bs.delta) continue; /* delta lobes: the camera chain */
+    G = c3_add(G, c3_mul(bs.weight, gather_radiance(c, ps, spawn_ray(it, wi), &gs, ts)));
   }
-  return L;
+  sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
+  rgb L = estimate_direct_nomis(c, it, b, fr, wo, smp, ts);
+  if (ps->caustic.n) L = c3_add(L, estimate(&ps->caustic, ps->r2_caustic, k, it, b, fr, wo));
+  return c3_add(L, c3_scale(G, 1.0f / (float)n));
 }
+
+static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return li_shade_through_delta(c, r, smp, ts, photon_shade); }
 
 const integrator_ops integrator_photon = {
     "photon",

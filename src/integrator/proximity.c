@@ -6,10 +6,13 @@
  * and P = (1 + |n . n_s|) / 2 (the angle between the normals mapped into [0.5, 1]: a
  * surface seen face-on occludes twice what one seen edge-on does; points stand for both
  * sides, so the sign of n_s is not used). Each point's darkness is weighted by its share
- * of surface over the search disc, d^2 / r^2, so the result does not depend on the
- * spacing to first order; the pixel is 1 - min(1, M K T) with strength M and K a constant
+ * of surface over the search disc, a / r^2 (a: its shape's area over the points placed
+ * on it; the midpoint splitting makes the density a step function of d, so d^2 would
+ * misjudge it by up to 2x), so the result does not depend on the spacing; the pixel is 1 - min(1, M K T) with strength M and K a constant
  * fitted once so that M = 1 matches ray-traced ao (ray length r) on CornellBox-Original's
- * mean (docs/integrators.md). Deterministic and noise-free: every sample per pixel only
+ * mean at the default r (docs/integrators.md). Points are found by a radius search
+ * restricted to the half-space in front of x, which never visits the shaded surface's
+ * own (coplanar) points. Deterministic and noise-free: every sample per pixel only
  * moves the camera ray (antialiasing). d, r and M are parameters, per shape in a JSON
  * scene ("proximity": {"spacing", "radius", "strength"}); r and M are those of the shape
  * being shaded, d that of the shape splatted. */
@@ -20,14 +23,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PROX_K 0.79f           /* fitted: see the comment at the top (0.9 x 0.88) */
+#define PROX_K 1.84f           /* fitted: see the comment at the top */
 #define PROX_MAX_POINTS 50000000u
 
 enum { P_SPACING, P_RADIUS, P_STRENGTH };
 static const integrator_param prox_params[] = {
     {"spacing", IPARAM_FLOAT, 0, 0, 1e30, "distance between splatted points d in scene units; 0 = automatic, radius / 8"},
     {"radius", IPARAM_FLOAT, 0, 0, 1e30,
-     "search radius r in scene units (like ao's ray length); 0 = automatic, half the radius of the scene's bounding sphere"},
+     "search radius r in scene units (like ao's ray length); 0 = automatic, 1/10 of the radius of the scene's bounding sphere"},
     {"strength", IPARAM_FLOAT, 1, 0, 1e6, "strength M multiplying the darkness (1: calibrated to match ao's mean)"},
     {NULL, IPARAM_FLOAT, 0, 0, 0, NULL}};
 
@@ -77,20 +80,28 @@ static int grid_grow(grid *g) {
   return 0;
 }
 
-typedef struct splat_ctx { splat_points *sp; grid g; uint32_t max_points; int oom; } splat_ctx;
+typedef struct splat_ctx { splat_points *sp; grid g; uint32_t max_points; int oom; uint32_t group; uint32_t *pgroup; } splat_ctx;
+
+static int cell_has_close(const splat_ctx *c, int64_t x, int64_t y, int64_t z, vec3 p, float d2) {
+  const grid *g = &c->g;
+  uint32_t h = slot_of(g, cell_key(x, y, z));
+  for (int32_t i = g->head[h]; i >= 0; i = g->next[i])
+    if (v3_len2(v3_sub(c->sp->p[i], p)) < d2) return 1;
+  return 0;
+}
 
 static int too_close(const splat_ctx *c, vec3 p, float dmin) {
   const grid *g = &c->g;
   int64_t r = (int64_t)ceilf(dmin / g->cell);
   int64_t cx = (int64_t)floorf(p.x / g->cell), cy = (int64_t)floorf(p.y / g->cell), cz = (int64_t)floorf(p.z / g->cell);
   float d2 = dmin * dmin;
+  /* the point's own cell first: on finely tessellated meshes most candidates are
+   * rejected there */
+  if (cell_has_close(c, cx, cy, cz, p, d2)) return 1;
   for (int64_t x = cx - r; x <= cx + r; x++)
     for (int64_t y = cy - r; y <= cy + r; y++)
-      for (int64_t z = cz - r; z <= cz + r; z++) {
-        uint32_t h = slot_of(g, cell_key(x, y, z));
-        for (int32_t i = g->head[h]; i >= 0; i = g->next[i])
-          if (v3_len2(v3_sub(c->sp->p[i], p)) < d2) return 1;
-      }
+      for (int64_t z = cz - r; z <= cz + r; z++)
+        if ((x != cx || y != cy || z != cz) && cell_has_close(c, x, y, z, p, d2)) return 1;
   return 0;
 }
 
@@ -106,14 +117,19 @@ static void place(splat_ctx *c, vec3 p, vec3 n, float d) {
     if (nn) sp->n = nn;
     float *na = realloc(sp->area, cap * sizeof *na);
     if (na) sp->area = na;
+    float *ns = realloc(sp->spacing, cap * sizeof *ns);
+    if (ns) sp->spacing = ns;
+    uint32_t *pg = realloc(c->pgroup, cap * sizeof *pg);
+    if (pg) c->pgroup = pg;
     int32_t *nx = realloc(c->g.next, cap * sizeof *nx);
     if (nx) c->g.next = nx;
-    if (!np || !nn || !na || !nx) { c->oom = 1; return; }
+    if (!np || !nn || !na || !nx || !ns || !pg) { c->oom = 1; return; }
     sp->cap = cap;
   }
   if (2 * (c->g.used + 1) > c->g.cap && grid_grow(&c->g)) { c->oom = 1; return; }
   uint32_t i = sp->n_pts++;
-  sp->p[i] = p; sp->n[i] = n; sp->area[i] = d * d;
+  sp->p[i] = p; sp->n[i] = n; sp->spacing[i] = d; sp->area[i] = 0;
+  c->pgroup[i] = c->group;
   uint64_t k = cell_key((int64_t)floorf(p.x / c->g.cell), (int64_t)floorf(p.y / c->g.cell), (int64_t)floorf(p.z / c->g.cell));
   uint32_t h = slot_of(&c->g, k);
   if (c->g.head[h] < 0) { c->g.key[h] = k; c->g.used++; }
@@ -137,7 +153,12 @@ static void split(splat_ctx *c, vec3 a, vec3 b, vec3 t, vec3 n, float d, int dep
   }
   float ratio = sqrtf(lab) / (2 * d);
   if (ratio > c->sp->max_edge_ratio) c->sp->max_edge_ratio = ratio;
-  place(c, v3_scale(v3_add(v3_add(a, b), t), 1.0f / 3.0f), n, d);
+  /* the centroid, unless it is too close to a corner (the seed's rule; cheap, and it
+   * settles every triangle finer than the spacing without a grid lookup) */
+  vec3 g = v3_scale(v3_add(v3_add(a, b), t), 1.0f / 3.0f);
+  float q = 0.25f * d * d;
+  if (v3_len2(v3_sub(g, a)) < q || v3_len2(v3_sub(g, b)) < q || v3_len2(v3_sub(g, t)) < q) return;
+  place(c, g, n, d);
 }
 
 int splat_scene(const scene *s, float default_spacing, uint32_t max_points, splat_points *out) {
@@ -150,9 +171,16 @@ int splat_scene(const scene *s, float default_spacing, uint32_t max_points, spla
   for (uint32_t i = 0; i < s->nshape_ao; i++)
     if (s->shape_ao[i].spacing > 0 && s->shape_ao[i].spacing < dmin) dmin = s->shape_ao[i].spacing;
   c.g.cell = 0.5f * dmin;
-  if (!(c.g.cell > 0) || grid_grow(&c.g)) { free(c.g.key); free(c.g.head); return -1; }
+  uint8_t *vdone = calloc(s->nverts ? s->nverts : 1, 1);
+  if (!vdone || !(c.g.cell > 0) || grid_grow(&c.g)) { free(vdone); free(c.g.key); free(c.g.head); return -1; }
+  /* group g < nshape_ao: that shape; nshape_ao: every triangle without settings */
+  double *garea = calloc(s->nshape_ao + 1, sizeof *garea);
+  uint32_t *gcount = calloc(s->nshape_ao + 1, sizeof *gcount);
+  if (!garea || !gcount) c.oom = 1;
   for (uint32_t t = 0; t < s->ntris && !c.oom; t++) {
     const shape_ao *sa = shape_ao_of(s, t);
+    c.group = sa ? (uint32_t)(sa - s->shape_ao) : s->nshape_ao;
+    garea[c.group] += 0.5 * (double)v3_len(scene_tri_ng(s, t));
     float d = sa && sa->spacing > 0 ? sa->spacing : default_spacing;
     const uint32_t *ix = &s->idx[3 * t];
     vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], e = s->pos[ix[2]];
@@ -160,16 +188,23 @@ int splat_scene(const scene *s, float default_spacing, uint32_t max_points, spla
     float l = v3_len(n);
     if (!(l > 0) || !isfinite(l)) continue; /* degenerate */
     n = v3_scale(n, 1 / l);
-    place(&c, a, n, d); place(&c, b, n, d); place(&c, e, n, d);
+    /* each vertex once (a mesh vertex is shared by about six triangles) */
+    for (int k = 0; k < 3; k++)
+      if (!vdone[ix[k]]) { vdone[ix[k]] = 1; place(&c, s->pos[ix[k]], n, d); }
     split(&c, a, b, e, n, d, 0);
   }
-  free(c.g.key); free(c.g.head); free(c.g.next);
+  if (!c.oom) {
+    /* each point's share of its group's surface */
+    for (uint32_t i = 0; i < out->n_pts; i++) gcount[c.pgroup[i]]++;
+    for (uint32_t i = 0; i < out->n_pts; i++) out->area[i] = (float)(garea[c.pgroup[i]] / gcount[c.pgroup[i]]);
+  }
+  free(c.g.key); free(c.g.head); free(c.g.next); free(vdone); free(garea); free(gcount); free(c.pgroup);
   if (c.oom) { splat_free(out); return -1; }
   return 0;
 }
 
 void splat_free(splat_points *sp) {
-  free(sp->p); free(sp->n); free(sp->area);
+  free(sp->p); free(sp->n); free(sp->area); free(sp->spacing);
   memset(sp, 0, sizeof *sp);
 }
 
@@ -187,7 +222,7 @@ static void prox_destroy(void *st) {
 
 static float prox_radius(const render_ctx *c) { return ao_ray_length(c->s, c->param[P_RADIUS]); }
 static float prox_spacing(const render_ctx *c) {
-  return c->param[P_SPACING] > 0 ? (float)c->param[P_SPACING] : prox_radius(c) / 8;
+  return c->param[P_SPACING] > 0 ? (float)c->param[P_SPACING] : prox_radius(c) / 6;
 }
 
 static valo_status prox_create(const render_ctx *c, void **out, valo_error *err) {
@@ -228,7 +263,7 @@ static float prox_occlusion(const render_ctx *c, vec3 x, vec3 n, uint32_t tri) {
   float r = sa && sa->radius > 0 ? sa->radius : prox_radius(c);
   float M = sa && sa->strength >= 0 ? sa->strength : (float)c->param[P_STRENGTH];
   prox_q q = {ps, x, n, 1 / (r * r), 1e-3f * r, 0};
-  point_tree_radius(&ps->tree, x, r * r, prox_visit, &q);
+  point_tree_radius_halfspace(&ps->tree, x, r * r, n, q.eps, prox_visit, &q);
   return M * PROX_K * q.T;
 }
 
@@ -238,7 +273,9 @@ static rgb prox_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   if (!ctx_intersect(c, &r, &h, ts)) return c3(0, 0, 0);
   isect it;
   isect_from_hit(c->s, &r, &h, &it);
-  vec3 n = v3_faceforward(it.ns, v3_neg(r.d));
+  /* the geometric normal: points stand for geometry, and a normal or bump map's shading
+   * normal would tilt the surface's own points in front of it */
+  vec3 n = v3_faceforward(it.ng, v3_neg(r.d));
   float v = 1 - prox_occlusion(c, it.p, n, it.tri);
   v = v > 0 ? v : 0;
   return c3(v, v, v);

@@ -6,7 +6,9 @@
 
 typedef struct splat_points {
   vec3 *p, *n;      /* position and unit geometric normal (points stand for both sides) */
-  float *area;      /* spacing^2 of the shape the point came from: its share of surface */
+  float *spacing;   /* d of the shape the point came from */
+  float *area;      /* its share of surface: the area of its shape (or of all shapes
+                       without settings) over the points placed there */
   uint32_t n_pts, cap;
   float max_edge_ratio;  /* longest edge of a final (unsplit) triangle over its 2d: < 1 */
 } splat_points;

@@ -189,6 +189,7 @@ static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, con
       frame cf = frame_from_n(w);
       rgb acc = c3(0, 0, 0);
       sampler ls = sampler_child(smp, i, vs->n);
+      sampler_set_dim(&ls, SDIM_EXTRA);
       for (int m = 0; m < cone; m++) {
         float u1, u2;
         sampler_2d(&ls, &u1, &u2);
@@ -218,13 +219,8 @@ static rgb compensate(const render_ctx *c, const vpl_state *vs, const isect *it,
   sampler cs = sampler_child(smp, 0, 1);
   sampler_set_dim(&cs, SDIM_EXTRA);
   bsdf_sample bs;
-  vec3 wo_l = frame_to_local(fr, wo);
-  float ul = sampler_1d(&cs), u1, u2;
-  sampler_2d(&cs, &u1, &u2);
-  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, &bs) || bs.delta || !(bs.pdf > 0)) return c3(0, 0, 0);
-  vec3 wi = v3_norm(frame_to_world(fr, bs.wi));
-  int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g) return c3(0, 0, 0);
+  vec3 wi, wo_l = frame_to_local(fr, wo);
+  if (!sample_bsdf_world(it, b, fr, wo, &cs, &bs, &wi) || bs.delta || !(bs.pdf > 0)) return c3(0, 0, 0);
   rgb f = bsdf_eval(b, wo_l, bs.wi);
   float cos_x = fabsf(bs.wi.z), fmax = c3_max(f);
   if (!(fmax > 0)) return c3(0, 0, 0);
@@ -244,46 +240,24 @@ static rgb compensate(const render_ctx *c, const vpl_state *vs, const isect *it,
   return c3_scale(c3_mul(bs.weight, Lr), w);
 }
 
-static rgb vpl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
+/* At a camera path's first non-delta surface: direct light (`direct` NEE samples,
+ * stratified together across the pixel's samples), the pass's lights, and compensation. */
+static rgb vpl_shade(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
+                     thread_stats *ts) {
   const vpl_state *vs = c->state;
-  const scene *s = c->s;
-  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
-  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
-  for (int depth = 0;; depth++) {
-    isect it;
-    rgb Le;
-    float w;
-    path_state st0 = path_state_start(r.o); /* emission along a delta chain counts fully */
-    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
-    L = c3_add(L, c3_mul(beta, Le));
-    if (!surface || depth >= max_depth) break;
-    vec3 wo = v3_neg(r.d);
-    bsdf b = bsdf_at(s, &it);
-    frame fr = shading_frame(&it, &b, wo);
-    if (bsdf_has_smooth(&b)) {
-      /* direct light: `direct` next-event samples, stratified together across the
-       * pixel's samples (the same parameter index in both tables) */
-      int nd = (int)c->param[P_DIRECT];
-      rgb Lx = c3(0, 0, 0);
-      for (int k = 0; k < nd; k++) {
-        sampler ds = sampler_child(smp, (uint32_t)k, (uint32_t)nd);
-        sampler_set_dim(&ds, sdim_bounce(depth, SDIM_LIGHT_PICK));
-        Lx = c3_add(Lx, estimate_direct_nomis(c, &it, &b, &fr, wo, &ds, ts));
-      }
-      Lx = c3_scale(Lx, 1.0f / (float)nd);
-      Lx = c3_add(Lx, gather(c, vs, &it, &b, &fr, wo, smp, ts));
-      if (!vs->spherical && vs->c > 0 && c->param[P_COMPENSATE] > 0) Lx = c3_add(Lx, compensate(c, vs, &it, &b, &fr, wo, smp, ts));
-      L = c3_add(L, c3_mul(beta, Lx));
-    }
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    path_state st = path_state_start(r.o);
-    rgb wgt;
-    if (!path_continue(&it, &b, &fr, wo, smp, &st, &wgt, &r) || !st.specular) break;
-    beta = c3_mul(beta, wgt);
-    if (c3_black(beta) || !c3_finite(beta)) break;
+  int nd = (int)c->param[P_DIRECT]; /* the same index in both tables */
+  rgb L = c3(0, 0, 0);
+  for (int k = 0; k < nd; k++) {
+    sampler ds = sampler_child(smp, (uint32_t)k, (uint32_t)nd);
+    sampler_set_dim(&ds, sdim_bounce(depth, SDIM_LIGHT_PICK));
+    L = c3_add(L, estimate_direct_nomis(c, it, b, fr, wo, &ds, ts));
   }
+  L = c3_add(c3_scale(L, 1.0f / (float)nd), gather(c, vs, it, b, fr, wo, smp, ts));
+  if (!vs->spherical && vs->c > 0 && c->param[P_COMPENSATE] > 0) L = c3_add(L, compensate(c, vs, it, b, fr, wo, smp, ts));
   return L;
 }
+
+static rgb vpl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return li_shade_through_delta(c, r, smp, ts, vpl_shade); }
 
 const integrator_ops integrator_vpl = {
     "vpl", "instant radiosity (Keller 1997): virtual point lights from light paths, clamping, bias compensation (Kollig & Keller 2004)",
