@@ -96,7 +96,7 @@ static void breakdown(const char *json_path, int w, int h, double *t_splat, doub
   float r = 0.1f * s->radius, d = r / 6;
   splat_points sp;
   double t0 = now();
-  splat_scene(s, d, 50000000, &sp);
+  splat_scene(s, d, 50000000, 2, &sp);
   *t_splat = now() - t0;
   point_tree t;
   t0 = now();

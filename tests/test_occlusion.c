@@ -143,9 +143,11 @@ static int proximity_splatting(void) {
   CHECK(load_internal(path, &s) == 0, "load");
   const float d = 0.05f;
   splat_points a, b;
-  CHECK(splat_scene(s, d, 10000000, &a) == 0, "splat");
-  CHECK(splat_scene(s, d, 10000000, &b) == 0, "splat again");
-  CHECK(a.n_pts == b.n_pts && !memcmp(a.p, b.p, a.n_pts * sizeof *a.p) && !memcmp(a.n, b.n, a.n_pts * sizeof *a.n), "not deterministic");
+  CHECK(splat_scene(s, d, 10000000, 1, &a) == 0, "splat");
+  CHECK(splat_scene(s, d, 10000000, 3, &b) == 0, "splat again, 3 threads");
+  CHECK(a.n_pts == b.n_pts && !memcmp(a.p, b.p, a.n_pts * sizeof *a.p) && !memcmp(a.n, b.n, a.n_pts * sizeof *a.n) &&
+            !memcmp(a.area, b.area, a.n_pts * sizeof *a.area),
+        "not deterministic");
   fprintf(stderr, "%u points; longest final edge / 2d = %.4f\n", a.n_pts, a.max_edge_ratio);
   CHECK(a.max_edge_ratio <= 1.0f, "a final edge is %.4f x 2d", a.max_edge_ratio);
   /* no two points closer than half their spacing */

@@ -20,6 +20,7 @@
 #include "integrator/proximity.h"
 #include "geometry/pointtree.h"
 #include "core/error.h"
+#include "core/threadpool.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -137,31 +138,81 @@ static void place(splat_ctx *c, vec3 p, vec3 n, float d) {
   c->g.head[h] = (int32_t)i;
 }
 
+/* Splatting runs in two phases so that it can use every thread and still place the
+ * very points of the sequential algorithm: (A) in parallel over chunks of triangles,
+ * each triangle's candidate points in the order the algorithm visits them — the
+ * vertices it is the first (non-degenerate) triangle to use, then the midpoints of the
+ * recursive split and the centroids that pass the corner rule, all decided by geometry
+ * alone; (B) one thread takes the candidates in triangle order and keeps those no
+ * closer than d/2 to a point already kept. */
+typedef struct cand { vec3 p, n; float d; uint32_t group; } cand;
+typedef struct cand_buf { cand *c; uint32_t n, cap; int oom; float max_ratio; } cand_buf;
+
+static void emit(cand_buf *cb, vec3 p, vec3 n, float d, uint32_t group) {
+  if (cb->oom) return;
+  if (cb->n == cb->cap) {
+    uint32_t cap = cb->cap ? 2 * cb->cap : 1024;
+    cand *nc = realloc(cb->c, cap * sizeof *nc);
+    if (!nc) { cb->oom = 1; return; }
+    cb->c = nc;
+    cb->cap = cap;
+  }
+  cand k = {p, n, d, group};
+  cb->c[cb->n++] = k;
+}
+
 /* Splits at the midpoint of the longest edge while it is longer than 2d; the centroid of
- * each final triangle gets a point. */
-static void split(splat_ctx *c, vec3 a, vec3 b, vec3 t, vec3 n, float d, int depth) {
+ * each final triangle, unless it is too close to a corner (the seed's rule; it settles
+ * every triangle finer than the spacing without a grid lookup). */
+static void split(cand_buf *cb, vec3 a, vec3 b, vec3 t, vec3 n, float d, uint32_t group, int depth) {
   float lab = v3_len2(v3_sub(b, a)), lbt = v3_len2(v3_sub(t, b)), lta = v3_len2(v3_sub(a, t));
   /* rotate so that (a, b) is the longest edge */
   if (lbt >= lab && lbt >= lta) { vec3 x = a; a = b; b = t; t = x; lab = lbt; }
   else if (lta >= lab && lta >= lbt) { vec3 x = t; t = b; b = a; a = x; lab = lta; }
-  if (lab > 4 * d * d && depth < 60 && !c->oom) {
+  if (lab > 4 * d * d && depth < 60 && !cb->oom) {
     vec3 m = v3_scale(v3_add(a, b), 0.5f);
-    place(c, m, n, d);
-    split(c, a, m, t, n, d, depth + 1);
-    split(c, m, b, t, n, d, depth + 1);
+    emit(cb, m, n, d, group);
+    split(cb, a, m, t, n, d, group, depth + 1);
+    split(cb, m, b, t, n, d, group, depth + 1);
     return;
   }
   float ratio = sqrtf(lab) / (2 * d);
-  if (ratio > c->sp->max_edge_ratio) c->sp->max_edge_ratio = ratio;
-  /* the centroid, unless it is too close to a corner (the seed's rule; cheap, and it
-   * settles every triangle finer than the spacing without a grid lookup) */
+  if (ratio > cb->max_ratio) cb->max_ratio = ratio;
   vec3 g = v3_scale(v3_add(v3_add(a, b), t), 1.0f / 3.0f);
   float q = 0.25f * d * d;
   if (v3_len2(v3_sub(g, a)) < q || v3_len2(v3_sub(g, b)) < q || v3_len2(v3_sub(g, t)) < q) return;
-  place(c, g, n, d);
+  emit(cb, g, n, d, group);
 }
 
-int splat_scene(const scene *s, float default_spacing, uint32_t max_points, splat_points *out) {
+#define SPLAT_CHUNK 4096
+typedef struct splat_job {
+  const scene *s;
+  float default_spacing;
+  const uint32_t *owner;   /* per vertex: the first non-degenerate triangle using it */
+  const uint8_t *degenerate;
+  cand_buf *bufs;
+} splat_job;
+
+static void splat_chunk(void *user, int64_t item, int thread) {
+  (void)thread;
+  splat_job *j = user;
+  const scene *s = j->s;
+  cand_buf *cb = &j->bufs[item];
+  uint32_t t0 = (uint32_t)item * SPLAT_CHUNK, t1 = t0 + SPLAT_CHUNK < s->ntris ? t0 + SPLAT_CHUNK : s->ntris;
+  for (uint32_t t = t0; t < t1; t++) {
+    if (j->degenerate[t]) continue;
+    const shape_ao *sa = shape_ao_of(s, t);
+    uint32_t group = sa ? (uint32_t)(sa - s->shape_ao) : s->nshape_ao;
+    float d = sa && sa->spacing > 0 ? sa->spacing : j->default_spacing;
+    const uint32_t *ix = &s->idx[3 * t];
+    vec3 n = v3_norm(scene_tri_ng(s, t));
+    for (int k = 0; k < 3; k++)
+      if (j->owner[ix[k]] == t) emit(cb, s->pos[ix[k]], n, d, group);
+    split(cb, s->pos[ix[0]], s->pos[ix[1]], s->pos[ix[2]], n, d, group, 0);
+  }
+}
+
+int splat_scene(const scene *s, float default_spacing, uint32_t max_points, int threads, splat_points *out) {
   memset(out, 0, sizeof *out);
   splat_ctx c;
   memset(&c, 0, sizeof c);
@@ -171,35 +222,45 @@ int splat_scene(const scene *s, float default_spacing, uint32_t max_points, spla
   for (uint32_t i = 0; i < s->nshape_ao; i++)
     if (s->shape_ao[i].spacing > 0 && s->shape_ao[i].spacing < dmin) dmin = s->shape_ao[i].spacing;
   c.g.cell = 0.5f * dmin;
-  uint8_t *vdone = calloc(s->nverts ? s->nverts : 1, 1);
-  if (!vdone || !(c.g.cell > 0) || grid_grow(&c.g)) { free(vdone); free(c.g.key); free(c.g.head); return -1; }
+  int64_t nchunks = ((int64_t)s->ntris + SPLAT_CHUNK - 1) / SPLAT_CHUNK;
+  uint32_t *owner = malloc((s->nverts ? s->nverts : 1) * sizeof *owner);
+  uint8_t *degenerate = malloc(s->ntris ? s->ntris : 1);
   /* group g < nshape_ao: that shape; nshape_ao: every triangle without settings */
   double *garea = calloc(s->nshape_ao + 1, sizeof *garea);
   uint32_t *gcount = calloc(s->nshape_ao + 1, sizeof *gcount);
-  if (!garea || !gcount) c.oom = 1;
-  for (uint32_t t = 0; t < s->ntris && !c.oom; t++) {
-    const shape_ao *sa = shape_ao_of(s, t);
-    c.group = sa ? (uint32_t)(sa - s->shape_ao) : s->nshape_ao;
-    garea[c.group] += 0.5 * (double)v3_len(scene_tri_ng(s, t));
-    float d = sa && sa->spacing > 0 ? sa->spacing : default_spacing;
-    const uint32_t *ix = &s->idx[3 * t];
-    vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], e = s->pos[ix[2]];
-    vec3 n = scene_tri_ng(s, t);
-    float l = v3_len(n);
-    if (!(l > 0) || !isfinite(l)) continue; /* degenerate */
-    n = v3_scale(n, 1 / l);
-    /* each vertex once (a mesh vertex is shared by about six triangles) */
-    for (int k = 0; k < 3; k++)
-      if (!vdone[ix[k]]) { vdone[ix[k]] = 1; place(&c, s->pos[ix[k]], n, d); }
-    split(&c, a, b, e, n, d, 0);
+  cand_buf *bufs = calloc((size_t)(nchunks ? nchunks : 1), sizeof *bufs);
+  int fail = !owner || !degenerate || !garea || !gcount || !bufs || !(c.g.cell > 0) || grid_grow(&c.g);
+  if (!fail) {
+    for (uint32_t v = 0; v < s->nverts; v++) owner[v] = UINT32_MAX;
+    for (uint32_t t = 0; t < s->ntris; t++) {
+      const shape_ao *sa = shape_ao_of(s, t);
+      float l = v3_len(scene_tri_ng(s, t));
+      garea[sa ? (uint32_t)(sa - s->shape_ao) : s->nshape_ao] += 0.5 * (double)l;
+      degenerate[t] = !(l > 0) || !isfinite(l);
+      if (degenerate[t]) continue;
+      for (int k = 0; k < 3; k++)
+        if (owner[s->idx[3 * t + k]] == UINT32_MAX) owner[s->idx[3 * t + k]] = t;
+    }
+    splat_job j = {s, default_spacing, owner, degenerate, bufs};
+    parallel_for(threads > 0 ? threads : 1, nchunks, splat_chunk, &j);
+    for (int64_t k = 0; k < nchunks && !c.oom; k++) {
+      if (bufs[k].oom) { c.oom = 1; break; }
+      if (bufs[k].max_ratio > out->max_edge_ratio) out->max_edge_ratio = bufs[k].max_ratio;
+      for (uint32_t i = 0; i < bufs[k].n && !c.oom; i++) {
+        c.group = bufs[k].c[i].group;
+        place(&c, bufs[k].c[i].p, bufs[k].c[i].n, bufs[k].c[i].d);
+      }
+    }
+    if (!c.oom) {
+      /* each point's share of its group's surface */
+      for (uint32_t i = 0; i < out->n_pts; i++) gcount[c.pgroup[i]]++;
+      for (uint32_t i = 0; i < out->n_pts; i++) out->area[i] = (float)(garea[c.pgroup[i]] / gcount[c.pgroup[i]]);
+    }
   }
-  if (!c.oom) {
-    /* each point's share of its group's surface */
-    for (uint32_t i = 0; i < out->n_pts; i++) gcount[c.pgroup[i]]++;
-    for (uint32_t i = 0; i < out->n_pts; i++) out->area[i] = (float)(garea[c.pgroup[i]] / gcount[c.pgroup[i]]);
-  }
-  free(c.g.key); free(c.g.head); free(c.g.next); free(vdone); free(garea); free(gcount); free(c.pgroup);
-  if (c.oom) { splat_free(out); return -1; }
+  for (int64_t k = 0; bufs && k < nchunks; k++) free(bufs[k].c);
+  free(bufs); free(owner); free(degenerate);
+  free(c.g.key); free(c.g.head); free(c.g.next); free(garea); free(gcount); free(c.pgroup);
+  if (fail || c.oom) { splat_free(out); return -1; }
   return 0;
 }
 
@@ -229,7 +290,7 @@ static valo_status prox_create(const render_ctx *c, void **out, valo_error *err)
   prox_state *ps = calloc(1, sizeof *ps);
   if (!ps) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   float d = prox_spacing(c);
-  if (splat_scene(c->s, d, PROX_MAX_POINTS, &ps->pts)) {
+  if (splat_scene(c->s, d, PROX_MAX_POINTS, c->threads, &ps->pts)) {
     prox_destroy(ps);
     return err_set(err, VALO_ERR_INVALID, "proximity-ao: spacing %g gives more than %u points (or memory ran out): choose a larger spacing", d,
                    PROX_MAX_POINTS);

@@ -14,12 +14,12 @@ typedef struct splat_points {
 } splat_points;
 
 /* Places points at spacing d(tri) on every triangle (deterministically, in triangle
- * order): each vertex, then the midpoint of the longest edge while it is longer than 2d
+ * order, whatever the thread count): each vertex, then the midpoint of the longest edge while it is longer than 2d
  * (splitting the triangle there), then the centroid of each final triangle; a point
  * closer than d/2 to one already placed is skipped, so none is placed twice on a shared
  * edge. d(tri) is the shape's "proximity" spacing or default_spacing. Returns 0, or -1
  * (out of memory, or more than max_points points: spacing too fine). */
-int splat_scene(const scene *s, float default_spacing, uint32_t max_points, splat_points *out);
+int splat_scene(const scene *s, float default_spacing, uint32_t max_points, int threads, splat_points *out);
 void splat_free(splat_points *sp);
 /* The proximity settings of the shape triangle t belongs to (NULL: none). */
 const shape_ao *shape_ao_of(const scene *s, uint32_t t);
