@@ -72,8 +72,13 @@ static vec3 sph_dir(double theta, double phi) { return v3((float)(sin(theta) * c
 typedef int (*sample_fn)(void *ctx, sampler *s, vec3 *dir);  /* 0: no direction / delta */
 typedef double (*pdf_fn)(void *ctx, vec3 dir);
 
+/* Samples whose own pdf or weight disagreed with pdf() and eval() (bsdf_sf counts them):
+ * any is a failure, not a sample quietly dropped. */
+static long g_sample_mismatch;
+
 static int run_chi2(const char *what, void *ctx, sample_fn sf, pdf_fn pf) {
   long n = nsamples();
+  g_sample_mismatch = 0;
   int cells = NT * NP + 1;
   double *obs = calloc(cells, sizeof(double)), *ex = calloc(cells, sizeof(double));
   for (long i = 0; i < n; i++) {
@@ -121,6 +126,7 @@ static int run_chi2(const char *what, void *ctx, sample_fn sf, pdf_fn pf) {
   int rc = chi2_check(what, obs, ex, cells);
   free(obs); free(ex);
   if (total > 1.002) { fprintf(stderr, "%s: pdf integrates to more than 1\n", what); return 1; }
+  if (g_sample_mismatch) { fprintf(stderr, "%s: %ld samples whose pdf or weight disagree with pdf() and eval()\n", what, g_sample_mismatch); return 1; }
   return rc;
 }
 
@@ -242,9 +248,22 @@ static int bsdf_sf(void *c, sampler *s, vec3 *d) {
   bsdf_sample bs;
   float ul = sampler_1d(s), u1 = sampler_1d(s), u2 = sampler_1d(s);
   if (!bsdf_sample_dir(&x->b, x->wo, ul, u1, u2, &bs) || bs.delta) return 0;
-  /* The sample's pdf and weight must agree with pdf() and eval(). */
+  /* The sample's pdf and weight must agree with pdf() and with eval() |cos| / pdf()
+   * computed here (the sampling routines compute some weights in closed form, e.g. the
+   * diffuse lobe's kd); a mismatch fails the test (run_chi2). */
   float p = bsdf_pdf(&x->b, x->wo, bs.wi);
-  if (fabsf(p - bs.pdf) > 1e-3f * p) { fprintf(stderr, "pdf mismatch %g vs %g\n", p, bs.pdf); return 0; }
+  rgb f = bsdf_eval(&x->b, x->wo, bs.wi), w = c3_scale(f, fabsf(bs.wi.z) / p);
+  int bad = !(fabsf(p - bs.pdf) <= 1e-3f * p);
+  for (int k = 0; k < 3; k++) {
+    float a = k == 0 ? w.r : k == 1 ? w.g : w.b, b = k == 0 ? bs.weight.r : k == 1 ? bs.weight.g : bs.weight.b;
+    if (!(fabsf(a - b) <= 1e-3f * fmaxf(fabsf(a), 1e-6f) + 1e-6f)) bad = 1;
+  }
+  if (bad) {
+    if (g_sample_mismatch++ < 3)
+      fprintf(stderr, "sample pdf %g (pdf() %g), weight (%g %g %g) against eval cos / pdf (%g %g %g)\n", bs.pdf, p, bs.weight.r, bs.weight.g,
+              bs.weight.b, w.r, w.g, w.b);
+    return 0;
+  }
   *d = bs.wi;
   return 1;
 }
