@@ -345,6 +345,10 @@ static int bad_options(void) {
   SAID("photon.k=0");
   EXPECT_FAIL(2, "render", obj, "--integrator", "ao", "--param", "distance=far", "--res", "4x4");
   SAID("ao.distance=far");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "vsl", "--param", "clamp=0.1", "--res", "4x4");
+  SAID("unknown parameter \"clamp\" for the vsl integrator");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "vpl", "--param", "count=0", "--res", "4x4");
+  SAID("vpl.count=0");
   EXPECT_FAIL(2, "render", obj, "--param", "photn.k=3", "--res", "4x4");
   SAID("no integrator \"photn\"");
   EXPECT_FAIL(2, "render", obj, "--param", "k", "--res", "4x4");
