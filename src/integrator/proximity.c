@@ -48,11 +48,16 @@ const shape_ao *shape_ao_of(const scene *s, uint32_t t) {
 }
 
 /* ---- splatting with a hash grid for the minimum-distance test ---- */
+/* Cells of side `cell`: a dense array over the scene's bounds when it has at most
+ * DENSE_MAX cells (no hashing: the common case), else a hash table. */
+#define DENSE_MAX (1 << 24)
 typedef struct grid {
-  uint64_t *key; int32_t *head;  /* open addressing: cell key -> first point */
+  uint64_t *key; int32_t *head;  /* hash mode, open addressing: cell key -> first point */
   int32_t *next;                 /* per point: next in its cell */
   uint32_t cap, used, next_cap;
   float cell;
+  int32_t *dense;                /* dense mode: nx*ny*nz heads, or NULL */
+  int64_t x0, y0, z0, nx, ny, nz;
 } grid;
 
 static uint64_t cell_key(int64_t x, int64_t y, int64_t z) {
@@ -83,10 +88,19 @@ static int grid_grow(grid *g) {
 
 typedef struct splat_ctx { splat_points *sp; grid g; uint32_t max_points; int oom; uint32_t group; uint32_t *pgroup; } splat_ctx;
 
+/* The first point of cell (x, y, z), or -1. */
+static int32_t cell_first(const grid *g, int64_t x, int64_t y, int64_t z) {
+  if (g->dense) {
+    x -= g->x0; y -= g->y0; z -= g->z0;
+    if (x < 0 || y < 0 || z < 0 || x >= g->nx || y >= g->ny || z >= g->nz) return -1;
+    return g->dense[(size_t)((z * g->ny + y) * g->nx + x)];
+  }
+  return g->head[slot_of(g, cell_key(x, y, z))];
+}
+
 static int cell_has_close(const splat_ctx *c, int64_t x, int64_t y, int64_t z, vec3 p, float d2) {
   const grid *g = &c->g;
-  uint32_t h = slot_of(g, cell_key(x, y, z));
-  for (int32_t i = g->head[h]; i >= 0; i = g->next[i])
+  for (int32_t i = cell_first(g, x, y, z); i >= 0; i = g->next[i])
     if (v3_len2(v3_sub(c->sp->p[i], p)) < d2) return 1;
   return 0;
 }
@@ -127,15 +141,25 @@ static void place(splat_ctx *c, vec3 p, vec3 n, float d) {
     if (!np || !nn || !na || !nx || !ns || !pg) { c->oom = 1; return; }
     sp->cap = cap;
   }
-  if (2 * (c->g.used + 1) > c->g.cap && grid_grow(&c->g)) { c->oom = 1; return; }
+  grid *g = &c->g;
+  int64_t x = (int64_t)floorf(p.x / g->cell), y = (int64_t)floorf(p.y / g->cell), z = (int64_t)floorf(p.z / g->cell);
+  int32_t *head;
+  if (g->dense) {
+    x -= g->x0; y -= g->y0; z -= g->z0;
+    if (x < 0 || y < 0 || z < 0 || x >= g->nx || y >= g->ny || z >= g->nz) { c->oom = 1; return; } /* cannot happen: bounds */
+    head = &g->dense[(size_t)((z * g->ny + y) * g->nx + x)];
+  } else {
+    if (2 * (g->used + 1) > g->cap && grid_grow(g)) { c->oom = 1; return; }
+    uint64_t k = cell_key(x, y, z);
+    uint32_t h = slot_of(g, k);
+    if (g->head[h] < 0) { g->key[h] = k; g->used++; }
+    head = &g->head[h];
+  }
   uint32_t i = sp->n_pts++;
   sp->p[i] = p; sp->n[i] = n; sp->spacing[i] = d; sp->area[i] = 0;
   c->pgroup[i] = c->group;
-  uint64_t k = cell_key((int64_t)floorf(p.x / c->g.cell), (int64_t)floorf(p.y / c->g.cell), (int64_t)floorf(p.z / c->g.cell));
-  uint32_t h = slot_of(&c->g, k);
-  if (c->g.head[h] < 0) { c->g.key[h] = k; c->g.used++; }
-  c->g.next[i] = c->g.head[h];
-  c->g.head[h] = (int32_t)i;
+  g->next[i] = *head;
+  *head = (int32_t)i;
 }
 
 /* Splatting runs in two phases so that it can use every thread and still place the
@@ -229,7 +253,19 @@ int splat_scene(const scene *s, float default_spacing, uint32_t max_points, int 
   double *garea = calloc(s->nshape_ao + 1, sizeof *garea);
   uint32_t *gcount = calloc(s->nshape_ao + 1, sizeof *gcount);
   cand_buf *bufs = calloc((size_t)(nchunks ? nchunks : 1), sizeof *bufs);
-  int fail = !owner || !degenerate || !garea || !gcount || !bufs || !(c.g.cell > 0) || grid_grow(&c.g);
+  /* dense cells over the bounds (one cell of margin), when few enough */
+  if (c.g.cell > 0 && s->ntris) {
+    grid *g = &c.g;
+    g->x0 = (int64_t)floorf(s->bounds.lo.x / g->cell) - 1; g->nx = (int64_t)floorf(s->bounds.hi.x / g->cell) + 2 - g->x0;
+    g->y0 = (int64_t)floorf(s->bounds.lo.y / g->cell) - 1; g->ny = (int64_t)floorf(s->bounds.hi.y / g->cell) + 2 - g->y0;
+    g->z0 = (int64_t)floorf(s->bounds.lo.z / g->cell) - 1; g->nz = (int64_t)floorf(s->bounds.hi.z / g->cell) + 2 - g->z0;
+    double cells = (double)g->nx * (double)g->ny * (double)g->nz;
+    if (cells > 0 && cells <= DENSE_MAX) {
+      g->dense = malloc((size_t)cells * sizeof *g->dense);
+      if (g->dense) memset(g->dense, 0xff, (size_t)cells * sizeof *g->dense); /* all -1 */
+    }
+  }
+  int fail = !owner || !degenerate || !garea || !gcount || !bufs || !(c.g.cell > 0) || (!c.g.dense && grid_grow(&c.g));
   if (!fail) {
     for (uint32_t v = 0; v < s->nverts; v++) owner[v] = UINT32_MAX;
     for (uint32_t t = 0; t < s->ntris; t++) {
@@ -259,7 +295,7 @@ int splat_scene(const scene *s, float default_spacing, uint32_t max_points, int 
   }
   for (int64_t k = 0; bufs && k < nchunks; k++) free(bufs[k].c);
   free(bufs); free(owner); free(degenerate);
-  free(c.g.key); free(c.g.head); free(c.g.next); free(garea); free(gcount); free(c.pgroup);
+  free(c.g.key); free(c.g.head); free(c.g.next); free(c.g.dense); free(garea); free(gcount); free(c.pgroup);
   if (fail || c.oom) { splat_free(out); return -1; }
   return 0;
 }
