@@ -121,28 +121,33 @@ static valo_status shoot_round(const render_ctx *c, uint64_t key, uint64_t first
   return st;
 }
 
-valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
-                            void *user, lp_set *out, valo_error *err) {
+/* Either rounds until `target` records (npaths == 0), or exactly npaths paths. */
+static valo_status shoot(const render_ctx *c, uint64_t key, uint64_t target, uint64_t npaths, size_t rec_size, int only_specular,
+                         lp_visit_fn visit, void *user, lp_set *out, valo_error *err) {
   memset(out, 0, sizeof *out);
-  if (target == 0 || c->ls.table.n == 0) return VALO_OK;
+  if ((target == 0 && npaths == 0) || c->ls.table.n == 0) return VALO_OK;
   thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  uint64_t emitted = 0, cap = target * MAX_EMIT_FACTOR;
-  if (cap < 65536) cap = 65536;
-  uint64_t n = 0, mcap = 0;
+  uint64_t emitted = 0, n = 0, mcap = 0;
   unsigned char *all = NULL;
   valo_status st = VALO_OK;
-  uint64_t round = 4 * CHUNK;
-  while (n < target && emitted < cap) {
-    round = (round + CHUNK - 1) / CHUNK * CHUNK;
-    st = shoot_round(c, key, emitted, round, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
-    emitted += round;
-    if (st) break;
-    /* next round: what the rate so far says reaches the target */
-    double rate = (double)n / (double)emitted;
-    double need = rate > 0 ? (double)(target - (n < target ? n : target)) / rate : (double)emitted * 4;
-    round = (uint64_t)need + CHUNK;
-    if (round > cap - (emitted < cap ? emitted : cap)) round = cap > emitted ? cap - emitted : CHUNK;
+  if (npaths) {
+    st = shoot_round(c, key, 0, npaths, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
+    emitted = npaths;
+  } else {
+    uint64_t cap = target * MAX_EMIT_FACTOR, round = 4 * CHUNK;
+    if (cap < 65536) cap = 65536;
+    while (n < target && emitted < cap) {
+      round = (round + CHUNK - 1) / CHUNK * CHUNK;
+      st = shoot_round(c, key, emitted, round, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
+      emitted += round;
+      if (st) break;
+      /* next round: what the rate so far says reaches the target */
+      double rate = (double)n / (double)emitted;
+      double need = rate > 0 ? (double)(target - (n < target ? n : target)) / rate : (double)emitted * 4;
+      round = (uint64_t)need + CHUNK;
+      if (round > cap - (emitted < cap ? emitted : cap)) round = cap > emitted ? cap - emitted : CHUNK;
+    }
   }
   free(ts);
   if (st) { free(all); return st; }
@@ -152,19 +157,12 @@ valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, 
   return VALO_OK;
 }
 
+valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
+                            void *user, lp_set *out, valo_error *err) {
+  return shoot(c, key, target, 0, rec_size, only_specular, visit, user, out, err);
+}
+
 valo_status lightpath_shoot_paths(const render_ctx *c, uint64_t key, uint64_t npaths, size_t rec_size, lp_visit_fn visit, void *user,
                                   lp_set *out, valo_error *err) {
-  memset(out, 0, sizeof *out);
-  if (npaths == 0 || c->ls.table.n == 0) return VALO_OK;
-  thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
-  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  uint64_t n = 0, mcap = 0;
-  unsigned char *all = NULL;
-  valo_status st = shoot_round(c, key, 0, npaths, rec_size, 0, visit, user, ts, &all, &n, &mcap, err);
-  free(ts);
-  if (st) { free(all); return st; }
-  out->rec = all;
-  out->n = (uint32_t)n;
-  out->emitted = npaths;
-  return VALO_OK;
+  return shoot(c, key, 0, npaths, rec_size, 0, visit, user, out, err);
 }

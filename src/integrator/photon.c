@@ -68,7 +68,7 @@ static vec3 oct_unpack(uint32_t u) {
   return v3_norm(v3(x, y, z));
 }
 
-typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; uint64_t emitted; } photon_map;
+typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; } photon_map;
 /* Radiance photons (Christensen 1999): every RAD_STRIDE-th global photon with its
  * precomputed outgoing radiance rho E / pi, found by gather rays with one nearest lookup
  * instead of a k-nearest estimate. */
@@ -122,8 +122,7 @@ static valo_status photon_create(const render_ctx *c, void **out, valo_error *er
  * the radiance photons' Lo = rho E / pi (pbrt-v2's diffuse approximation): the
  * directional albedo at normal incidence, by the BSDF's own sampling (16 stratified
  * samples; deterministic). */
-static rgb diffuse_reflectance(const bsdf *b, const isect *it, const frame *fr) {
-  (void)it; (void)fr;
+static rgb diffuse_reflectance(const bsdf *b) {
   rgb sum = c3(0, 0, 0);
   vec3 wo = v3(0, 0, 1);
   for (int i = 0; i < 16; i++) {
@@ -137,7 +136,7 @@ static rgb diffuse_reflectance(const bsdf *b, const isect *it, const frame *fr) 
 /* ---- shooting (lightpath.c) ---- */
 static int visit_global(void *user, const lp_vertex *v, void *rec) {
   (void)user;
-  photon ph = {v->it->p, v->power, oct_pack(v->d), oct_pack(v->fr->n), diffuse_reflectance(v->b, v->it, v->fr)};
+  photon ph = {v->it->p, v->power, oct_pack(v->d), oct_pack(v->fr->n), diffuse_reflectance(v->b)};
   memcpy(rec, &ph, sizeof ph);
   return 1;
 }
@@ -168,7 +167,6 @@ static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, ui
   for (uint32_t i = 0; i < n; i++) m->ph[i] = all[m->tree.id[i]];
   free(all);
   m->n = n;
-  m->emitted = set.emitted;
   return VALO_OK;
 }
 

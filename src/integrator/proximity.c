@@ -54,7 +54,7 @@ const shape_ao *shape_ao_of(const scene *s, uint32_t t) {
 typedef struct grid {
   uint64_t *key; int32_t *head;  /* hash mode, open addressing: cell key -> first point */
   int32_t *next;                 /* per point: next in its cell */
-  uint32_t cap, used, next_cap;
+  uint32_t cap, used;
   float cell;
   int32_t *dense;                /* dense mode: nx*ny*nz heads, or NULL */
   int64_t x0, y0, z0, nx, ny, nz;
