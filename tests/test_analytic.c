@@ -306,6 +306,9 @@ static int aovs(void) {
     if (k == 1) CHECK(fabsf(c[0] - 3 / expect) < 0.01f && corner[0] > 0.99f, "depth PNG centre %g (expected %g), corner %g", c[0], 3 / expect, corner[0]);
     if (k == 2) CHECK(c[0] > 0.99f, "spp PNG %g (every pixel has the largest count)", c[0]);
   }
+  /* The ao AOVs cost a ray per sample: without the VALO_AOVS_AO bit they were not
+   * recorded, and asking for them is a clear error. */
+  CHECK(valo_render_write(r, "ao:x.exr", NULL, &err) == VALO_ERR_INVALID && strstr(err.message, "VALO_AOVS_AO"), "ao AOV without the bit accepted");
   /* Without aovs set, asking for one is a clear error. */
   valo_render_destroy(r);
   CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);

@@ -35,7 +35,7 @@ static int ao_at(const char *shapes, double x, double cam_y, const char *params,
   const char *path = scratch_file("ao.json", json);
   valo_options o;
   valo_options_init(&o);
-  o.aovs = 1;
+  o.aovs = 1 | VALO_AOVS_AO;
   valo_scene *sc;
   valo_render *r = render_file(path, &o, &sc);
   if (!r) return -1;

@@ -64,7 +64,9 @@ typedef struct valo_options {
   char sampler[16];       /* "sobol" (default: Owen-scrambled Sobol, padded per dimension)
                              or "independent" (a hash per sample and dimension) */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
-                             valo_render_write can then write; VALO_UNSET = no */
+                             valo_render_write can then write; with the VALO_AOVS_AO bit
+                             also ambient occlusion and the bent normal (one more ray
+                             per camera sample); VALO_UNSET = no */
   int adaptive;           /* adaptive sampling (docs/integrators.md): spp is then the average
                              budget per pixel. VALO_ADAPTIVE_ERROR (1, default rule) or
                              VALO_ADAPTIVE_DIGEST (2, the digest's priority); 0 or
@@ -79,6 +81,8 @@ typedef struct valo_options {
                              VALO_UNSET = the scene's (file cameras: autofocus on the
                              surface at the image centre) */
 } valo_options;
+
+#define VALO_AOVS_AO 2
 
 #define VALO_ADAPTIVE_ERROR 1
 #define VALO_ADAPTIVE_DIGEST 2
@@ -169,7 +173,9 @@ VALO_API void valo_output_options_init(valo_output_options *o);
  * and renamed, so a reader never sees a partial file. A prefix "albedo:", "normal:" or
  * "depth:" writes that AOV instead (the render must have been created with aovs set):
  * the first camera hit's albedo, its shading normal (world space, facing the camera)
- * and its distance from the camera (0 where the ray escaped), averaged over samples.
+ * and its distance from the camera (0 where the ray escaped), averaged over samples;
+ * "ao:" and "bent:" (aovs with the VALO_AOVS_AO bit) its unoccluded fraction and the
+ * normalised mean unoccluded direction.
  * "spp:" writes the number of samples each pixel received (in all three channels). */
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
                                        const valo_output_options *o, valo_error *err);

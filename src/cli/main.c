@@ -317,14 +317,17 @@ static int cmd_render(int argc, char **argv) {
     snprintf(default_out, sizeof default_out, "%.*s.png", len, base);
     outputs[nout++] = default_out;
   }
+  int aovs = 0; /* the AOVs the outputs ask for */
   for (int i = 0; i < nout; i++) {
-    if (aov_prefix(outputs[i]) && strncmp(outputs[i], "spp:", 4)) opt.aovs = 1;
+    if (aov_prefix(outputs[i]) && strncmp(outputs[i], "spp:", 4)) aovs |= 1;
+    if (!strncmp(outputs[i], "ao:", 3) || !strncmp(outputs[i], "bent:", 5)) aovs |= VALO_AOVS_AO;
     const char *dot = strrchr(outputs[i], '.');
     if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
       fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);
       return EXIT_USAGE;
     }
   }
+  if (aovs) opt.aovs = aovs;
 
   /* Every output's folder must exist and be writable before hours of rendering. */
   for (int i = 0; i < nout; i++) {

@@ -349,6 +349,7 @@ static void record_aovs(const valo_render *r, ray ry, float *acc, sampler *smp, 
   acc[0] += a.r; acc[1] += a.g; acc[2] += a.b;
   acc[3] += n.x; acc[4] += n.y; acc[5] += n.z;
   acc[6] += h.t * v3_len(ry.d);
+  if (!(r->opt.aovs & VALO_AOVS_AO)) return;
   vec3 dir;
   sampler_set_dim(smp, SDIM_AOV);
   if (ao_sample(&r->ctx, &it, n, r->ao_dist, smp, ts, &dir)) {
@@ -640,6 +641,8 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
     size_t n = strlen(aov_names[k]);
     if (strncmp(path, aov_names[k], n)) continue;
     if (!r->aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", path);
+    if (k >= 3 && !(r->opt.aovs & VALO_AOVS_AO))
+      return err_set(err, VALO_ERR_INVALID, "%s: the render was made without the ao AOV (aovs needs VALO_AOVS_AO)", path);
     size_t np = (size_t)r->opt.width * r->opt.height;
     float *px = malloc(np * 3 * sizeof(float));
     if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
