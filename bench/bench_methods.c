@@ -212,19 +212,36 @@ static double relmse(const float *a, const float *b, int n) {
   return e / (3.0 * n);
 }
 
-static int bench_photon(int quick) {
-  char cb[2048];
-  snprintf(cb, sizeof cb,
-           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
-           "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
-  char path[64];
-  snprintf(path, sizeof path, "bench-ph-%ld.json", (long)getpid());
+/* A scene file for CornellBox-Original with the reference's camera (in the working
+ * folder; remove it after) and the path of that reference. */
+static int write_cornell(char *path, size_t pn, char *refp, size_t rn) {
+  snprintf(path, pn, "bench-cornell-%ld.json", (long)getpid());
   FILE *f = fopen(path, "w");
   if (!f) return 1;
-  fputs(cb, f);
+  fprintf(f, "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+             "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
   fclose(f);
-  char refp[2048];
-  snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", shared());
+  snprintf(refp, rn, "%s/references/cornell-original.exr", shared());
+  return 0;
+}
+
+/* Renders `integ` at each of spp[0..n) (w x w pixels) and prints a row per render with
+ * its time and relMSE against ref; fills t[] and e[]. */
+static int curve(const char *scene_path, const char *integ, const int *spp, int n, const image *ref, int w, double *t, double *e) {
+  for (int i = 0; i < n; i++) {
+    float *px = render(scene_path, integ, spp[i], NULL, w, w, &t[i]);
+    if (!px) return 1;
+    e[i] = relmse(px, ref->rgb, w * w);
+    printf("| %s | %d | %.2f | %.5f |\n", integ, spp[i], t[i], e[i]);
+    fflush(stdout);
+    free(px);
+  }
+  return 0;
+}
+
+static int bench_photon(int quick) {
+  char path[64], refp[2048];
+  if (write_cornell(path, sizeof path, refp, sizeof refp)) return 1;
   const char *scenes[2] = {path, VALO_SOURCE_DIR "/scenes/caustic.json"};
   const char *refs[2] = {refp, VALO_SOURCE_DIR "/tests/data/caustic-path.exr"};
   const char *names[2] = {"CornellBox-Original 256x256", "caustic.json 128x128"};
@@ -238,22 +255,7 @@ static int bench_photon(int quick) {
     const int pspp[4] = {4, 16, 64, 256}, fspp[4] = {1, 2, 4, 8};
     double pt[4], pe[4], ft[4], fe[4];
     int n = quick ? 3 : 4;
-    for (int i = 0; i < n; i++) {
-      float *px = render(scenes[k], "path", pspp[i], NULL, wh[k], wh[k], &pt[i]);
-      if (!px) return 1;
-      pe[i] = relmse(px, ref.rgb, wh[k] * wh[k]);
-      printf("| path | %d | %.2f | %.5f |\n", pspp[i], pt[i], pe[i]);
-      fflush(stdout);
-      free(px);
-    }
-    for (int i = 0; i < n; i++) {
-      float *px = render(scenes[k], "photon", fspp[i], NULL, wh[k], wh[k], &ft[i]);
-      if (!px) return 1;
-      fe[i] = relmse(px, ref.rgb, wh[k] * wh[k]);
-      printf("| photon | %d | %.2f | %.5f |\n", fspp[i], ft[i], fe[i]);
-      fflush(stdout);
-      free(px);
-    }
+    if (curve(scenes[k], "path", pspp, n, &ref, wh[k], pt, pe) || curve(scenes[k], "photon", fspp, n, &ref, wh[k], ft, fe)) return 1;
     /* path is unbiased: relMSE ~ c / t; its error at photon's last time */
     double c = pe[n - 1] * pt[n - 1], at = c / ft[n - 1];
     printf("\nAt photon's %.1f s: path's relMSE (extrapolated as c/t) %.5f, photon %.5f: photon/path error %.2f.\n\n", ft[n - 1], at, fe[n - 1],
@@ -265,18 +267,8 @@ static int bench_photon(int quick) {
 }
 
 static int bench_manylight(int quick) {
-  char cb[2048];
-  snprintf(cb, sizeof cb,
-           "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
-           "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
-  char path[64];
-  snprintf(path, sizeof path, "bench-ml-%ld.json", (long)getpid());
-  FILE *f = fopen(path, "w");
-  if (!f) return 1;
-  fputs(cb, f);
-  fclose(f);
-  char refp[2048];
-  snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", shared());
+  char path[64], refp[2048];
+  if (write_cornell(path, sizeof path, refp, sizeof refp)) return 1;
   const char *scenes[3] = {path, VALO_SOURCE_DIR "/scenes/cornell-glossy.json", VALO_SOURCE_DIR "/bench/sponza-sun.json"};
   const char *refs[3] = {refp, VALO_SOURCE_DIR "/tests/data/cornell-glossy-path.exr", VALO_SOURCE_DIR "/bench/references/sponza-sun-path.exr"};
   const char *names[3] = {"CornellBox-Original 256x256", "cornell-glossy.json 64x64", "Sponza under a sun (bench/sponza-sun.json) 128x72"};
