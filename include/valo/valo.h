@@ -80,6 +80,10 @@ typedef struct valo_options {
   double focus_distance;  /* distance to the plane of focus along the view axis, > 0;
                              VALO_UNSET = the scene's (file cameras: autofocus on the
                              surface at the image centre) */
+  int frames;             /* > 0: render a sequence of this many frames (the scene's
+                             camera animation, or a static camera), each at spp samples
+                             per pixel, calling the frame callback after each
+                             (valo_render_on_frame); VALO_UNSET = one still image */
 } valo_options;
 
 #define VALO_AOVS_AO 2
@@ -138,6 +142,11 @@ VALO_API valo_status valo_render_create(const valo_scene *scene, const valo_opti
  * pass too (each pixel is averaged over its own count). valo_render_write then writes it. */
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user,
                                      valo_error *err);
+/* Called by valo_render_run after each frame of a sequence (valo_options.frames), from
+ * the calling thread, with the film holding that frame alone (valo_render_write writes
+ * it). Returning non-zero stops the sequence with that status (err filled). */
+typedef valo_status (*valo_frame_fn)(void *user, const valo_render *r, int frame, valo_error *err);
+VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user);
 /* Asks a running render to stop: tiles already started finish, no new tile starts.
  * Thread-safe and async-signal-safe (one atomic store). */
 VALO_API void valo_render_cancel(valo_render *r);
@@ -147,7 +156,9 @@ typedef struct valo_stats {
   double build_seconds;   /* acceleration structure */
   double render_seconds;
   uint64_t rays;          /* all rays traced: camera, bounce and shadow */
-  int spp_done;           /* whole passes: samples every pixel has (adaptive: the average) */
+  int spp_done;           /* whole passes: samples every pixel has (adaptive: the average;
+                             a sequence: the current frame's) */
+  int frames_done;        /* a sequence: frames finished (and given to the callback) */
   uint64_t samples;       /* camera samples taken over the whole film */
   int width, height;
   int threads;

@@ -54,6 +54,9 @@ static void usage_render(FILE *f) {
           "  --spp N                samples per pixel (default 16)\n"
           "  --time SECONDS         time budget: stop after the pass that reaches it\n"
           "                         (with --spp, whichever comes first)\n"
+          "  --frames N             render a sequence of N frames (the scene's camera keyframes,\n"
+          "                         or a static camera), each at --spp; outputs with a frame\n"
+          "                         pattern (out_%%04d.png) get every frame, plain names the last\n"
           "  --threads N            worker threads (default: all cores)\n"
           "  --seed N               random seed (default 1); same seed, same image, any thread count\n"
           "  --res WxH              film resolution (default 256x256)\n"
@@ -118,7 +121,44 @@ static int parse_double(const char *s, double lo, double hi, double *out) {
   return 0;
 }
 
-typedef struct progress_state { int tty; int quiet; double last_print; int spp_total; double time_budget; } progress_state;
+typedef struct progress_state { int tty; int quiet; double last_print; int spp_total; double time_budget; int frames; } progress_state;
+
+/* Where the frame number goes in an output name: a "%d" or "%0Nd" (N < 10). Returns the
+ * offset of the '%' and the conversion's length in *len, -1 when there is none, -2 when
+ * the name has another '%' (not allowed). */
+static int frame_pattern(const char *name, int *len) {
+  const char *p = strchr(name, '%');
+  if (!p) return -1;
+  const char *q = p + 1;
+  if (*q == '0') { q++; if (*q >= '1' && *q <= '9') q++; else return -2; }
+  if (*q != 'd' || strchr(q + 1, '%')) return -2;
+  *len = (int)(q + 1 - p);
+  return (int)(p - name);
+}
+/* name with its frame pattern replaced by frame f. */
+static void frame_name(const char *name, int f, char *out, size_t n) {
+  int len, at = frame_pattern(name, &len);
+  if (at < 0) { snprintf(out, n, "%s", name); return; }
+  int width = len > 2 ? name[at + 2] - '0' : 0;
+  snprintf(out, n, "%.*s%0*d%s", at, name, width, f, name + at + len);
+}
+
+typedef struct frame_out { const char *const *outputs; int nout; int frames; int quiet; const valo_output_options *oo; } frame_out;
+/* The frame callback: writes the outputs with a frame pattern, and at the last frame the
+ * plain ones. */
+static valo_status write_frame(void *user, const valo_render *r, int f, valo_error *err) {
+  const frame_out *fo = user;
+  for (int i = 0; i < fo->nout; i++) {
+    int len, pat = frame_pattern(fo->outputs[i], &len) >= 0;
+    if (!pat && f != fo->frames - 1) continue;
+    char name[4096];
+    frame_name(fo->outputs[i], f, name, sizeof name);
+    valo_status st = valo_render_write(r, name, fo->oo, err);
+    if (st) return st;
+    if (!fo->quiet && !isatty(2)) fprintf(stderr, "valo: wrote %s (frame %d)\n", name, f);
+  }
+  return VALO_OK;
+}
 
 static void fmt_time(double s, char *buf, size_t n) {
   if (!(s >= 0) || s > 1e7) { snprintf(buf, n, "--:--"); return; }
@@ -136,17 +176,19 @@ static int on_progress(void *user, double frac, int spp_done, double seconds) {
   fmt_time(eta, e, sizeof e);
   fmt_time(seconds, el, sizeof el);
   char sp[48];
-  if (p->spp_total >= 1048576) snprintf(sp, sizeof sp, "%d spp", spp_done);
+  if (p->frames > 0) { snprintf(sp, sizeof sp, "frame %d/%d", (int)(frac * p->frames + 0.5), p->frames); rate = seconds > 0 ? frac * p->frames / seconds : 0; }
+  else if (p->spp_total >= 1048576) snprintf(sp, sizeof sp, "%d spp", spp_done);
   else snprintf(sp, sizeof sp, "%d/%d spp", spp_done, p->spp_total);
+  const char *unit = p->frames > 0 ? "frames/s" : "spp/s";
   if (p->tty) {
     int width = 30, fill = (int)(frac * width + 0.5);
     char bar[64];
     for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
     bar[width] = 0;
-    fprintf(stderr, "\r[%s] %3d%%  %s  %.2f spp/s  elapsed %s  ETA %s ", bar, (int)(frac * 100 + 0.5), sp, rate, el, e);
+    fprintf(stderr, "\r[%s] %3d%%  %s  %.2f %s  elapsed %s  ETA %s ", bar, (int)(frac * 100 + 0.5), sp, rate, unit, el, e);
     fflush(stderr);
   } else if (seconds - p->last_print >= 5.0 || frac >= 1.0) {
-    fprintf(stderr, "valo: %3d%% %s, %.2f spp/s, elapsed %s, ETA %s\n", (int)(frac * 100 + 0.5), sp, rate, el, e);
+    fprintf(stderr, "valo: %3d%% %s, %.2f %s, elapsed %s, ETA %s\n", (int)(frac * 100 + 0.5), sp, rate, unit, el, e);
     p->last_print = seconds;
   }
   return g_interrupted;
@@ -202,6 +244,10 @@ static int cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (parse_double(val, 0.001, 1e8, &dv)) BAD_VALUE("seconds, > 0");
       opt.time_budget = dv;
+    } else if (!strcmp(a, "--frames")) {
+      NEED_VALUE();
+      if (parse_int(val, 1, 1000000, &lv)) BAD_VALUE("a whole number from 1 to 1000000");
+      opt.frames = (int)lv;
     } else if (!strcmp(a, "--threads")) {
       NEED_VALUE();
       if (parse_int(val, 1, 1024, &lv)) BAD_VALUE("a whole number from 1 to 1024");
@@ -321,6 +367,9 @@ static int cmd_render(int argc, char **argv) {
   for (int i = 0; i < nout; i++) {
     if (aov_prefix(outputs[i]) && strncmp(outputs[i], "spp:", 4)) aovs |= 1;
     if (!strncmp(outputs[i], "ao:", 3) || !strncmp(outputs[i], "bent:", 5)) aovs |= VALO_AOVS_AO;
+    int plen, pat = frame_pattern(outputs[i], &plen);
+    if (pat == -2) { fprintf(stderr, "valo: %s: a '%%' in an output name must be a frame pattern, %%d or %%04d\n", outputs[i]); return EXIT_USAGE; }
+    if (pat >= 0 && opt.frames == VALO_UNSET) { fprintf(stderr, "valo: %s: a frame pattern needs --frames\n", outputs[i]); return EXIT_USAGE; }
     const char *dot = strrchr(outputs[i], '.');
     if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
       fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);
@@ -376,10 +425,14 @@ static int cmd_render(int argc, char **argv) {
   valo_scene_file_options(sc, &eff);
   int spp_total = opt.spp != VALO_UNSET ? opt.spp : (eff.spp != VALO_UNSET ? eff.spp : 16);
   double time_total = opt.time_budget != VALO_UNSET ? opt.time_budget : eff.time_budget;
-  progress_state ps = {isatty(2), quiet, -1e9, spp_total, time_total};
+  int frames = opt.frames != VALO_UNSET ? opt.frames : 0;
+  progress_state ps = {isatty(2), quiet, -1e9, spp_total, time_total, frames};
+  frame_out fo = {outputs, nout, frames, quiet, &oo};
+  if (frames > 0) valo_render_on_frame(r, write_frame, &fo);
   if (!quiet) {
     char budget[96];
-    if (time_total > 0 && spp_total >= 1048576) snprintf(budget, sizeof budget, "time budget %g s", time_total);
+    if (frames > 0) snprintf(budget, sizeof budget, "%d frames at %d spp%s", frames, spp_total, time_total > 0 ? " (time-limited)" : "");
+    else if (time_total > 0 && spp_total >= 1048576) snprintf(budget, sizeof budget, "time budget %g s", time_total);
     else if (time_total > 0) snprintf(budget, sizeof budget, "%d spp or %g s, whichever comes first", spp_total, time_total);
     else snprintf(budget, sizeof budget, "%d spp", spp_total);
     fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %s, %s integrator, %s, %d threads\n", scene_path,
@@ -397,7 +450,26 @@ static int cmd_render(int argc, char **argv) {
   if (ps.tty && !quiet) fprintf(stderr, "\n");
   int rc = 0;
   valo_render_stats(r, &st);
-  if (rs == VALO_ERR_CANCELLED || g_interrupted) {
+  if (frames > 0) {
+    /* the frame callback wrote every frame as it finished */
+    if (rs == VALO_ERR_CANCELLED || g_interrupted) {
+      rc = EXIT_INTERRUPTED;
+      fprintf(stderr, "valo: interrupted after %d of %d frames (each written as it finished)\n", st.frames_done, frames);
+    } else if (rs) {
+      fprintf(stderr, "valo: error: %s\n", err.message);
+      rc = 1;
+    } else {
+      if (st.frames_done < frames && st.frames_done > 0) {
+        /* the time budget ended the sequence early: plain names get its last frame */
+        for (int i = 0; i < nout; i++) {
+          int plen;
+          if (frame_pattern(outputs[i], &plen) >= 0) continue;
+          if (valo_render_write(r, outputs[i], &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
+        }
+      }
+      if (!quiet) fprintf(stderr, "valo: wrote %d frames%s\n", st.frames_done, st.frames_done < frames ? " (the time budget ended the sequence)" : "");
+    }
+  } else if (rs == VALO_ERR_CANCELLED || g_interrupted) {
     rc = EXIT_INTERRUPTED;
     if (st.spp_done > 0 || st.samples > 0)
       fprintf(stderr, "valo: interrupted after %d spp%s; writing what is finished\n", st.spp_done,
@@ -407,7 +479,7 @@ static int cmd_render(int argc, char **argv) {
     fprintf(stderr, "valo: error: %s\n", err.message);
     rc = 1;
   }
-  if (rc == 0 || (rc == EXIT_INTERRUPTED && (st.spp_done > 0 || st.samples > 0))) {
+  if (frames == 0 && (rc == 0 || (rc == EXIT_INTERRUPTED && (st.spp_done > 0 || st.samples > 0)))) {
     for (int i = 0; i < nout; i++) {
       if (valo_render_write(r, outputs[i], &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
       else if (!quiet) fprintf(stderr, "valo: wrote %s (%d spp)\n", outputs[i], st.spp_done);

@@ -10,10 +10,11 @@
 #include <math.h>
 
 extern const integrator_ops integrator_path, integrator_whitted, integrator_distribution, integrator_ao,
-    integrator_proximity_ao, integrator_photon, integrator_vpl, integrator_vsl;
+    integrator_proximity_ao, integrator_photon, integrator_vpl, integrator_vsl, integrator_restir_di, integrator_restir_gi;
 static const integrator_ops *const registry[] = {&integrator_path, &integrator_whitted, &integrator_distribution, &integrator_photon,
-                                                 &integrator_vpl, &integrator_vsl, &integrator_ao, &integrator_proximity_ao, NULL};
-static const char *const names[] = {"path", "whitted", "distribution", "photon", "vpl", "vsl", "ao", "proximity-ao", NULL};
+                                                 &integrator_vpl, &integrator_vsl, &integrator_ao, &integrator_proximity_ao,
+                                                 &integrator_restir_di, &integrator_restir_gi, NULL};
+static const char *const names[] = {"path", "whitted", "distribution", "photon", "vpl", "vsl", "ao", "proximity-ao", "restir-di", "restir-gi", NULL};
 
 const integrator_ops *integrator_find(const char *name) {
   for (int i = 0; registry[i]; i++)

@@ -35,6 +35,8 @@ typedef struct render_ctx {
   const void *state;       /* what the integrator's create/prepare made (photon maps, points) */
   uint64_t seed;
   int threads;
+  int width, height;       /* the film */
+  int sampler_kind;        /* sampler_kind of the render (Sobol or independent) */
 } render_ctx;
 #define PATH_HARD_CAP 1024
 
@@ -45,6 +47,43 @@ typedef struct render_ctx {
  * pass's photons or VPLs into fresh buffers, deterministic for any thread count) and
  * destroy; li() then reads c->state. The render loop runs one sample per pixel per pass
  * for integrators with prepare, so each pass's camera samples see one independent set. */
+/* A pinhole camera on a film (render.c fills it per frame): unit basis, tangent of half
+ * the vertical field of view and the film's aspect. Film coordinates are pixels from the
+ * top-left corner (x right, y down). */
+typedef struct cam_view {
+  vec3 o, fwd, right, up;
+  float tan_half, aspect;
+  int width, height;
+} cam_view;
+/* Unit direction of the ray through film point (fx, fy). */
+static inline vec3 cam_view_dir(const cam_view *v, float fx, float fy) {
+  float sx = (2.0f * fx / (float)v->width - 1.0f) * v->tan_half * v->aspect;
+  float sy = (1.0f - 2.0f * fy / (float)v->height) * v->tan_half;
+  return v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
+}
+/* Film point where p is seen (the inverse of cam_view_dir); 0 when p is behind the camera
+ * or off the film. */
+static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
+  vec3 d = v3_sub(p, v->o);
+  float z = v3_dot(d, v->fwd);
+  if (!(z > 0)) return 0;
+  float sx = v3_dot(d, v->right) / (z * v->tan_half * v->aspect), sy = v3_dot(d, v->up) / (z * v->tan_half);
+  *fx = (sx + 1.0f) * 0.5f * (float)v->width;
+  *fy = (1.0f - sy) * 0.5f * (float)v->height;
+  return *fx >= 0 && *fy >= 0 && *fx < (float)v->width && *fy < (float)v->height;
+}
+
+/* One frame of an image-wide integrator (render_frame). The render loop calls it once per
+ * frame of a sequence (--frames), or once per pass of a still image on the static
+ * camera, whose frames are averaged. */
+typedef struct frame_ctx {
+  int frame;            /* 0 for the first frame the integrator sees (no history yet) */
+  cam_view cam, prev;   /* this frame's camera and the previous frame's (equal for frame 0) */
+  float *rgb;           /* out: width*height*3 radiance estimates of this frame */
+  thread_stats *ts;     /* one per thread */
+  const _Atomic int *cancel; /* non-zero: stop between stages and return VALO_ERR_CANCELLED */
+} frame_ctx;
+
 typedef struct integrator_ops {
   const char *name;
   const char *description;
@@ -54,6 +93,11 @@ typedef struct integrator_ops {
   valo_status (*create)(const render_ctx *c, void **state, valo_error *err);
   valo_status (*prepare)(void *state, const render_ctx *c, int sample_index, valo_error *err);
   void (*destroy)(void *state);
+  /* Image-wide integrators (restir-di, restir-gi) give render_frame instead of li: it runs
+   * its stages as parallel_for over pixels (each a barrier), reading the buffers of the
+   * previous stage or frame and writing its own (double-buffered), so the result does
+   * not depend on the thread count; state persists from frame to frame. */
+  valo_status (*render_frame)(void *state, const render_ctx *c, const frame_ctx *f, valo_error *err);
 } integrator_ops;
 
 const integrator_ops *integrator_find(const char *name);

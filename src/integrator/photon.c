@@ -315,4 +315,4 @@ static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts)
 const integrator_ops integrator_photon = {
     "photon",
     "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass",
-    photon_params, photon_li, photon_create, photon_prepare, photon_destroy};
+    photon_params, photon_li, photon_create, photon_prepare, photon_destroy, NULL};

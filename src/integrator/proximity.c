@@ -381,4 +381,4 @@ static rgb prox_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
 const integrator_ops integrator_proximity_ao = {
     "proximity-ao",
     "ambient proximity occlusion (digest 003): splatted points and a fixed-radius kd-tree search; noise-free",
-    prox_params, prox_li, prox_create, NULL, prox_destroy};
+    prox_params, prox_li, prox_create, NULL, prox_destroy, NULL};

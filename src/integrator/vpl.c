@@ -261,7 +261,7 @@ static rgb vpl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { 
 
 const integrator_ops integrator_vpl = {
     "vpl", "instant radiosity (Keller 1997): virtual point lights from light paths, clamping, bias compensation (Kollig & Keller 2004)",
-    vpl_params, vpl_li, vpl_create, vpl_prepare, vpl_destroy};
+    vpl_params, vpl_li, vpl_create, vpl_prepare, vpl_destroy, NULL};
 const integrator_ops integrator_vsl = {
     "vsl", "virtual spherical lights (Hasan et al. 2009): each VPL's flux spread over a sphere, integrated over the cone it subtends",
-    vsl_params, vpl_li, vsl_create, vpl_prepare, vpl_destroy};
+    vsl_params, vpl_li, vsl_create, vpl_prepare, vpl_destroy, NULL};

@@ -129,6 +129,48 @@ static float solid_angle_if_used(const scene *s, const light *l, vec3 p, vec3 di
   return omega > 0 && omega <= SPH_MAX_SOLID_ANGLE ? omega : 0;
 }
 
+/* Surface UV of point pl on area light l's triangle (barycentrics clamped into it). */
+static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float *tv) {
+  const uint32_t *ix = &s->idx[3 * l->tri];
+  vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+  vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), q = v3_sub(pl, a);
+  float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), q1 = v3_dot(q, e1), q2 = v3_dot(q, e2);
+  float den = d11 * d22 - d12 * d12;
+  float bb1 = den != 0 ? (d22 * q1 - d12 * q2) / den : 0, bb2 = den != 0 ? (d11 * q2 - d12 * q1) / den : 0;
+  bb1 = clampf(bb1, 0, 1); bb2 = clampf(bb2, 0, 1 - bb1);
+  scene_tri_uv(s, l->tri, bb1, bb2, tu, tv);
+}
+
+int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g) {
+  *g = 1;
+  switch (l->type) {
+  case LIGHT_AREA: {
+    vec3 d = v3_sub(y, p);
+    float d2 = v3_len2(d);
+    if (!(d2 > 0)) return 0;
+    float dist = sqrtf(d2);
+    vec3 wi = v3_scale(d, 1 / dist), n = v3_norm(scene_tri_ng(s, l->tri));
+    float cos_l = fabsf(v3_dot(n, wi));
+    if (!(cos_l > 0)) return 0;
+    float tu, tv;
+    area_uv_at(s, l, y, &tu, &tv);
+    o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
+    if (c3_black(o->L)) return 0;
+    o->wi = wi; o->dist = dist; o->p_light = y; o->n_light = n; o->pdf = 0; o->delta = 0;
+    *g = cos_l / d2;
+    return isfinite(*g);
+  }
+  case LIGHT_ENV:
+    o->wi = y; o->dist = INFINITY; o->L = light_env_radiance(s, l, y); o->pdf = 0; o->delta = 0;
+    o->p_light = v3_add(p, v3_scale(y, 2 * s->radius));
+    o->n_light = v3(0, 0, 0);
+    return !c3_black(o->L);
+  case LIGHT_POINT: case LIGHT_SPOT: case LIGHT_DIRECTIONAL:
+    return light_sample(s, l, p, 0, 0, o); /* delta lights: one point (or direction) */
+  }
+  return 0;
+}
+
 int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *o) {
   o->delta = 0;
   switch (l->type) {
@@ -149,15 +191,8 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
       float t = v3_dot(n, v3_sub(a, p)) / dn;
       if (!(t > 0)) return 0;
       pl = v3_add(p, v3_scale(w, t));
-      /* Barycentrics of pl (for an emission map), clamped into the triangle. */
-      vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), q = v3_sub(pl, a);
-      float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), q1 = v3_dot(q, e1), q2 = v3_dot(q, e2);
-      float den = d11 * d22 - d12 * d12;
-      float bb1 = den != 0 ? (d22 * q1 - d12 * q2) / den : 0, bb2 = den != 0 ? (d11 * q2 - d12 * q1) / den : 0;
-      bb1 = clampf(bb1, 0, 1); bb2 = clampf(bb2, 0, 1 - bb1);
-      b0 = 1 - bb1 - bb2; b1 = bb1;
       float tu, tv;
-      scene_tri_uv(s, l->tri, b1, bb2, &tu, &tv);
+      area_uv_at(s, l, pl, &tu, &tv);
       o->L = light_area_radiance(s, l, n, v3_neg(w), tu, tv);
       if (c3_black(o->L)) return 0;
       o->wi = w; o->dist = t; o->p_light = pl; o->n_light = n;

@@ -38,6 +38,12 @@ typedef struct light_li {
 
 /* Samples light l as seen from p; returns 0 if it contributes nothing. */
 int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *out);
+/* Light l as seen from p through a point y it could have sampled (ReSTIR reuses samples
+ * across shading points): area lights, y a point on the triangle; the environment, y a
+ * direction; delta lights, y is ignored. Fills wi, dist, p_light, n_light and L as
+ * light_sample does (pdf 0) and *g, the factor from y's own measure to solid angle at
+ * p: |cos theta_l| / d^2 for area lights, 1 otherwise. Returns 0 when it sends nothing. */
+int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g);
 /* Solid-angle density with which light_sample picks direction wi from p to point
  * p_light with normal n_light on area light l (env: the direction alone). */
 float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 p_light, vec3 n_light);

@@ -50,10 +50,14 @@ struct valo_render {
   double build_seconds, render_seconds;
   uint64_t rays, bad_samples;
   atomic_int cancel;
-  /* camera basis */
-  vec3 cam_o, cam_fwd, cam_right, cam_up;
-  float tan_half, aspect;
+  camera cam_still;       /* the scene camera fitted to the film (frame 0 of an animation) */
+  cam_view view, view_prev;/* this frame's pinhole basis and the previous frame's */
   float aperture, focus;   /* thin lens: radius (0 = pinhole) and focus distance */
+  int frames_done;         /* a sequence: frames finished */
+  int image_frames;        /* render_frame calls made (the integrator's frame index) */
+  float *frame_rgb;        /* render_frame output, width*height*3 */
+  valo_frame_fn on_frame;
+  void *on_frame_user;
 };
 
 static double now_seconds(void) {
@@ -77,6 +81,7 @@ VALO_API void valo_options_init(valo_options *o) {
   o->spectral = VALO_UNSET;
   o->aperture_radius = o->focus_distance = VALO_UNSET;
   o->max_depth = VALO_DEPTH_UNSET; /* -1 is a meaningful value */
+  o->frames = VALO_UNSET;
 }
 
 VALO_API void valo_output_options_init(valo_output_options *o) {
@@ -185,6 +190,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     if (o->spectral != VALO_UNSET) dst->spectral = o->spectral;
     if (o->aperture_radius != VALO_UNSET) dst->aperture_radius = o->aperture_radius;
     if (o->focus_distance != VALO_UNSET) dst->focus_distance = o->focus_distance;
+    if (o->frames != VALO_UNSET) dst->frames = o->frames;
   }
   if (dst->width == VALO_UNSET) dst->width = 256;
   if (dst->height == VALO_UNSET) dst->height = 256;
@@ -196,9 +202,27 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
   if (dst->noise_threshold == VALO_UNSET) dst->noise_threshold = 0;
   if (dst->spectral == VALO_UNSET) dst->spectral = 0;
   if (dst->max_depth == VALO_DEPTH_UNSET) dst->max_depth = -1;
+  if (dst->frames == VALO_UNSET) dst->frames = 0;
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
   if (!dst->sampler[0]) snprintf(dst->sampler, sizeof dst->sampler, "sobol");
+}
+
+/* The pinhole basis of frame f of a sequence (the scene's camera animation, if any), or
+ * of the still camera (a still ignores the animation: it is the camera's own fields);
+ * -1 when up is parallel to the view direction. */
+static int set_view(valo_render *r, int f) {
+  camera c = r->opt.frames > 0 ? scene_camera_at(r->s, &r->cam_still, (float)f) : r->cam_still;
+  cam_view *v = &r->view;
+  v->o = c.pos;
+  v->fwd = v3_norm(v3_sub(c.look_at, c.pos));
+  v->right = v3_norm(v3_cross(v->fwd, c.up));
+  v->up = v3_cross(v->right, v->fwd);
+  v->tan_half = tanf(0.5f * c.fov_deg * PI_F / 180.0f);
+  v->width = r->opt.width;
+  v->height = r->opt.height;
+  v->aspect = (float)r->opt.width / (float)r->opt.height;
+  return (!v3_finite(v->right) || !(v3_len2(v->right) > 0.5f)) ? -1 : 0;
 }
 
 VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options *opts, valo_render **out, valo_error *err) {
@@ -218,6 +242,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     return err_set(err, VALO_ERR_INVALID, "aperture radius must be >= 0");
   if (o.focus_distance != VALO_UNSET && !(o.focus_distance > 0 && o.focus_distance < 1e9))
     return err_set(err, VALO_ERR_INVALID, "focus distance must be > 0");
+  if (o.frames < 0 || o.frames > 1000000) return err_set(err, VALO_ERR_INVALID, "frame count %d is out of range (1..1000000)", o.frames);
   if (o.max_depth < -1) return err_set(err, VALO_ERR_INVALID, "max_depth must be -1 (unlimited) or >= 0");
   if (strcmp(o.sampler, "sobol") && strcmp(o.sampler, "independent"))
     return err_set(err, VALO_ERR_INVALID, "unknown sampler \"%s\" (sobol or independent)", o.sampler);
@@ -239,6 +264,12 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   if (pst) return pst;
   if (o.adaptive && integ->prepare)
     return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with the %s integrator (each pass shares one light-path set)", integ->name);
+  if (o.adaptive && o.frames > 0) return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with --frames");
+  if (integ->render_frame) {
+    if (o.adaptive) return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with the %s integrator (it renders whole frames)", integ->name);
+    if (o.aovs) return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator records no AOVs (albedo:, normal:, depth:, ao:, bent: outputs)", integ->name);
+    if (o.aperture_radius > 0) return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator has a pinhole camera (no aperture)", integ->name);
+  }
   valo_render *r = calloc(1, sizeof *r);
   if (!r) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   r->s = s;
@@ -249,10 +280,14 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   atomic_init(&r->cancel, 0);
   r->sum = calloc((size_t)o.width * o.height * 3, sizeof(double));
   if (o.aovs) r->aov = calloc((size_t)o.width * o.height * AOV_FLOATS, sizeof(float));
+  if (integ->render_frame && !(r->frame_rgb = calloc((size_t)o.width * o.height * 3, sizeof(float)))) {
+    free(r->sum); free(r->aov); free(r);
+    return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
+  }
   r->count = calloc((size_t)o.width * o.height, sizeof(uint32_t));
   if (o.adaptive) r->lum = calloc((size_t)o.width * o.height * 2, sizeof(double));
   if (!r->sum || (o.aovs && !r->aov) || !r->count || (o.adaptive && !r->lum)) {
-    free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r);
+    free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r->frame_rgb); free(r);
     return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
   }
   double t0 = now_seconds();
@@ -263,7 +298,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->alpha_filter.tri_flags = s->tri_flags;
   r->alpha_filter.flag_bit = TRI_ALPHA;
   valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &r->alpha_filter : NULL, &r->acc, err);
-  if (st) { free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r); return st; }
+  if (st) { free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r->frame_rgb); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
   if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   r->ctx.s = s;
@@ -272,26 +307,24 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->ctx.param = r->param;
   r->ctx.seed = (uint64_t)o.seed;
   r->ctx.threads = o.threads;
+  r->ctx.width = o.width;
+  r->ctx.height = o.height;
+  r->ctx.sampler_kind = r->sampler_kind;
   r->ao_dist = ao_ray_length(s, ao_param[0]);
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
-  camera fitted = scene_camera_fit(s, (float)o.width / (float)o.height);
-  const camera *c = &fitted;
-  r->cam_o = c->pos;
-  r->cam_fwd = v3_norm(v3_sub(c->look_at, c->pos));
-  r->cam_right = v3_norm(v3_cross(r->cam_fwd, c->up));
-  r->cam_up = v3_cross(r->cam_right, r->cam_fwd);
-  r->tan_half = tanf(0.5f * c->fov_deg * PI_F / 180.0f);
-  r->aspect = (float)o.width / (float)o.height;
-  if (!v3_finite(r->cam_right) || !(v3_len2(r->cam_right) > 0.5f)) {
+  r->cam_still = scene_camera_fit(s, (float)o.width / (float)o.height);
+  const camera *c = &r->cam_still;
+  if (set_view(r, 0)) {
     valo_render_destroy(r);
     return err_set(err, VALO_ERR_INVALID, "%s: camera up vector is parallel to the view direction", s->path);
   }
+  r->view_prev = r->view;
   r->aperture = o.aperture_radius != VALO_UNSET ? (float)o.aperture_radius : c->aperture_radius;
   r->focus = o.focus_distance != VALO_UNSET ? (float)o.focus_distance : c->focus_distance;
   if (!(r->focus > 0)) {
     /* Autofocus (file cameras carry no focus distance): the surface at the image
      * centre, or the distance to the look-at point if the centre ray escapes. */
-    ray cr = {r->cam_o, r->cam_fwd, INFINITY};
+    ray cr = {r->view.o, r->view.fwd, INFINITY};
     hit h;
     r->focus = accel_intersect(r->acc, &cr, &h) ? h.t : v3_len(v3_sub(c->look_at, c->pos));
     if (!(r->focus > 0)) r->focus = 1;
@@ -309,11 +342,9 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   float jx, jy;
   sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
-  float sx = (2.0f * ((float)px + jx) / (float)r->opt.width - 1.0f) * r->tan_half * r->aspect;
-  float sy = (1.0f - 2.0f * ((float)py + jy) / (float)r->opt.height) * r->tan_half;
-  vec3 d = v3_norm(v3_add(r->cam_fwd, v3_add(v3_scale(r->cam_right, sx), v3_scale(r->cam_up, sy))));
+  vec3 d = cam_view_dir(&r->view, (float)px + jx, (float)py + jy);
   ray ry;
-  ry.o = r->cam_o;
+  ry.o = r->view.o;
   ry.tmax = INFINITY;
   float lu, lv;
   sampler_set_dim(smp, SDIM_LENS);
@@ -321,11 +352,11 @@ static ray camera_ray(const valo_render *r, int px, int py, sampler *smp) {
   sampler_set_dim(smp, SDIM_WAVELENGTH);
   if (r->aperture > 0) {
     /* Thin lens: every ray through the lens meets at the plane of focus. */
-    float ft = r->focus / v3_dot(d, r->cam_fwd);
-    vec3 pf = v3_add(r->cam_o, v3_scale(d, ft));
+    float ft = r->focus / v3_dot(d, r->view.fwd);
+    vec3 pf = v3_add(r->view.o, v3_scale(d, ft));
     float dx, dy;
     sample_concentric_disk(lu, lv, &dx, &dy);
-    ry.o = v3_add(r->cam_o, v3_add(v3_scale(r->cam_right, dx * r->aperture), v3_scale(r->cam_up, dy * r->aperture)));
+    ry.o = v3_add(r->view.o, v3_add(v3_scale(r->view.right, dx * r->aperture), v3_scale(r->view.up, dy * r->aperture)));
     d = v3_norm(v3_sub(pf, ry.o));
   }
   ry.d = d;
@@ -467,11 +498,97 @@ static void adapt_chunk(void *user, int64_t item, int thread) {
   }
 }
 
+/* One frame of an image-wide integrator, added to the film as one sample per pixel (in
+ * pixel order: the film does not depend on the thread count). */
+static valo_status image_frame(valo_render *r, thread_stats *ts, valo_error *err) {
+  frame_ctx f = {r->image_frames, r->view, r->image_frames ? r->view_prev : r->view, r->frame_rgb, ts, &r->cancel};
+  valo_status st = r->integ->render_frame(r->istate, &r->ctx, &f, err);
+  if (st) return st;
+  r->image_frames++;
+  r->view_prev = r->view;
+  size_t np = (size_t)r->opt.width * r->opt.height;
+  for (size_t i = 0; i < np; i++) {
+    rgb L = c3(r->frame_rgb[3 * i], r->frame_rgb[3 * i + 1], r->frame_rgb[3 * i + 2]);
+    r->count[i]++;
+    if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts[0].bad_samples++; continue; }
+    r->sum[3 * i] += L.r; r->sum[3 * i + 1] += L.g; r->sum[3 * i + 2] += L.b;
+  }
+  return VALO_OK;
+}
+
+/* Samples [s0, s1) of every pixel through the tile loop (per-ray integrators); those
+ * with prepare take one sample index at a time, each after its prepare. */
+static valo_status tile_samples(valo_render *r, int s0, int s1, thread_stats *ts, valo_error *err) {
+  int tiles_x = (r->opt.width + TILE - 1) / TILE, tiles_y = (r->opt.height + TILE - 1) / TILE;
+  for (int a = s0; a < s1;) {
+    int b = s1;
+    if (r->integ->prepare) {
+      b = a + 1;
+      valo_status pst = r->integ->prepare(r->istate, &r->ctx, a, err);
+      if (pst) return pst;
+    }
+    pass_job job = {r, a, b, tiles_x, ts};
+    parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
+    if (atomic_load(&r->cancel)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled");
+    a = b;
+  }
+  return VALO_OK;
+}
+
+/* A sequence (opt.frames): each frame on its own camera (the animation's), with a fresh
+ * film of spp samples per pixel, handed to the frame callback. Sample indices go on
+ * from frame to frame (frame f takes [f spp, (f+1) spp)), so no two frames share noise. */
+static valo_status run_sequence(valo_render *r, valo_progress_fn progress, void *user, thread_stats *ts, valo_error *err) {
+  double t0 = now_seconds();
+  double budget = r->opt.time_budget > 0 ? r->opt.time_budget : 0;
+  size_t np = (size_t)r->opt.width * r->opt.height;
+  for (int f = r->frames_done; f < r->opt.frames; f++) {
+    if (set_view(r, f)) return err_set(err, VALO_ERR_INVALID, "%s: the camera at frame %d has its up vector along the view direction", r->s->path, f);
+    memset(r->sum, 0, np * 3 * sizeof *r->sum);
+    memset(r->count, 0, np * sizeof *r->count);
+    r->spp_done = 0;
+    if (r->integ->render_frame) {
+      for (int k = 0; k < r->opt.spp; k++) {
+        valo_status st = image_frame(r, ts, err);
+        if (st) return st;
+        r->spp_done++;
+      }
+    } else {
+      int64_t s0 = (int64_t)f * r->opt.spp;
+      if (s0 + r->opt.spp > UINT32_MAX) return err_set(err, VALO_ERR_INVALID, "frames x spp is more than 2^32 sample indices");
+      valo_status st = tile_samples(r, (int)s0, (int)(s0 + r->opt.spp), ts, err);
+      if (st) return st;
+      r->spp_done = r->opt.spp;
+    }
+    r->frames_done++;
+    if (r->on_frame) {
+      valo_status st = r->on_frame(r->on_frame_user, r, f, err);
+      if (st) return st;
+    }
+    double el = now_seconds() - t0;
+    double frac = (double)(f + 1) / r->opt.frames;
+    if (progress && progress(user, frac, r->spp_done, el)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d frames", r->frames_done);
+    if (budget > 0 && el >= budget) break;
+  }
+  return VALO_OK;
+}
+
+VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user) { r->on_frame = fn; r->on_frame_user = user; }
+
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
   if (err) { err->status = VALO_OK; err->message[0] = 0; }
   int threads = r->opt.threads;
   thread_stats *ts = calloc((size_t)threads, sizeof *ts);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  if (r->opt.frames > 0) {
+    double t0 = now_seconds();
+    valo_status sst = run_sequence(r, progress, user, ts, err);
+    r->render_seconds += now_seconds() - t0;
+    for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
+    free(ts);
+    if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
+    return sst;
+  }
   int tiles_x = (r->opt.width + TILE - 1) / TILE, tiles_y = (r->opt.height + TILE - 1) / TILE;
   double t0 = now_seconds();
   double budget = r->opt.time_budget > 0 ? r->opt.time_budget : 0;
@@ -492,9 +609,16 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
       valo_status pst = r->integ->prepare(r->istate, &r->ctx, r->spp_done, err);
       if (pst) { st = pst; break; }
     }
-    pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
     double p0 = now_seconds();
-    parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
+    if (r->integ->render_frame) {
+      /* a still image from an image-wide integrator: frames on the static camera, averaged */
+      n = 1;
+      valo_status fst = image_frame(r, ts, err);
+      if (fst && fst != VALO_ERR_CANCELLED) { st = fst; break; }
+    } else {
+      pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
+      parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
+    }
     double pt = now_seconds() - p0;
     if (atomic_load(&r->cancel)) {
       /* A cancelled pass stops between tiles: every tile holds whole samples (a tile
@@ -586,6 +710,7 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   o->render_seconds = r->render_seconds;
   o->rays = r->rays;
   o->spp_done = r->spp_done;
+  o->frames_done = r->frames_done;
   size_t np = (size_t)r->opt.width * r->opt.height;
   for (size_t i = 0; i < np; i++) o->samples += r->count[i];
   o->width = r->opt.width;
@@ -686,5 +811,6 @@ VALO_API void valo_render_destroy(valo_render *r) {
   free(r->aov);
   free(r->count);
   free(r->lum);
+  free(r->frame_rgb);
   free(r);
 }

@@ -126,8 +126,41 @@ static valo_status get_bool(jctx *c, const cJSON *o, const char *key, const char
 
 #define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
+/* camera.keyframes: [{"frame": F, "position", "look_at", "up", "fov"}, ...], frames
+ * increasing; a key's missing fields take the camera's. */
+static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
+  if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) < 1) return bad(c, "camera.keyframes", "must be a non-empty array of objects");
+  int n = cJSON_GetArraySize(a);
+  if (n > 100000) return bad(c, "camera.keyframes", "more than 100000 keyframes");
+  cam_key *k = calloc((size_t)n, sizeof *k);
+  if (!k) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->cam_keys = k;
+  c->s->ncam_keys = (uint32_t)n;
+  static const char *const keys[] = {"frame", "position", "look_at", "up", "fov", NULL};
+  int i = 0;
+  for (const cJSON *e = a->child; e; e = e->next, i++) {
+    char where[64];
+    snprintf(where, sizeof where, "camera.keyframes[%d]", i);
+    TRY(check_keys(c, e, where, keys));
+    if (!cJSON_GetObjectItemCaseSensitive(e, "frame")) return bad(c, where, "needs \"frame\"");
+    double d = 0;
+    TRY(get_num(c, e, "frame", where, -1e9, 1e9, &d));
+    k[i].frame = (float)d;
+    if (i > 0 && !(k[i].frame > k[i - 1].frame)) return bad(c, where, "frames must increase from key to key");
+    k[i].pos = cam->pos; k[i].look_at = cam->look_at; k[i].up = cam->up; k[i].fov_deg = cam->fov_deg;
+    TRY(get_vec(c, e, "position", where, 0, &k[i].pos));
+    TRY(get_vec(c, e, "look_at", where, 0, &k[i].look_at));
+    TRY(get_vec(c, e, "up", where, 0, &k[i].up));
+    d = k[i].fov_deg; TRY(get_num(c, e, "fov", where, 1e-3, 179.9, &d)); k[i].fov_deg = (float)d;
+    vec3 fwd = v3_sub(k[i].look_at, k[i].pos);
+    if (!(v3_len2(fwd) > 0)) return bad(c, where, "position and look_at must differ");
+    if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(k[i].up))) > 1e-12f)) return bad(c, where, "up must not be parallel to the view direction");
+  }
+  return VALO_OK;
+}
+
 static valo_status parse_camera(jctx *c, const cJSON *o) {
-  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", "from_file", NULL};
+  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", "from_file", "keyframes", NULL};
   TRY(check_keys(c, o, "camera", keys));
   camera *cam = &c->s->cam;
   const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
@@ -159,6 +192,8 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
   if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(cam->up))) > 1e-12f)) return bad(c, "camera.up", "must not be parallel to the view direction");
   if (cam->focus_distance <= 0) cam->focus_distance = v3_len(fwd);
   c->s->has_camera = 1;
+  const cJSON *kf = cJSON_GetObjectItemCaseSensitive(o, "keyframes");
+  if (kf) TRY(parse_keyframes(c, kf, cam));
   return VALO_OK;
 }
 

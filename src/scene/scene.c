@@ -19,7 +19,7 @@ scene *scene_new(const char *path) {
 void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->idx); free(s->tri_mat); free(s->tri_flags);
-  free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao);
+  free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys);
   if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
   free(s->tex);
@@ -332,4 +332,24 @@ camera scene_camera_fit(const scene *s, float aspect) {
   c->pos = v3_sub(c->look_at, v3_scale(f, D));
   c->focus_distance = D;
   return cam;
+}
+
+camera scene_camera_at(const scene *s, const camera *still, float f) {
+  camera c = *still;
+  if (!s->ncam_keys) return c;
+  const cam_key *k = s->cam_keys;
+  uint32_t n = s->ncam_keys, i = 0;
+  if (f <= k[0].frame || n == 1) i = 0;
+  else if (f >= k[n - 1].frame) i = n - 1;
+  else {
+    while (i + 1 < n && k[i + 1].frame <= f) i++;
+    float t = (f - k[i].frame) / (k[i + 1].frame - k[i].frame);
+    c.pos = v3_add(v3_scale(k[i].pos, 1 - t), v3_scale(k[i + 1].pos, t));
+    c.look_at = v3_add(v3_scale(k[i].look_at, 1 - t), v3_scale(k[i + 1].look_at, t));
+    c.up = v3_add(v3_scale(k[i].up, 1 - t), v3_scale(k[i + 1].up, t));
+    c.fov_deg = k[i].fov_deg * (1 - t) + k[i + 1].fov_deg * t;
+    return c;
+  }
+  c.pos = k[i].pos; c.look_at = k[i].look_at; c.up = k[i].up; c.fov_deg = k[i].fov_deg;
+  return c;
 }

@@ -61,6 +61,11 @@ typedef struct camera {
   float aperture_radius, focus_distance;
 } camera;
 
+/* One keyframe of a camera animation: the camera at frame `frame` (frames between
+ * keyframes interpolate position, look_at, up and fov linearly; before the first and
+ * after the last the camera holds still). */
+typedef struct cam_key { float frame; vec3 pos, look_at, up; float fov_deg; } cam_key;
+
 /* Triangle flags. */
 enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
 
@@ -92,6 +97,8 @@ typedef struct scene {
   struct envmap *env_map;  /* equirectangular map (owned), or NULL for constant */
   camera cam;
   int has_camera;
+  cam_key *cam_keys;       /* camera animation (JSON camera.keyframes), sorted by frame; or NULL */
+  uint32_t ncam_keys;
   int up_z;                /* automatic framing: the model's up axis is +z (else +y) */
   int cam_auto;            /* the camera was framed automatically (scene_camera_fit) */
   valo_options file_opts;
@@ -128,6 +135,9 @@ static inline vec3 scene_tri_ng(const scene *s, uint32_t t) {
 /* The scene's camera for a film of this aspect: an automatic camera moved along its axis
  * to the nearest distance that frames the bounds; any other camera as it is. */
 camera scene_camera_fit(const scene *s, float aspect);
+/* The camera at frame f: the keyframes' interpolation when the scene has an animation,
+ * else `still` (the lens of `still` is kept either way). */
+camera scene_camera_at(const scene *s, const camera *still, float f);
 
 /* Loaders (one per file kind). */
 valo_status load_json(scene *s, const char *path, valo_error *err);

@@ -1,0 +1,640 @@
+/* restir.c — owns restir-di and restir-gi (digest 001): reservoir-based spatiotemporal
+ * importance resampling of direct light (Bitterli et al. 2020) and of indirect light
+ * (Ouyang et al. 2021), as image-wide integrators (render_frame). One frame runs these
+ * stages, each a parallel_for over rows with a barrier after it, each reading only the
+ * buffers of earlier stages or of the previous frame and writing its own (so the image is
+ * the same for any thread count):
+ *   G-buffer (camera ray through delta lobes to the first surface with a non-delta lobe)
+ *   -> candidates (RIS) and their visibility -> temporal reuse (the reprojected pixel of
+ *   the previous frame) -> n rounds of spatial reuse (k neighbours) -> shading.
+ * Reservoirs follow the digest: {y, w_sum, M}, W = w_sum / (M p^(y)) (biased) or
+ * w_sum / (Z p^(y)), Z the candidates of the reservoirs merged whose own target (with
+ * visibility) is non-zero at y (unbiased; Bitterli et al. Alg. 6).
+ * DI samples are points on lights in the light's own measure (area for triangles, a
+ * direction for the environment, the light itself for delta lights), so reuse needs no
+ * Jacobian; GI samples are surface points x_s found from x_v in solid angle, so reuse
+ * multiplies by the Jacobian |cos phi_r| / |cos phi_q| * |x_q - x_s|^2 / |x_r - x_s|^2.
+ * Geometry is static between frames; only the camera moves. */
+#include "integrator/integrator.h"
+#include "integrator/restir.h"
+#include "core/threadpool.h"
+#include "core/sampling.h"
+#include "core/error.h"
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- parameters (docs/integrators.md lists the same) */
+enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIASED, P_NORMAL, P_DEPTH, P_DIRECT, P_JACOBIAN };
+#define DI_PARAMS_COMMON                                                                                                              \
+  {"candidates", IPARAM_INT, 32, 1, 1024, "M: light samples per pixel per frame (RIS candidates)"},                                   \
+  {"temporal", IPARAM_INT, 1, 0, 1, "1: reuse the previous frame's reservoir at the reprojected pixel"},                              \
+  {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},                    \
+  {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
+  {"radius", IPARAM_FLOAT, 30, 1, 1000, "spatial neighbours come from a disc of this many pixels"},                                    \
+  {"iterations", IPARAM_INT, 2, 0, 8, "n: rounds of spatial reuse"},                                                                   \
+  {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased, darker at contact)"},         \
+  {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"}, \
+  {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"}
+static const integrator_param di_params[] = {DI_PARAMS_COMMON, {NULL, IPARAM_INT, 0, 0, 0, NULL}};
+static const integrator_param gi_params[] = {
+    {"candidates", IPARAM_INT, 32, 1, 1024, "M of the direct-light reservoirs (direct=1)"},
+    {"temporal", IPARAM_INT, 1, 0, 1, "1: reuse the previous frame's reservoirs at the reprojected pixel"},
+    {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},
+    {"spatial", IPARAM_INT, 3, 0, 64, "k: neighbours merged per spatial round"},
+    {"radius", IPARAM_FLOAT, 30, 1, 1000, "spatial neighbours come from a disc of this many pixels"},
+    {"iterations", IPARAM_INT, 1, 0, 8, "n: rounds of spatial reuse"},
+    {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased)"},
+    {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"},
+    {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"},
+    {"direct", IPARAM_INT, 1, 0, 1, "direct light at the camera hit: 1 restir-di (its defaults), 0 plain next-event estimation"},
+    {"jacobian", IPARAM_INT, 1, 0, 1, "1: reused samples carry the solid-angle Jacobian (0 only to show the bias without it)"},
+    {NULL, IPARAM_INT, 0, 0, 0, NULL}};
+
+/* ---- per-pixel random streams: (seed, pixel, frame); stages use fixed dimensions */
+enum { RD_FILM = 0, RD_DELTA = 1, RD_GI_DIR = 40, RD_GI_PATH = 41, RD_NEE = 42, RD_CAND = 64, RD_TEMPORAL = 0x1000, RD_SPATIAL = 0x2000 };
+
+typedef struct gpix {
+  isect it;
+  frame fr;
+  bsdf b;
+  vec3 wo;
+  rgb beta;      /* throughput of the delta chain from the camera to it */
+  rgb Le;        /* emission seen along that chain (weighted) */
+  float depth;   /* camera-to-first-hit distance */
+  int valid;     /* a surface with a non-delta lobe */
+  int chain;     /* reached through a delta bounce: not reprojected */
+} gpix;
+
+typedef struct restir_state {
+  int gi;
+  int width, height;
+  size_t np;
+  restir_cfg dcfg, gcfg;        /* DI settings; GI settings (gi only) */
+  int direct_restir;          /* gi: direct light by restir-di */
+  gpix *g, *g_prev;
+  di_res *di[2], *di_prev;    /* ping-pong buffers of this frame; last frame's final */
+  gi_res *gr[2], *gr_prev;
+  int di_final, gi_final;     /* which ping-pong buffer holds the final reservoirs */
+  int have_prev;
+} restir_state;
+
+/* ---- shared helpers */
+int restir_similar(const restir_cfg *cfg, vec3 n_a, float depth_a, vec3 n_b, float depth_b) {
+  if (v3_dot(n_a, n_b) < cfg->normal_threshold) return 0;
+  return fabsf(depth_a - depth_b) <= cfg->depth_threshold * depth_a;
+}
+
+static inline float rnd(sampler *s) { return rng_to_float(sampler_u32(s)); }
+
+/* Streaming weighted reservoir update: returns 1 when the candidate replaces the kept
+ * sample (probability w / w_sum after adding w). */
+static inline int wrs_take(float *w_sum, float w, float u) {
+  if (!(w > 0) || !isfinite(w)) return 0;
+  *w_sum += w;
+  return u * *w_sum < w;
+}
+
+/* ---- DI target: unshadowed f * Le * |cos| * g at pixel g for light sample y (in y's
+ * measure); p^ is its luminance. */
+float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
+                       light_li *li) {
+  const light *l = &c->s->lights[y->light];
+  float g;
+  if (!light_eval_point(c->s, l, it->p, y->y, li, &g)) return 0;
+  vec3 wi_l = frame_to_local(fr, li->wi), wo_l = frame_to_local(fr, wo);
+  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(li->wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g || v3_dot(li->wi, it->ng) == 0) return 0;
+  rgb f = bsdf_eval(b, wo_l, wi_l);
+  if (c3_black(f)) return 0;
+  *contrib = c3_scale(c3_mul(f, li->L), fabsf(wi_l.z) * g);
+  float p = c3_lum(*contrib);
+  return p > 0 && isfinite(p) ? p : 0;
+}
+static float di_target_g(const render_ctx *c, const gpix *g, const di_sample *y, rgb *contrib, light_li *li) {
+  return restir_di_target(c, &g->it, &g->b, &g->fr, g->wo, y, contrib, li);
+}
+static int di_visible(const render_ctx *c, const gpix *g, const light_li *li, thread_stats *ts) {
+  return !ctx_segment_blocked(c, &g->it, li->p_light, li->n_light, ts);
+}
+
+int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
+                         sampler *rng, di_res *r) {
+  memset(r, 0, sizeof *r);
+  float phat_kept = 0;
+  for (int i = 0; i < M; i++) {
+    sampler cs = sampler_child(smp, (uint32_t)i, (uint32_t)M);
+    float ul = sampler_1d(&cs), u1, u2;
+    sampler_2d(&cs, &u1, &u2);
+    float u = rnd(rng);
+    float pmf;
+    uint32_t li = light_select(&c->ls, c->s, it->p, ul, &pmf);
+    if (li == UINT32_MAX || !(pmf > 0)) continue;
+    const light *l = &c->s->lights[li];
+    light_li ls;
+    if (!light_sample(c->s, l, it->p, u1, u2, &ls)) continue;
+    di_sample y = {li, l->type == LIGHT_ENV ? ls.wi : ls.p_light};
+    rgb contrib;
+    light_li le;
+    float phat = restir_di_target(c, it, b, fr, wo, &y, &contrib, &le);
+    if (!(phat > 0)) continue;
+    /* the source density in y's measure: pmf * pdf_omega * (|cos_l| / d^2 for area lights) */
+    float g = l->type == LIGHT_AREA ? fabsf(v3_dot(le.n_light, le.wi)) / (le.dist * le.dist) : 1.0f;
+    float pdf = pmf * ls.pdf * g;
+    if (!(pdf > 0) || !isfinite(pdf)) continue;
+    if (wrs_take(&r->w_sum, phat / pdf, u)) { r->y = y; phat_kept = phat; }
+  }
+  r->M = (float)M;
+  r->W = phat_kept > 0 ? r->w_sum / (r->M * phat_kept) : 0;
+  return phat_kept > 0;
+}
+
+/* ---- G-buffer: the camera ray of pixel (x, y) this frame, followed through delta lobes */
+static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y, gpix *g, thread_stats *ts) {
+  memset(g, 0, sizeof *g);
+  uint64_t pix = (uint64_t)y * (uint64_t)c->width + (uint64_t)x;
+  sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)f->frame, (sampler_kind)c->sampler_kind);
+  float jx, jy;
+  sampler_set_dim(&smp, RD_FILM);
+  sampler_2d(&smp, &jx, &jy);
+  ray r = {f->cam.o, cam_view_dir(&f->cam, (float)x + jx, (float)y + jy), INFINITY};
+  ts->rays++;
+  rgb beta = c3(1, 1, 1), L = c3(0, 0, 0);
+  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
+  for (int depth = 0;; depth++) {
+    isect it;
+    rgb Le;
+    float w;
+    path_state st0 = path_state_start(r.o);
+    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
+    L = c3_add(L, c3_mul(beta, Le));
+    if (!surface || depth >= max_depth) break;
+    vec3 wo = v3_neg(r.d);
+    if (depth == 0) g->depth = v3_len(v3_sub(it.p, f->cam.o));
+    bsdf b = bsdf_at(c->s, &it);
+    frame fr = shading_frame(&it, &b, wo);
+    if (bsdf_has_smooth(&b)) {
+      g->it = it; g->fr = fr; g->b = b; g->wo = wo; g->beta = beta; g->valid = 1; g->chain = depth > 0;
+      break;
+    }
+    sampler_set_dim(&smp, RD_DELTA + depth);
+    path_state st = path_state_start(r.o);
+    rgb wgt;
+    if (!path_continue(&it, &b, &fr, wo, &smp, &st, &wgt, &r) || !st.specular) break;
+    beta = c3_mul(beta, wgt);
+    if (c3_black(beta) || !c3_finite(beta) || depth >= 16) break;
+  }
+  g->Le = L;
+}
+
+/* ---- stage jobs */
+typedef struct stage_job {
+  restir_state *s;
+  const render_ctx *c;
+  const frame_ctx *f;
+  int src, dst;     /* ping-pong buffer indices */
+} stage_job;
+
+static sampler pixel_stream(const render_ctx *c, const frame_ctx *f, size_t pix, uint32_t dim) {
+  sampler s = sampler_make(c->seed ^ 0x5bd1e995u, pix, (uint64_t)f->frame);
+  sampler_set_dim(&s, dim);
+  return s;
+}
+
+static void stage_gbuffer(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  for (int x = 0; x < j->s->width; x++)
+    gbuffer_pixel(j->c, j->f, x, (int)row, &j->s->g[(size_t)row * j->s->width + x], &j->f->ts[thread]);
+}
+
+static void stage_di_initial(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  restir_state *s = j->s;
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    di_res *r = &s->di[j->dst][pix];
+    memset(r, 0, sizeof *r);
+    if (!g->valid) continue;
+    sampler smp = sampler_make_kind(j->c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)j->c->sampler_kind);
+    sampler_set_dim(&smp, RD_CAND);
+    sampler rng = pixel_stream(j->c, j->f, pix, RD_CAND);
+    if (restir_di_candidates(j->c, &g->it, &g->b, &g->fr, g->wo, s->dcfg.candidates, &smp, &rng, r)) {
+      /* visibility reuse: a shadowed survivor passes nothing on */
+      rgb contrib;
+      light_li li;
+      if (!(di_target_g(j->c, g, &r->y, &contrib, &li) > 0) || !di_visible(j->c, g, &li, &j->f->ts[thread])) r->W = 0;
+    }
+  }
+}
+
+/* Previous-frame pixel of this pixel's surface, or -1 (no history, moved off screen, a
+ * delta chain, or a different surface there). */
+static int64_t reproject(const restir_state *s, const restir_cfg *cfg, const frame_ctx *f, const gpix *g) {
+  if (!s->have_prev || !g->valid || g->chain) return -1;
+  float fx, fy;
+  if (!cam_view_project(&f->prev, g->it.p, &fx, &fy)) return -1;
+  int px = (int)fx, py = (int)fy;
+  size_t q = (size_t)py * s->width + px;
+  const gpix *h = &s->g_prev[q];
+  if (!h->valid || h->chain) return -1;
+  float d_prev = v3_len(v3_sub(g->it.p, f->prev.o));
+  if (!restir_similar(cfg, g->fr.n, d_prev, h->fr.n, h->depth)) return -1;
+  return (int64_t)q;
+}
+
+/* Merges reservoirs in[0..n) (in[0] the pixel's own) into *out at pixel g: each is
+ * resampled with weight p^_g(y) V_g(y) W M (M of in[1..] capped by cap_M), M summed. The
+ * target includes visibility (Bitterli et al. 2020, sec. 4 and Alg. 6 with V): every
+ * reservoir holds a sample its own pixel sees (or W = 0), so in[0]'s needs no test and
+ * shading needs no shadow ray. The unbiased normalisation Z counts the M of the inputs
+ * whose own pixel (gs[i]) has p^ V > 0 at y. */
+static void di_merge(const render_ctx *c, const restir_cfg *cfg, const gpix *g, const di_res *const *in, const gpix *const *gs, int n,
+                     float cap_M, sampler *rng, thread_stats *ts, di_res *out) {
+  memset(out, 0, sizeof *out);
+  float phat_kept = 0, Msum = 0;
+  int kept = -1;
+  float Ms[72];
+  for (int i = 0; i < n; i++) {
+    const di_res *r = in[i];
+    float M = r->M;
+    if (i > 0 && cap_M > 0 && M > cap_M) M = cap_M;
+    Ms[i] = M;
+    Msum += M;
+    float u = rnd(rng);
+    if (!(r->W > 0)) continue;
+    rgb contrib;
+    light_li li;
+    float phat = di_target_g(c, g, &r->y, &contrib, &li);
+    if (!(phat > 0)) continue;
+    /* the target is p^ V: another pixel's sample counts only if g sees it */
+    if (i > 0 && !di_visible(c, g, &li, ts)) continue;
+    if (wrs_take(&out->w_sum, phat * r->W * M, u)) { out->y = r->y; phat_kept = phat; kept = i; }
+  }
+  out->M = Msum;
+  if (kept < 0) return;
+  float Z = Msum;
+  if (cfg->unbiased) {
+    Z = 0;
+    for (int i = 0; i < n; i++) {
+      if (i == 0 || i == kept) { Z += Ms[i]; continue; } /* g sees its own and the kept sample (tested) */
+      rgb contrib;
+      light_li li;
+      if (di_target_g(c, gs[i], &out->y, &contrib, &li) > 0 && di_visible(c, gs[i], &li, ts)) Z += Ms[i];
+    }
+  }
+  out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
+}
+
+static void stage_di_temporal(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  restir_state *s = j->s;
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    const di_res *cur = &s->di[j->src][pix];
+    di_res *out = &s->di[j->dst][pix];
+    int64_t q = reproject(s, &s->dcfg, j->f, g);
+    if (q < 0) { *out = *cur; continue; }
+    const di_res *in[2] = {cur, &s->di_prev[q]};
+    const gpix *gs[2] = {g, &s->g_prev[q]};
+    sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL);
+    di_merge(j->c, &s->dcfg, g, in, gs, 2, (float)(s->dcfg.history * s->dcfg.candidates), &rng, &j->f->ts[thread], out);
+  }
+}
+
+/* k distinct-ish neighbours of (x, y) in a disc of radius R, similar to g; returns how
+ * many were found (indices in nb). */
+static int neighbours(const restir_state *s, const restir_cfg *cfg, int x, int y, const gpix *g, sampler *rng, size_t *nb) {
+  int n = 0;
+  for (int t = 0; t < cfg->spatial; t++) {
+    float u1 = rnd(rng), u2 = rnd(rng);
+    float dx, dy;
+    sample_concentric_disk(u1, u2, &dx, &dy);
+    int nx = x + (int)lrintf(dx * cfg->radius), ny = y + (int)lrintf(dy * cfg->radius);
+    if (nx < 0 || ny < 0 || nx >= s->width || ny >= s->height || (nx == x && ny == y)) continue;
+    size_t q = (size_t)ny * s->width + nx;
+    const gpix *h = &s->g[q];
+    if (!h->valid || h->chain != g->chain || !restir_similar(cfg, g->fr.n, g->depth, h->fr.n, h->depth)) continue;
+    nb[n++] = q;
+  }
+  return n;
+}
+
+typedef struct spatial_job { stage_job j; int round; } spatial_job;
+static void stage_di_spatial(void *user, int64_t row, int thread) {
+  spatial_job *sj = user;
+  stage_job *j = &sj->j;
+  restir_state *s = j->s;
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    di_res *out = &s->di[j->dst][pix];
+    const di_res *cur = &s->di[j->src][pix];
+    if (!g->valid) { *out = *cur; continue; }
+    sampler rng = pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)sj->round);
+    size_t nb[64];
+    int k = neighbours(s, &s->dcfg, x, (int)row, g, &rng, nb);
+    const di_res *in[65];
+    const gpix *gs[65];
+    in[0] = cur; gs[0] = g;
+    for (int i = 0; i < k; i++) { in[i + 1] = &s->di[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
+    di_merge(j->c, &s->dcfg, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+  }
+}
+
+/* Direct light of pixel g from its final reservoir: f Le |cos| g W (the sample is visible:
+ * reservoirs hold only samples their pixel sees). */
+static rgb di_shade(const render_ctx *c, const gpix *g, const di_res *r) {
+  if (!(r->W > 0)) return c3(0, 0, 0);
+  rgb contrib;
+  light_li li;
+  if (!(di_target_g(c, g, &r->y, &contrib, &li) > 0)) return c3(0, 0, 0);
+  return c3_scale(contrib, r->W);
+}
+
+/* ---- GI */
+/* p^ of GI sample y at pixel g: luminance of f(wo, wi) |cos| L^, wi towards x_s; 0 when
+ * g is behind x_s's surface (as seen from the pixel that made y). */
+static float gi_target(const gpix *g, const gi_res *r, rgb *contrib, vec3 *wi_out) {
+  vec3 d = v3_sub(r->xs, g->it.p);
+  float d2 = v3_len2(d);
+  if (!(d2 > 0) || v3_dot(r->ns, v3_neg(d)) <= 0) return 0;
+  vec3 wi = v3_scale(d, 1 / sqrtf(d2));
+  vec3 wi_l = frame_to_local(&g->fr, wi), wo_l = frame_to_local(&g->fr, g->wo);
+  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, g->it.ng) > 0) == (v3_dot(g->wo, g->it.ng) > 0);
+  if (refl_l != refl_g || v3_dot(wi, g->it.ng) == 0) return 0;
+  rgb f = bsdf_eval(&g->b, wo_l, wi_l);
+  *contrib = c3_scale(c3_mul(f, r->Lo), fabsf(wi_l.z));
+  *wi_out = wi;
+  float p = c3_lum(*contrib);
+  return p > 0 && isfinite(p) ? p : 0;
+}
+
+float restir_gi_jacobian(vec3 x_from, vec3 x_to, vec3 xs, vec3 ns) {
+  vec3 a = v3_sub(x_from, xs), b = v3_sub(x_to, xs);
+  float la2 = v3_len2(a), lb2 = v3_len2(b);
+  if (!(la2 > 0) || !(lb2 > 0)) return 0;
+  float cos_from = fabsf(v3_dot(ns, a)) / sqrtf(la2), cos_to = fabsf(v3_dot(ns, b)) / sqrtf(lb2);
+  if (!(cos_from > 0)) return 0;
+  float J = (cos_to / cos_from) * (la2 / lb2);
+  return isfinite(J) ? J : 0;
+}
+
+static int gi_visible(const render_ctx *c, const gpix *g, const gi_res *r, thread_stats *ts) {
+  return !ctx_segment_blocked(c, &g->it, r->xs, r->ns, ts);
+}
+
+static void stage_gi_initial(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  restir_state *s = j->s;
+  const render_ctx *c = j->c;
+  thread_stats *ts = &j->f->ts[thread];
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    gi_res *r = &s->gr[j->dst][pix];
+    memset(r, 0, sizeof *r);
+    if (!g->valid) continue;
+    r->M = 1;
+    sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)c->sampler_kind);
+    sampler_set_dim(&smp, RD_GI_DIR);
+    bsdf_sample bs;
+    vec3 wi;
+    isect it = g->it;
+    if (!sample_bsdf_world(&it, &g->b, &g->fr, g->wo, &smp, &bs, &wi) || bs.delta || !(bs.pdf > 0)) continue;
+    ray ry = spawn_ray(&it, wi);
+    hit h;
+    if (!ctx_intersect(c, &ry, &h, ts)) continue; /* the environment is direct light */
+    isect hs;
+    isect_from_hit(c->s, &ry, &h, &hs);
+    sampler_set_dim(&smp, RD_GI_PATH);
+    sampler ps = sampler_child(&smp, 0, 1);
+    rgb Lo = path_radiance(c, ry, &ps, ts, 0);
+    r->xs = hs.p;
+    r->ns = v3_dot(hs.ng, wi) > 0 ? v3_neg(hs.ng) : hs.ng; /* facing x_v */
+    r->Lo = Lo;
+    rgb contrib;
+    vec3 wi2;
+    float phat = gi_target(g, r, &contrib, &wi2);
+    if (!(phat > 0)) { r->Lo = c3(0, 0, 0); continue; }
+    r->w_sum = phat / bs.pdf;
+    r->W = 1 / bs.pdf;
+  }
+}
+
+/* GI merge: like di_merge, each reused reservoir's W carried into this pixel's solid
+ * angle by the Jacobian from its pixel (xs_from) to this one. */
+static void gi_merge(const render_ctx *c, const restir_cfg *cfg, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs,
+                     int n, float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
+  memset(out, 0, sizeof *out);
+  float phat_kept = 0, Msum = 0;
+  int kept = -1;
+  float Ms[72];
+  for (int i = 0; i < n; i++) {
+    const gi_res *r = in[i];
+    float M = r->M;
+    if (i > 0 && cap_M > 0 && M > cap_M) M = cap_M;
+    Ms[i] = M;
+    Msum += M;
+    float u = rnd(rng);
+    if (!(r->W > 0)) continue;
+    rgb contrib;
+    vec3 wi;
+    float phat = gi_target(g, r, &contrib, &wi);
+    if (!(phat > 0)) continue;
+    float J = i == 0 || !use_jacobian ? 1.0f : restir_gi_jacobian(gs[i]->it.p, g->it.p, r->xs, r->ns);
+    if (!(J > 0)) continue;
+    if (i > 0 && !gi_visible(c, g, r, ts)) continue;
+    if (wrs_take(&out->w_sum, phat * r->W * J * M, u)) { out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo; phat_kept = phat; kept = i; }
+  }
+  out->M = Msum;
+  if (kept < 0) return;
+  float Z = Msum;
+  if (cfg->unbiased) {
+    Z = 0;
+    for (int i = 0; i < n; i++) {
+      if (i == 0 || i == kept) { Z += Ms[i]; continue; }
+      rgb contrib;
+      vec3 wi;
+      if (gi_target(gs[i], out, &contrib, &wi) > 0 && gi_visible(c, gs[i], out, ts)) Z += Ms[i];
+    }
+  }
+  out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
+}
+
+static void stage_gi_temporal(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  restir_state *s = j->s;
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    const gi_res *cur = &s->gr[j->src][pix];
+    gi_res *out = &s->gr[j->dst][pix];
+    int64_t q = reproject(s, &s->gcfg, j->f, g);
+    if (q < 0) { *out = *cur; continue; }
+    const gi_res *in[2] = {cur, &s->gr_prev[q]};
+    const gpix *gs[2] = {g, &s->g_prev[q]};
+    sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7);
+    gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
+  }
+}
+
+static void stage_gi_spatial(void *user, int64_t row, int thread) {
+  spatial_job *sj = user;
+  stage_job *j = &sj->j;
+  restir_state *s = j->s;
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    gi_res *out = &s->gr[j->dst][pix];
+    const gi_res *cur = &s->gr[j->src][pix];
+    if (!g->valid) { *out = *cur; continue; }
+    sampler rng = pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)sj->round + 7);
+    size_t nb[64];
+    int k = neighbours(s, &s->gcfg, x, (int)row, g, &rng, nb);
+    const gi_res *in[65];
+    const gpix *gs[65];
+    in[0] = cur; gs[0] = g;
+    for (int i = 0; i < k; i++) { in[i + 1] = &s->gr[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
+    gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+  }
+}
+
+static void stage_shade(void *user, int64_t row, int thread) {
+  stage_job *j = user;
+  restir_state *s = j->s;
+  const render_ctx *c = j->c;
+  thread_stats *ts = &j->f->ts[thread];
+  for (int x = 0; x < s->width; x++) {
+    size_t pix = (size_t)row * s->width + x;
+    const gpix *g = &s->g[pix];
+    rgb L = g->Le;
+    if (g->valid) {
+      rgb Lr = c3(0, 0, 0);
+      if (!s->gi || s->direct_restir) Lr = di_shade(c, g, &s->di[s->di_final][pix]);
+      else {
+        sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)c->sampler_kind);
+        sampler_set_dim(&smp, RD_NEE);
+        isect it = g->it;
+        Lr = estimate_direct_nomis(c, &it, &g->b, &g->fr, g->wo, &smp, ts);
+      }
+      if (s->gi) {
+        const gi_res *r = &s->gr[s->gi_final][pix];
+        rgb contrib;
+        vec3 wi;
+        if (r->W > 0 && gi_target(g, r, &contrib, &wi) > 0) Lr = c3_add(Lr, c3_scale(contrib, r->W));
+      }
+      L = c3_add(L, c3_mul(g->beta, Lr));
+    }
+    float *o = &j->f->rgb[3 * pix];
+    o[0] = L.r; o[1] = L.g; o[2] = L.b;
+  }
+}
+
+/* ---- the frame */
+static int run_stage(const render_ctx *c, const frame_ctx *f, parallel_fn fn, void *job) {
+  parallel_for(c->threads, c->height, fn, job);
+  return atomic_load(f->cancel) != 0;
+}
+
+static valo_status restir_frame(void *state, const render_ctx *c, const frame_ctx *f, valo_error *err) {
+  restir_state *s = state;
+  if (f->frame == 0) s->have_prev = 0;
+  stage_job j = {s, c, f, 0, 0};
+#define STAGE(fn, job) do { if (run_stage(c, f, fn, job)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled"); } while (0)
+  STAGE(stage_gbuffer, &j);
+  if (!s->gi || s->direct_restir) {
+    j.dst = 0;
+    STAGE(stage_di_initial, &j);
+    int cur = 0;
+    if (s->dcfg.temporal) { j.src = cur; j.dst = 1 - cur; STAGE(stage_di_temporal, &j); cur = 1 - cur; }
+    for (int it = 0; it < s->dcfg.iterations && s->dcfg.spatial > 0; it++) {
+      spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
+      STAGE(stage_di_spatial, &sj);
+      cur = 1 - cur;
+    }
+    s->di_final = cur;
+  }
+  if (s->gi) {
+    j.src = 0; j.dst = 0;
+    STAGE(stage_gi_initial, &j);
+    int cur = 0;
+    if (s->gcfg.temporal) { j.src = cur; j.dst = 1 - cur; STAGE(stage_gi_temporal, &j); cur = 1 - cur; }
+    for (int it = 0; it < s->gcfg.iterations && s->gcfg.spatial > 0; it++) {
+      spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
+      STAGE(stage_gi_spatial, &sj);
+      cur = 1 - cur;
+    }
+    s->gi_final = cur;
+  }
+  STAGE(stage_shade, &j);
+#undef STAGE
+  /* this frame's G-buffer and final reservoirs become the history */
+  gpix *tg = s->g; s->g = s->g_prev; s->g_prev = tg;
+  if (!s->gi || s->direct_restir) { di_res *t = s->di_prev; s->di_prev = s->di[s->di_final]; s->di[s->di_final] = t; }
+  if (s->gi) { gi_res *t = s->gr_prev; s->gr_prev = s->gr[s->gi_final]; s->gr[s->gi_final] = t; }
+  s->have_prev = 1;
+  return VALO_OK;
+}
+
+static restir_cfg cfg_from(const double *p, int gi) {
+  restir_cfg k;
+  k.candidates = (int)p[P_CANDIDATES];
+  k.temporal = (int)p[P_TEMPORAL];
+  k.history = (float)p[P_HISTORY];
+  k.spatial = (int)p[P_SPATIAL];
+  k.radius = (float)p[P_RADIUS];
+  k.iterations = (int)p[P_ITER];
+  k.unbiased = (int)p[P_UNBIASED];
+  k.normal_threshold = (float)p[P_NORMAL];
+  k.depth_threshold = (float)p[P_DEPTH];
+  k.jacobian = gi ? (int)p[P_JACOBIAN] : 1;
+  return k;
+}
+
+static void restir_destroy(void *state) {
+  restir_state *s = state;
+  if (!s) return;
+  free(s->g); free(s->g_prev);
+  free(s->di[0]); free(s->di[1]); free(s->di_prev);
+  free(s->gr[0]); free(s->gr[1]); free(s->gr_prev);
+  free(s);
+}
+
+static valo_status restir_create_common(const render_ctx *c, void **state, int gi, valo_error *err) {
+  restir_state *s = calloc(1, sizeof *s);
+  if (!s) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  s->gi = gi;
+  s->width = c->width; s->height = c->height;
+  s->np = (size_t)c->width * c->height;
+  if (gi) {
+    s->gcfg = cfg_from(c->param, 1);
+    s->direct_restir = (int)c->param[P_DIRECT];
+    /* direct light: restir-di's defaults, with this integrator's candidate count */
+    double dp[INTEGRATOR_MAX_PARAMS];
+    for (int i = 0; di_params[i].name; i++) dp[i] = di_params[i].def;
+    dp[P_CANDIDATES] = c->param[P_CANDIDATES];
+    s->dcfg = cfg_from(dp, 0);
+  } else s->dcfg = cfg_from(c->param, 0);
+  int ok = (s->g = calloc(s->np, sizeof *s->g)) && (s->g_prev = calloc(s->np, sizeof *s->g_prev));
+  if (ok && (!gi || s->direct_restir))
+    ok = (s->di[0] = calloc(s->np, sizeof(di_res))) && (s->di[1] = calloc(s->np, sizeof(di_res))) && (s->di_prev = calloc(s->np, sizeof(di_res)));
+  if (ok && gi)
+    ok = (s->gr[0] = calloc(s->np, sizeof(gi_res))) && (s->gr[1] = calloc(s->np, sizeof(gi_res))) && (s->gr_prev = calloc(s->np, sizeof(gi_res)));
+  if (!ok) { restir_destroy(s); return err_set(err, VALO_ERR_NOMEM, "out of memory for the %dx%d reservoir buffers", c->width, c->height); }
+  if (!c->s->nlights) log_warning("the scene has no light: restir renders only what is seen directly");
+  *state = s;
+  return VALO_OK;
+}
+static valo_status restir_di_create(const render_ctx *c, void **state, valo_error *err) { return restir_create_common(c, state, 0, err); }
+static valo_status restir_gi_create(const render_ctx *c, void **state, valo_error *err) { return restir_create_common(c, state, 1, err); }
+
+const integrator_ops integrator_restir_di = {
+    "restir-di",
+    "ReSTIR direct light (Bitterli et al. 2020): RIS over light samples, temporal and spatial reuse; frames averaged for a still",
+    di_params, NULL, restir_di_create, NULL, restir_destroy, restir_frame};
+const integrator_ops integrator_restir_gi = {
+    "restir-gi",
+    "ReSTIR GI (Ouyang et al. 2021): path-traced sample points reused over pixels and frames; direct light by restir-di or NEE",
+    gi_params, NULL, restir_gi_create, NULL, restir_destroy, restir_frame};

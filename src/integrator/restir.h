@@ -1,0 +1,41 @@
+/* restir.h — owns the reservoir types and the pieces of restir.c that tests check on
+ * their own: candidate generation by RIS, the DI target, the GI Jacobian and the
+ * similarity test (digest 001). */
+#ifndef VALO_RESTIR_H
+#define VALO_RESTIR_H
+#include "integrator/integrator.h"
+
+/* A DI sample: light index and a point on it (area: on the triangle; environment: a
+ * direction; delta lights: unused). */
+typedef struct di_sample { uint32_t light; vec3 y; } di_sample;
+/* Reservoir: the kept sample, the sum of resampling weights, the candidate count M and
+ * the unbiased contribution weight W (an estimate of 1 / pdf(y)). */
+typedef struct di_res { di_sample y; float w_sum, M, W; } di_res;
+/* A GI sample: the sample point x_s, its normal n_s (facing the pixel that found it) and
+ * the radiance L^ it sends towards that pixel. */
+typedef struct gi_res { vec3 xs, ns; rgb Lo; float w_sum, M, W; } gi_res;
+
+typedef struct restir_cfg {
+  int candidates, temporal, spatial, iterations, unbiased, jacobian;
+  float history, radius, normal_threshold, depth_threshold;
+} restir_cfg;
+
+/* RIS at a surface point: M candidates from the power-proportional light selection and
+ * light sampling (stream smp, child j of M for candidate j), kept by streaming weighted
+ * reservoir sampling (uniform numbers from rng), target p^ = luminance of the unshadowed
+ * f Le |cos| g. Fills *r (W = w_sum / (M p^(y)), no visibility); returns 1 when a sample
+ * was kept. */
+int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
+                         sampler *rng, di_res *r);
+/* p^ of DI sample y at a surface point, with the unshadowed contribution in *contrib and
+ * the light's evaluation in *li (for the shadow ray). */
+float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
+                       light_li *li);
+/* Jacobian of moving GI sample point xs (normal ns) from the pixel at x_from to the one
+ * at x_to: d omega_from / d omega_to = |cos phi_to| / |cos phi_from| * |x_from - xs|^2 /
+ * |x_to - xs|^2; a reservoir's W is multiplied by it. 0 when degenerate. */
+float restir_gi_jacobian(vec3 x_from, vec3 x_to, vec3 xs, vec3 ns);
+/* The reuse test: normals within normal_threshold (cosine) and depths within
+ * depth_threshold (relative to depth_a). */
+int restir_similar(const restir_cfg *cfg, vec3 n_a, float depth_a, vec3 n_b, float depth_b);
+#endif

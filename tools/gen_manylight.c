@@ -1,0 +1,127 @@
+/* gen_manylight.c — writes the many-light scenes of docs/integrators.md (restir-di/gi):
+ * OBJ+MTL files of small one-sided emissive triangles, each its own colour and power,
+ * every one tilted and placed at its own height so no two lie in one plane. Deterministic
+ * (a fixed splitmix64 stream); run by hand, the outputs are committed:
+ *   gen_manylight room   DIR   -> DIR/manylight-room.obj/.mtl   (room, boxes, 1024 lamps)
+ *   gen_manylight sponza DIR   -> DIR/sponza-lamps.obj/.mtl     (1200 lamps for Sponza's atrium)
+ * Colours: hue uniform, saturation 0.3..1; radiance log-uniform over a factor 30, so
+ * that no one lamp dominates and many matter at every point. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+static uint64_t st = 0x243f6a8885a308d3ULL;
+static double rnd(void) {
+  uint64_t z = (st += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return (double)(z >> 11) * 0x1p-53;
+}
+
+typedef struct { double x, y, z; } v3;
+static v3 mk(double x, double y, double z) { v3 v = {x, y, z}; return v; }
+static v3 add(v3 a, v3 b) { return mk(a.x + b.x, a.y + b.y, a.z + b.z); }
+static v3 scl(v3 a, double s) { return mk(a.x * s, a.y * s, a.z * s); }
+static v3 crs(v3 a, v3 b) { return mk(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
+static v3 nrm(v3 a) { double l = sqrt(a.x * a.x + a.y * a.y + a.z * a.z); return scl(a, 1 / l); }
+
+static int nv = 0;
+static void vert(FILE *f, v3 p) { fprintf(f, "v %.6f %.6f %.6f\n", p.x, p.y, p.z); nv++; }
+/* An axis-aligned box [lo, hi] (outward faces, counter-clockwise seen from outside). */
+static void box(FILE *f, v3 lo, v3 hi, const char *mat) {
+  fprintf(f, "usemtl %s\n", mat);
+  int b = nv + 1;
+  for (int i = 0; i < 8; i++) vert(f, mk(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z));
+  static const int q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (int k = 0; k < 6; k++) fprintf(f, "f %d %d %d %d\n", b + q[k][0], b + q[k][1], b + q[k][2], b + q[k][3]);
+}
+/* A quad seen from the side its normal n points to. */
+static void quad(FILE *f, v3 a, v3 b, v3 c, v3 d, const char *mat) {
+  fprintf(f, "usemtl %s\n", mat);
+  int i = nv + 1;
+  vert(f, a); vert(f, b); vert(f, c); vert(f, d);
+  fprintf(f, "f %d %d %d %d\n", i, i + 1, i + 2, i + 3);
+}
+
+static void hsv(double h, double s, double v, double *r, double *g, double *b) {
+  double c = v * s, hp = h * 6, x = c * (1 - fabs(fmod(hp, 2) - 1)), m = v - c;
+  double rr = 0, gg = 0, bb = 0;
+  if (hp < 1) { rr = c; gg = x; } else if (hp < 2) { rr = x; gg = c; } else if (hp < 3) { gg = c; bb = x; }
+  else if (hp < 4) { gg = x; bb = c; } else if (hp < 5) { rr = x; bb = c; } else { rr = c; bb = x; }
+  *r = rr + m; *g = gg + m; *b = bb + m;
+}
+
+/* n lamps with centres drawn in [lo, hi] (rejecting those inside any of the nb boxes,
+ * grown by a margin), equilateral, of edge `edge`, normal within `tilt` radians of -y. */
+static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double tilt, double L0, const v3 *blo, const v3 *bhi, int nb) {
+  for (int i = 0; i < n; i++) {
+    v3 c;
+    for (;;) {
+      c = mk(lo.x + (hi.x - lo.x) * rnd(), lo.y + (hi.y - lo.y) * rnd(), lo.z + (hi.z - lo.z) * rnd());
+      int inside = 0;
+      for (int k = 0; k < nb; k++)
+        if (c.x > blo[k].x - edge && c.x < bhi[k].x + edge && c.y > blo[k].y - edge && c.y < bhi[k].y + edge && c.z > blo[k].z - edge &&
+            c.z < bhi[k].z + edge) inside = 1;
+      if (!inside) break;
+    }
+    double th = tilt * sqrt(rnd()), ph = 2 * M_PI * rnd();
+    v3 nn = nrm(mk(sin(th) * cos(ph), -cos(th), sin(th) * sin(ph)));
+    v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), u = crs(nn, t);
+    double rot = 2 * M_PI * rnd(), r = edge / sqrt(3.0);
+    v3 p[3];
+    for (int k = 0; k < 3; k++) {
+      double a = rot + 2 * M_PI * k / 3;
+      p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
+    }
+    double R, G, B;
+    hsv(rnd(), 0.3 + 0.7 * rnd(), 1, &R, &G, &B);
+    double L = L0 * exp(log(30.0) * rnd());
+    fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R * L, G * L, B * L);
+    fprintf(obj, "usemtl lamp%04d\n", i);
+    /* winding so that the emitting side (counter-clockwise) faces along nn */
+    v3 e1 = add(p[1], scl(p[0], -1)), e2 = add(p[2], scl(p[0], -1)), g = crs(e1, e2);
+    int flip = g.x * nn.x + g.y * nn.y + g.z * nn.z < 0;
+    vert(obj, p[0]); vert(obj, p[flip ? 2 : 1]); vert(obj, p[flip ? 1 : 2]);
+    fprintf(obj, "f %d %d %d\n", nv - 2, nv - 1, nv);
+  }
+}
+
+int main(int argc, char **argv) {
+  if (argc != 3 || (strcmp(argv[1], "room") && strcmp(argv[1], "sponza"))) {
+    fprintf(stderr, "usage: gen_manylight room|sponza DIR\n");
+    return 2;
+  }
+  int room = !strcmp(argv[1], "room");
+  char po[4096], pm[4096];
+  snprintf(po, sizeof po, "%s/%s.obj", argv[2], room ? "manylight-room" : "sponza-lamps");
+  snprintf(pm, sizeof pm, "%s/%s.mtl", argv[2], room ? "manylight-room" : "sponza-lamps");
+  FILE *obj = fopen(po, "w"), *mtl = fopen(pm, "w");
+  if (!obj || !mtl) { fprintf(stderr, "gen_manylight: cannot write %s\n", obj ? pm : po); return 1; }
+  fprintf(obj, "# made by tools/gen_manylight.c (%s); do not edit\nmtllib %s\n", argv[1], strrchr(pm, '/') + 1);
+  fprintf(mtl, "# made by tools/gen_manylight.c (%s); do not edit\n", argv[1]);
+  if (room) {
+    fprintf(mtl, "newmtl white\nKd 0.7 0.7 0.7\n\nnewmtl red\nKd 0.6 0.1 0.08\n\nnewmtl green\nKd 0.12 0.5 0.15\n\nnewmtl grey\nKd 0.4 0.4 0.45\n\n");
+    /* room: x, z in [-2, 2], y in [0, 2.5], open towards +z */
+    quad(obj, mk(-2, 0, -2), mk(-2, 0, 2), mk(2, 0, 2), mk(2, 0, -2), "white");          /* floor, +y */
+    quad(obj, mk(-2, 2.5, -2), mk(2, 2.5, -2), mk(2, 2.5, 2), mk(-2, 2.5, 2), "white");  /* ceiling, -y */
+    quad(obj, mk(-2, 0, -2), mk(2, 0, -2), mk(2, 2.5, -2), mk(-2, 2.5, -2), "white");    /* back, +z */
+    quad(obj, mk(-2, 0, -2), mk(-2, 2.5, -2), mk(-2, 2.5, 2), mk(-2, 0, 2), "red");      /* left, +x */
+    quad(obj, mk(2, 0, -2), mk(2, 0, 2), mk(2, 2.5, 2), mk(2, 2.5, -2), "green");        /* right, -x */
+    v3 blo[4] = {mk(-1.3, 0, -1.2), mk(0.4, 0, -0.3), mk(-0.2, 0, -1.9), mk(1.0, 1.2, -1.6)};
+    v3 bhi[4] = {mk(-0.6, 1.4, -0.5), mk(1.1, 0.6, 0.4), mk(0.2, 2.5, -1.5), mk(1.6, 1.35, -1.0)};
+    box(obj, blo[0], bhi[0], "grey");
+    box(obj, blo[1], bhi[1], "white");
+    box(obj, blo[2], bhi[2], "grey");   /* a pillar to the ceiling */
+    box(obj, blo[3], bhi[3], "white");  /* a shelf */
+    lamps(obj, mtl, 1024, mk(-1.85, 1.5, -1.85), mk(1.85, 2.42, 1.2), 0.06, 1.0, 2.0, blo, bhi, 4);
+  } else {
+    /* Sponza's atrium: x in [-13, 13], z in [-3.4, 3.4], from the floor to the roof line */
+    lamps(obj, mtl, 1200, mk(-13, 0.4, -3.4), mk(13, 12.5, 3.4), 0.25, 1.2, 12.0, NULL, NULL, 0);
+  }
+  fclose(obj);
+  fclose(mtl);
+  printf("wrote %s and %s\n", po, pm);
+  return 0;
+}
