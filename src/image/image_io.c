@@ -50,7 +50,21 @@ static valo_status write_pfm(const char *tmp, int w, int h, const float *px) {
   return ok ? VALO_OK : VALO_ERR_IO;
 }
 
+/* OpenEXR before 3.4.8 (Debian 12 has 3.1) stores the zlib stream of a chunk whose
+ * compressed size equals its raw size, which readers then take for raw pixels
+ * (openexr issue 2306): a noisy render came back with a garbled 16-line chunk. The
+ * compressor is wrapped to store the raw bytes in that case, as the format asks. */
+typedef struct zip_fix { exr_result_t (*orig)(exr_encode_pipeline_t *); } zip_fix;
+static exr_result_t zip_checked(exr_encode_pipeline_t *e) {
+  const zip_fix *z = e->encoding_user_data;
+  exr_result_t rv = z->orig(e);
+  if (rv == EXR_ERR_SUCCESS && e->compressed_bytes == e->packed_bytes && e->compressed_buffer != e->packed_buffer)
+    memcpy(e->compressed_buffer, e->packed_buffer, e->packed_bytes);
+  return rv;
+}
+
 static valo_status write_exr(const char *tmp, int w, int h, const float *px, char *msg, size_t msglen) {
+  zip_fix zfix = {NULL};
   exr_context_t ctx = NULL;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = exr_quiet;
@@ -86,7 +100,10 @@ static valo_status write_exr(const char *tmp, int w, int h, const float *px, cha
       enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
       enc.channels[c].encode_from_ptr = (const uint8_t *)&px[(size_t)y * w * 3 + off];
     }
-    if (have_enc && y == 0) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+    if (y == 0) {
+      rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+      if (rv == EXR_ERR_SUCCESS && enc.compress_fn) { zfix.orig = enc.compress_fn; enc.compress_fn = zip_checked; enc.encoding_user_data = &zfix; }
+    }
     if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
   }
   if (have_enc) exr_encoding_destroy(ctx, &enc);

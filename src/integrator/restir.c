@@ -411,6 +411,7 @@ static void stage_gi_initial(void *user, int64_t row, int thread) {
     sampler_set_dim(&smp, RD_GI_PATH);
     sampler ps = sampler_child(&smp, 0, 1);
     rgb Lo = path_radiance(c, ry, &ps, ts, 0);
+    if (!c3_finite(Lo) || Lo.r < 0 || Lo.g < 0 || Lo.b < 0) { ts->bad_samples++; continue; } /* never kept: it would live on as history */
     r->xs = hs.p;
     r->ns = v3_dot(hs.ng, wi) > 0 ? v3_neg(hs.ng) : hs.ng; /* facing x_v */
     r->Lo = Lo;
