@@ -4,7 +4,9 @@
  * (a fixed splitmix64 stream); run by hand, the outputs are committed:
  *   gen_manylight room   DIR   -> DIR/manylight-room.obj/.mtl   (room, boxes, 1024 lamps)
  *   gen_manylight sponza DIR   -> DIR/sponza-lamps.obj/.mtl     (1200 lamps for Sponza's atrium)
- * Colours: hue uniform, saturation 0.3..1; radiance log-uniform over a factor 30, so
+ * Colours: hue uniform, saturation 0.1..0.5 (tinted whites, as real lamps; fully saturated
+ * random hues put a floor under any one-sample estimator's per-channel error, see
+ * docs/integrators.md); radiance log-uniform over a factor 30, so
  * that no one lamp dominates and many matter at every point. */
 #include <math.h>
 #include <stdint.h>
@@ -76,7 +78,7 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
       p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
     }
     double R, G, B;
-    hsv(rnd(), 0.3 + 0.7 * rnd(), 1, &R, &G, &B);
+    hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
     double L = L0 * exp(log(30.0) * rnd());
     fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R * L, G * L, B * L);
     fprintf(obj, "usemtl lamp%04d\n", i);
@@ -117,8 +119,8 @@ int main(int argc, char **argv) {
     box(obj, blo[3], bhi[3], "white");  /* a shelf */
     lamps(obj, mtl, 1024, mk(-1.85, 1.5, -1.85), mk(1.85, 2.42, 1.2), 0.06, 1.0, 2.0, blo, bhi, 4);
   } else {
-    /* Sponza's atrium: x in [-13, 13], z in [-3.4, 3.4], from the floor to the roof line */
-    lamps(obj, mtl, 1200, mk(-13, 0.4, -3.4), mk(13, 12.5, 3.4), 0.25, 1.2, 12.0, NULL, NULL, 0);
+    /* Sponza's atrium: x in [-13, 13], z in [-3.4, 3.4], from the floor to below the upper gallery */
+    lamps(obj, mtl, 1200, mk(-13, 0.4, -3.4), mk(13, 7.0, 3.4), 0.2, 1.2, 3.0, NULL, NULL, 0);
   }
   fclose(obj);
   fclose(mtl);

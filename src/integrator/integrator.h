@@ -82,6 +82,8 @@ typedef struct frame_ctx {
   float *rgb;           /* out: width*height*3 radiance estimates of this frame */
   thread_stats *ts;     /* one per thread */
   const _Atomic int *cancel; /* non-zero: stop between stages and return VALO_ERR_CANCELLED */
+  int sequence;         /* 1: frames of a sequence (--frames), shown one by one; 0: the frames of a
+                           still, averaged */
 } frame_ctx;
 
 typedef struct integrator_ops {

@@ -28,10 +28,10 @@
 enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIASED, P_NORMAL, P_DEPTH, P_DIRECT, P_JACOBIAN };
 #define DI_PARAMS_COMMON                                                                                                              \
   {"candidates", IPARAM_INT, 32, 1, 1024, "M: light samples per pixel per frame (RIS candidates)"},                                   \
-  {"temporal", IPARAM_INT, 1, 0, 1, "1: reuse the previous frame's reservoir at the reprojected pixel"},                              \
+  {"temporal", IPARAM_INT, -1, -1, 1, "1: reuse the previous frame's reservoir at the reprojected pixel; -1: in sequences only"},  \
   {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},                    \
   {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
-  {"radius", IPARAM_FLOAT, 30, 1, 1000, "spatial neighbours come from a disc of this many pixels"},                                    \
+  {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"}, \
   {"iterations", IPARAM_INT, 2, 0, 8, "n: rounds of spatial reuse"},                                                                   \
   {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased, darker at contact)"},         \
   {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"}, \
@@ -39,10 +39,10 @@ enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIA
 static const integrator_param di_params[] = {DI_PARAMS_COMMON, {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 static const integrator_param gi_params[] = {
     {"candidates", IPARAM_INT, 32, 1, 1024, "M of the direct-light reservoirs (direct=1)"},
-    {"temporal", IPARAM_INT, 1, 0, 1, "1: reuse the previous frame's reservoirs at the reprojected pixel"},
+    {"temporal", IPARAM_INT, -1, -1, 1, "1: reuse the previous frame's reservoirs at the reprojected pixel; -1: in sequences only"},
     {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},
     {"spatial", IPARAM_INT, 3, 0, 64, "k: neighbours merged per spatial round"},
-    {"radius", IPARAM_FLOAT, 30, 1, 1000, "spatial neighbours come from a disc of this many pixels"},
+    {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"},
     {"iterations", IPARAM_INT, 1, 0, 8, "n: rounds of spatial reuse"},
     {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased)"},
     {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"},
@@ -52,7 +52,7 @@ static const integrator_param gi_params[] = {
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 /* ---- per-pixel random streams: (seed, pixel, frame); stages use fixed dimensions */
-enum { RD_FILM = 0, RD_DELTA = 1, RD_GI_DIR = 40, RD_GI_PATH = 41, RD_NEE = 42, RD_CAND = 64, RD_TEMPORAL = 0x1000, RD_SPATIAL = 0x2000 };
+enum { RD_FILM = 0, RD_DELTA = 1, RD_GI_DIR = 40, RD_GI_PATH = 42, RD_NEE = 43, RD_CAND = 64, RD_TEMPORAL = 0x1000, RD_SPATIAL = 0x2000 };
 
 typedef struct gpix {
   isect it;
@@ -87,9 +87,7 @@ int restir_similar(const restir_cfg *cfg, vec3 n_a, float depth_a, vec3 n_b, flo
 
 static inline float rnd(sampler *s) { return rng_to_float(sampler_u32(s)); }
 
-/* Streaming weighted reservoir update: returns 1 when the candidate replaces the kept
- * sample (probability w / w_sum after adding w). */
-static inline int wrs_take(float *w_sum, float w, float u) {
+int restir_wrs_take(float *w_sum, float w, float u) {
   if (!(w > 0) || !isfinite(w)) return 0;
   *w_sum += w;
   return u * *w_sum < w;
@@ -142,7 +140,7 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
     float g = l->type == LIGHT_AREA ? fabsf(v3_dot(le.n_light, le.wi)) / (le.dist * le.dist) : 1.0f;
     float pdf = pmf * ls.pdf * g;
     if (!(pdf > 0) || !isfinite(pdf)) continue;
-    if (wrs_take(&r->w_sum, phat / pdf, u)) { r->y = y; phat_kept = phat; }
+    if (restir_wrs_take(&r->w_sum, phat / pdf, u)) { r->y = y; phat_kept = phat; }
   }
   r->M = (float)M;
   r->W = phat_kept > 0 ? r->w_sum / (r->M * phat_kept) : 0;
@@ -243,6 +241,53 @@ static int64_t reproject(const restir_state *s, const restir_cfg *cfg, const fra
   return (int64_t)q;
 }
 
+/* ---- unbiased reuse: pairwise MIS with confidence weights (Bitterli 2022, ch. 9.1;
+ * Lin et al. 2022, "Generalized resampled importance sampling", sec. 7). Input 0 is the
+ * canonical (this pixel's) reservoir, 1..k the neighbours'. Each neighbour forms a pair
+ * with the canonical; pair i gets the share a_i = (M_i + M_0/k) / sum M and splits it by
+ * the balance heuristic between neighbour i (confidence M_i) and the canonical (M_0/k):
+ *   m_i(y) = a_i M_i p_i(y) / (M_i p_i(y) + M_0/k p_0(y)),
+ *   m_0(y) = sum_i a_i (M_0/k) p_0(y) / (M_i p_i(y) + M_0/k p_0(y)),
+ * so that the weights of every y sum to one. p_j is input j's target with its own
+ * visibility, in a measure common to all pixels (DI: the light's; GI: area at x_s).
+ * Resampling weight w_i = m_i(y_i) p_0(y_i) W_i; the result's W = w_sum / p_0(y). Costs
+ * two shadow rays per neighbour (y_i seen from here; y_0 seen from there), as the Z test
+ * did, with far lower variance when neighbours' targets differ from ours. */
+typedef struct pw_in {
+  float M;       /* confidence (capped for history) */
+  float W;       /* contribution weight in the common measure */
+  float p_own;   /* p_i(y_i) (its own sample, visible there) */
+  float p_here;  /* p_0(y_i): this pixel's target (with visibility) of its sample */
+  float p_can;   /* p_i(y_0): its target (with visibility) of the canonical sample */
+} pw_in;
+/* Returns the chosen input (or -1), its resampling weight sum in *w_sum. */
+static int pairwise_select(const pw_in *in, int n, sampler *rng, float *w_sum) {
+  int k = n - 1, kept = -1;
+  *w_sum = 0;
+  float Mt = 0;
+  for (int i = 0; i < n; i++) Mt += in[i].M;
+  if (!(Mt > 0)) return -1;
+  float Mck = k > 0 ? in[0].M / (float)k : in[0].M;
+  for (int i = 0; i < n; i++) {
+    float u = rnd(rng);
+    if (!(in[i].W > 0) || !(in[i].p_here > 0)) continue;
+    float m;
+    if (k == 0) m = 1;
+    else if (i == 0) {
+      m = 0;
+      for (int j = 1; j < n; j++) {
+        float a = (in[j].M + Mck) / Mt, den = in[j].M * in[j].p_can + Mck * in[0].p_here;
+        if (den > 0) m += a * Mck * in[0].p_here / den;
+      }
+    } else {
+      float a = (in[i].M + Mck) / Mt, den = in[i].M * in[i].p_own + Mck * in[i].p_here;
+      m = den > 0 ? a * in[i].M * in[i].p_own / den : 0;
+    }
+    if (restir_wrs_take(w_sum, m * in[i].p_here * in[i].W, u)) kept = i;
+  }
+  return kept;
+}
+
 /* Merges reservoirs in[0..n) (in[0] the pixel's own) into *out at pixel g: each is
  * resampled with weight p^_g(y) V_g(y) W M (M of in[1..] capped by cap_M), M summed. The
  * target includes visibility (Bitterli et al. 2020, sec. 4 and Alg. 6 with V): every
@@ -269,7 +314,7 @@ static void di_merge(const render_ctx *c, const restir_cfg *cfg, const gpix *g, 
     if (!(phat > 0)) continue;
     /* the target is p^ V: another pixel's sample counts only if g sees it */
     if (i > 0 && !di_visible(c, g, &li, ts)) continue;
-    if (wrs_take(&out->w_sum, phat * r->W * M, u)) { out->y = r->y; phat_kept = phat; kept = i; }
+    if (restir_wrs_take(&out->w_sum, phat * r->W * M, u)) { out->y = r->y; phat_kept = phat; kept = i; }
   }
   out->M = Msum;
   if (kept < 0) return;
@@ -286,6 +331,44 @@ static void di_merge(const render_ctx *c, const restir_cfg *cfg, const gpix *g, 
   out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
 }
 
+/* Unbiased DI merge (pairwise MIS above); same inputs as di_merge. */
+static void di_merge_pairwise(const render_ctx *c, const gpix *g, const di_res *const *in, const gpix *const *gs, int n, float cap_M,
+                              sampler *rng, thread_stats *ts, di_res *out) {
+  memset(out, 0, sizeof *out);
+  pw_in pw[72];
+  rgb contrib;
+  light_li li;
+  int can = in[0]->W > 0;
+  for (int i = 0; i < n; i++) {
+    const di_res *r = in[i];
+    pw_in *p = &pw[i];
+    p->M = r->M;
+    if (i > 0 && cap_M > 0 && p->M > cap_M) p->M = cap_M;
+    out->M += p->M;
+    p->W = r->W;
+    p->p_own = p->p_here = p->p_can = 0;
+    if (i == 0) {
+      if (can) p->p_own = p->p_here = di_target_g(c, g, &r->y, &contrib, &li);
+      continue;
+    }
+    if (r->W > 0) {
+      p->p_own = di_target_g(c, gs[i], &r->y, &contrib, &li);
+      p->p_here = di_target_g(c, g, &r->y, &contrib, &li);
+      if (p->p_here > 0 && !di_visible(c, g, &li, ts)) p->p_here = 0;
+    }
+    if (can) {
+      p->p_can = di_target_g(c, gs[i], &in[0]->y, &contrib, &li);
+      if (p->p_can > 0 && !di_visible(c, gs[i], &li, ts)) p->p_can = 0;
+    }
+  }
+  float w_sum;
+  int kept = pairwise_select(pw, n, rng, &w_sum);
+  out->w_sum = w_sum;
+  if (kept < 0) return;
+  out->y = in[kept]->y;
+  out->W = w_sum / pw[kept].p_here;
+}
+
 static void stage_di_temporal(void *user, int64_t row, int thread) {
   stage_job *j = user;
   restir_state *s = j->s;
@@ -299,7 +382,9 @@ static void stage_di_temporal(void *user, int64_t row, int thread) {
     const di_res *in[2] = {cur, &s->di_prev[q]};
     const gpix *gs[2] = {g, &s->g_prev[q]};
     sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL);
-    di_merge(j->c, &s->dcfg, g, in, gs, 2, (float)(s->dcfg.history * s->dcfg.candidates), &rng, &j->f->ts[thread], out);
+    float cap = (float)(s->dcfg.history * s->dcfg.candidates);
+    if (s->dcfg.unbiased) di_merge_pairwise(j->c, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
+    else di_merge(j->c, &s->dcfg, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -339,7 +424,8 @@ static void stage_di_spatial(void *user, int64_t row, int thread) {
     const gpix *gs[65];
     in[0] = cur; gs[0] = g;
     for (int i = 0; i < k; i++) { in[i + 1] = &s->di[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    di_merge(j->c, &s->dcfg, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    if (s->dcfg.unbiased) di_merge_pairwise(j->c, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    else di_merge(j->c, &s->dcfg, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -447,7 +533,7 @@ static void gi_merge(const render_ctx *c, const restir_cfg *cfg, int use_jacobia
     float J = i == 0 || !use_jacobian ? 1.0f : restir_gi_jacobian(gs[i]->it.p, g->it.p, r->xs, r->ns);
     if (!(J > 0)) continue;
     if (i > 0 && !gi_visible(c, g, r, ts)) continue;
-    if (wrs_take(&out->w_sum, phat * r->W * J * M, u)) { out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo; phat_kept = phat; kept = i; }
+    if (restir_wrs_take(&out->w_sum, phat * r->W * J * M, u)) { out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo; phat_kept = phat; kept = i; }
   }
   out->M = Msum;
   if (kept < 0) return;
@@ -464,6 +550,58 @@ static void gi_merge(const render_ctx *c, const restir_cfg *cfg, int use_jacobia
   out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
 }
 
+/* Area-measure factor at pixel g for GI sample point xs: |cos phi_g| / |x_g - xs|^2 (1
+ * when the Jacobian is switched off, to show what leaving it out does). */
+static float gi_area(const gpix *g, const gi_res *r, int use_jacobian) {
+  if (!use_jacobian) return 1;
+  vec3 d = v3_sub(g->it.p, r->xs);
+  float d2 = v3_len2(d);
+  if (!(d2 > 0)) return 0;
+  float f = fabsf(v3_dot(r->ns, d)) / (d2 * sqrtf(d2));
+  return isfinite(f) ? f : 0;
+}
+/* Unbiased GI merge (pairwise MIS), in the area measure at the sample points: a target
+ * p^_omega times gi_area, W divided by the owner's gi_area (the Jacobian of the shift). */
+static void gi_merge_pairwise(const render_ctx *c, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs, int n,
+                              float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
+  memset(out, 0, sizeof *out);
+  pw_in pw[72];
+  rgb contrib;
+  vec3 wi;
+  int can = in[0]->W > 0;
+  for (int i = 0; i < n; i++) {
+    const gi_res *r = in[i];
+    pw_in *p = &pw[i];
+    p->M = r->M;
+    if (i > 0 && cap_M > 0 && p->M > cap_M) p->M = cap_M;
+    out->M += p->M;
+    p->p_own = p->p_here = p->p_can = p->W = 0;
+    float a_own = gi_area(gs[i], r, use_jacobian);
+    if (r->W > 0 && a_own > 0) p->W = r->W / a_own;
+    if (i == 0) {
+      if (can) p->p_own = p->p_here = gi_target(g, r, &contrib, &wi) * a_own;
+      continue;
+    }
+    if (p->W > 0) {
+      p->p_own = gi_target(gs[i], r, &contrib, &wi) * a_own;
+      p->p_here = gi_target(g, r, &contrib, &wi) * gi_area(g, r, use_jacobian);
+      if (p->p_here > 0 && !gi_visible(c, g, r, ts)) p->p_here = 0;
+    }
+    if (can) {
+      p->p_can = gi_target(gs[i], in[0], &contrib, &wi) * gi_area(gs[i], in[0], use_jacobian);
+      if (p->p_can > 0 && !gi_visible(c, gs[i], in[0], ts)) p->p_can = 0;
+    }
+  }
+  float w_sum;
+  int kept = pairwise_select(pw, n, rng, &w_sum);
+  out->w_sum = w_sum;
+  if (kept < 0) return;
+  const gi_res *r = in[kept];
+  out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo;
+  /* W in this pixel's solid angle: w_sum / p^_area(y) * area factor = w_sum / p^_omega(y) */
+  out->W = w_sum / pw[kept].p_here * gi_area(g, r, use_jacobian);
+}
+
 static void stage_gi_temporal(void *user, int64_t row, int thread) {
   stage_job *j = user;
   restir_state *s = j->s;
@@ -477,7 +615,8 @@ static void stage_gi_temporal(void *user, int64_t row, int thread) {
     const gi_res *in[2] = {cur, &s->gr_prev[q]};
     const gpix *gs[2] = {g, &s->g_prev[q]};
     sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7);
-    gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
+    if (s->gcfg.unbiased) gi_merge_pairwise(j->c, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
+    else gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -498,7 +637,8 @@ static void stage_gi_spatial(void *user, int64_t row, int thread) {
     const gpix *gs[65];
     in[0] = cur; gs[0] = g;
     for (int i = 0; i < k; i++) { in[i + 1] = &s->gr[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    if (s->gcfg.unbiased) gi_merge_pairwise(j->c, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    else gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -534,6 +674,11 @@ static void stage_shade(void *user, int64_t row, int thread) {
 }
 
 /* ---- the frame */
+/* Temporal reuse: 1 on, 0 off, -1 (default) on in sequences and off for a still, whose
+ * frames are averaged: history correlates them, so the average converges slower
+ * (measured on the many-light room, docs/integrators.md). */
+static int temporal_on(int t, const frame_ctx *f) { return t > 0 || (t < 0 && f->sequence); }
+
 static int run_stage(const render_ctx *c, const frame_ctx *f, parallel_fn fn, void *job) {
   parallel_for(c->threads, c->height, fn, job);
   return atomic_load(f->cancel) != 0;
@@ -549,7 +694,7 @@ static valo_status restir_frame(void *state, const render_ctx *c, const frame_ct
     j.dst = 0;
     STAGE(stage_di_initial, &j);
     int cur = 0;
-    if (s->dcfg.temporal) { j.src = cur; j.dst = 1 - cur; STAGE(stage_di_temporal, &j); cur = 1 - cur; }
+    if (temporal_on(s->dcfg.temporal, f)) { j.src = cur; j.dst = 1 - cur; STAGE(stage_di_temporal, &j); cur = 1 - cur; }
     for (int it = 0; it < s->dcfg.iterations && s->dcfg.spatial > 0; it++) {
       spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
       STAGE(stage_di_spatial, &sj);
@@ -561,7 +706,7 @@ static valo_status restir_frame(void *state, const render_ctx *c, const frame_ct
     j.src = 0; j.dst = 0;
     STAGE(stage_gi_initial, &j);
     int cur = 0;
-    if (s->gcfg.temporal) { j.src = cur; j.dst = 1 - cur; STAGE(stage_gi_temporal, &j); cur = 1 - cur; }
+    if (temporal_on(s->gcfg.temporal, f)) { j.src = cur; j.dst = 1 - cur; STAGE(stage_gi_temporal, &j); cur = 1 - cur; }
     for (int it = 0; it < s->gcfg.iterations && s->gcfg.spatial > 0; it++) {
       spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
       STAGE(stage_gi_spatial, &sj);
@@ -579,13 +724,18 @@ static valo_status restir_frame(void *state, const render_ctx *c, const frame_ct
   return VALO_OK;
 }
 
-static restir_cfg cfg_from(const double *p, int gi) {
+/* The automatic radius: the paper's 30 pixels at 1920 wide, scaled to the film (a fixed 30
+ * pixels on a 160-pixel film mixes surfaces lit by different lamps: 1.8x the per-frame
+ * error of 3 pixels on the many-light room, docs/integrators.md). */
+static float auto_radius(int width) { float r = (float)width / 64.0f; return r > 3 ? r : 3; }
+
+static restir_cfg cfg_from(const double *p, int gi, int width) {
   restir_cfg k;
   k.candidates = (int)p[P_CANDIDATES];
   k.temporal = (int)p[P_TEMPORAL];
   k.history = (float)p[P_HISTORY];
   k.spatial = (int)p[P_SPATIAL];
-  k.radius = (float)p[P_RADIUS];
+  k.radius = p[P_RADIUS] > 0 ? (float)p[P_RADIUS] : auto_radius(width);
   k.iterations = (int)p[P_ITER];
   k.unbiased = (int)p[P_UNBIASED];
   k.normal_threshold = (float)p[P_NORMAL];
@@ -610,14 +760,14 @@ static valo_status restir_create_common(const render_ctx *c, void **state, int g
   s->width = c->width; s->height = c->height;
   s->np = (size_t)c->width * c->height;
   if (gi) {
-    s->gcfg = cfg_from(c->param, 1);
+    s->gcfg = cfg_from(c->param, 1, c->width);
     s->direct_restir = (int)c->param[P_DIRECT];
     /* direct light: restir-di's defaults, with this integrator's candidate count */
     double dp[INTEGRATOR_MAX_PARAMS];
     for (int i = 0; di_params[i].name; i++) dp[i] = di_params[i].def;
     dp[P_CANDIDATES] = c->param[P_CANDIDATES];
-    s->dcfg = cfg_from(dp, 0);
-  } else s->dcfg = cfg_from(c->param, 0);
+    s->dcfg = cfg_from(dp, 0, c->width);
+  } else s->dcfg = cfg_from(c->param, 0, c->width);
   int ok = (s->g = calloc(s->np, sizeof *s->g)) && (s->g_prev = calloc(s->np, sizeof *s->g_prev));
   if (ok && (!gi || s->direct_restir))
     ok = (s->di[0] = calloc(s->np, sizeof(di_res))) && (s->di[1] = calloc(s->np, sizeof(di_res))) && (s->di_prev = calloc(s->np, sizeof(di_res)));

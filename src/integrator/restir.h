@@ -15,6 +15,11 @@ typedef struct di_res { di_sample y; float w_sum, M, W; } di_res;
  * the radiance L^ it sends towards that pixel. */
 typedef struct gi_res { vec3 xs, ns; rgb Lo; float w_sum, M, W; } gi_res;
 
+/* Streaming weighted reservoir sampling, one candidate of weight w: adds w to *w_sum and
+ * returns 1 (keep the candidate) when u * w_sum < w, i.e. with probability w / w_sum; a
+ * candidate of weight 0 (or not finite) is never kept and adds nothing. */
+int restir_wrs_take(float *w_sum, float w, float u);
+
 typedef struct restir_cfg {
   int candidates, temporal, spatial, iterations, unbiased, jacobian;
   float history, radius, normal_threshold, depth_threshold;
@@ -32,8 +37,10 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
 float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
                        light_li *li);
 /* Jacobian of moving GI sample point xs (normal ns) from the pixel at x_from to the one
- * at x_to: d omega_from / d omega_to = |cos phi_to| / |cos phi_from| * |x_from - xs|^2 /
- * |x_to - xs|^2; a reservoir's W is multiplied by it. 0 when degenerate. */
+ * at x_to: d omega_to / d omega_from = |cos phi_to| / |cos phi_from| * |x_from - xs|^2 /
+ * |x_to - xs|^2 (the solid angle a patch at xs subtends from x_to over that from x_from).
+ * A reservoir's W estimates 1 / pdf in x_from's solid angle; times this it does in x_to's.
+ * 0 when degenerate. */
 float restir_gi_jacobian(vec3 x_from, vec3 x_to, vec3 xs, vec3 ns);
 /* The reuse test: normals within normal_threshold (cosine) and depths within
  * depth_threshold (relative to depth_a). */

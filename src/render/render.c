@@ -501,7 +501,7 @@ static void adapt_chunk(void *user, int64_t item, int thread) {
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(valo_render *r, thread_stats *ts, valo_error *err) {
-  frame_ctx f = {r->image_frames, r->view, r->image_frames ? r->view_prev : r->view, r->frame_rgb, ts, &r->cancel};
+  frame_ctx f = {r->image_frames, r->view, r->image_frames ? r->view_prev : r->view, r->frame_rgb, ts, &r->cancel, r->opt.frames > 0};
   valo_status st = r->integ->render_frame(r->istate, &r->ctx, &f, err);
   if (st) return st;
   r->image_frames++;

@@ -1,0 +1,250 @@
+/* bench_restir.c — restir-di and restir-gi against the baselines of the ReSTIR papers, at
+ * equal time, on the many-light scenes (docs/performance.md):
+ *  - direct light: restir-di against path limited to direct light (--max-depth 1: power-
+ *    proportional light selection, one NEE sample, MIS with BSDF sampling);
+ *  - global illumination: restir-gi against path.
+ * For each: per-frame relMSE at 1 sample per pixel per frame (the baseline given as many
+ * samples per pixel as fit in restir's frame time, at least 1), the relMSE of the image
+ * accumulated over an equal total time, and temporal stability on a static camera (mean
+ * over pixels of |f_k - f_(k-1)| / (f_k + f_(k-1) + 0.01), luminance, over a sequence).
+ * relMSE: mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01), pixels that see
+ * a lamp (and their neighbours) left out: lamps smaller than a pixel are equally noisy
+ * for every method.
+ * References (bench/references, commands in docs/performance.md): path at high spp.
+ * Usage: bench_restir [--quick] [--only room|sponza] [--seconds S] */
+#include "valo/valo.h"
+#include "image/image_io.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#ifndef VALO_SOURCE_DIR
+#define VALO_SOURCE_DIR "."
+#endif
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct scene_def { const char *name, *file, *ref_direct, *ref_path; int w, h; } scene_def;
+
+typedef struct job {
+  const char *file, *integ, *params;
+  int w, h, spp, frames, max_depth;
+  double budget;
+  uint64_t seed;
+  /* out */
+  double secs;
+  float *px;            /* final film */
+  float *seq[64];       /* a sequence's frames */
+  int nseq;
+} job;
+
+static valo_status grab(void *user, const valo_render *r, int f, valo_error *err) {
+  (void)err; (void)f;
+  job *j = user;
+  if (j->nseq < 64) {
+    j->seq[j->nseq] = malloc((size_t)j->w * j->h * 3 * sizeof(float));
+    valo_render_pixels(r, j->seq[j->nseq]);
+    j->nseq++;
+  }
+  return VALO_OK;
+}
+
+/* Runs j; secs excludes scene loading and the acceleration-structure build. */
+static int run(job *j) {
+  valo_error err;
+  valo_scene *sc;
+  if (valo_scene_load(j->file, &sc, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  valo_options o;
+  valo_options_init(&o);
+  snprintf(o.integrator, sizeof o.integrator, "%s", j->integ);
+  if (j->params) snprintf(o.params, sizeof o.params, "%s", j->params);
+  o.width = j->w; o.height = j->h; o.spp = j->spp; o.threads = 2; o.seed = (int64_t)(j->seed ? j->seed : 5);
+  if (j->max_depth >= 0) o.max_depth = j->max_depth;
+  if (j->budget > 0) o.time_budget = j->budget;
+  if (j->frames > 0) o.frames = j->frames;
+  valo_render *r;
+  double t0 = now();
+  if (valo_render_create(sc, &o, &r, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  j->nseq = 0;
+  if (j->frames > 0) valo_render_on_frame(r, grab, j);
+  if (valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  valo_stats st;
+  valo_render_stats(r, &st);
+  j->secs = now() - t0 - st.build_seconds;
+  j->px = malloc((size_t)j->w * j->h * 3 * sizeof(float));
+  valo_render_pixels(r, j->px);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return 0;
+}
+static void job_free(job *j) {
+  free(j->px);
+  for (int i = 0; i < j->nseq; i++) free(j->seq[i]);
+}
+
+static unsigned char *g_ok;
+static double relmse(const float *a, const float *b, int n) {
+  double e = 0;
+  long cnt = 0;
+  for (int i = 0; i < n; i++) {
+    if (g_ok && !g_ok[i]) continue;
+    for (int c = 0; c < 3; c++) { double d = a[3 * i + c] - b[3 * i + c]; e += d * d / (b[3 * i + c] * b[3 * i + c] + 0.01); }
+    cnt += 3;
+  }
+  return cnt ? e / (double)cnt : 0;
+}
+static double mean_ratio(const float *a, const float *b, int n) {
+  double sa = 0, sb = 0;
+  for (int i = 0; i < n; i++)
+    if (!g_ok || g_ok[i]) for (int c = 0; c < 3; c++) { sa += a[3 * i + c]; sb += b[3 * i + c]; }
+  return sa / sb;
+}
+static double flicker(const job *j, int n) {
+  double s = 0;
+  long cnt = 0;
+  for (int k = 1; k < j->nseq; k++)
+    for (int i = 0; i < n; i++) {
+      if (g_ok && !g_ok[i]) continue;
+      const float *a = &j->seq[k][3 * i], *b = &j->seq[k - 1][3 * i];
+      double la = 0.2126 * a[0] + 0.7152 * a[1] + 0.0722 * a[2], lb = 0.2126 * b[0] + 0.7152 * b[1] + 0.0722 * b[2];
+      s += fabs(la - lb) / (la + lb + 0.01);
+      cnt++;
+    }
+  return cnt ? s / (double)cnt : 0;
+}
+
+/* A copy of the scene file without its camera animation (static-camera sequences). */
+static int static_copy(const char *src, char *out, size_t n) {
+  FILE *f = fopen(src, "rb");
+  if (!f) return -1;
+  static char buf[1 << 16];
+  size_t len = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[len] = 0;
+  char *k = strstr(buf, "\"keyframes\"");
+  if (k) {
+    /* cut from the comma before "keyframes" to its closing bracket */
+    char *start = k;
+    while (start > buf && *start != ',') start--;
+    char *end = strchr(k, '[');
+    for (int depth = 0; end && *end; end++) {
+      if (*end == '[') depth++;
+      else if (*end == ']' && --depth == 0) break;
+    }
+    if (!end || !*end) return -1;
+    memmove(start, end + 1, strlen(end + 1) + 1);
+  }
+  const char *slash = strrchr(src, '/');
+  snprintf(out, n, "%.*s/.bench-static-%s", slash ? (int)(slash - src) : 1, slash ? src : ".", slash ? slash + 1 : src);
+  f = fopen(out, "wb");
+  if (!f) return -1;
+  fputs(buf, f);
+  fclose(f);
+  return 0;
+}
+
+static int bench_scene(const scene_def *sd, int quick, double seconds) {
+  int n = sd->w * sd->h;
+  char stat[1024];
+  if (static_copy(sd->file, stat, sizeof stat)) { fprintf(stderr, "cannot copy %s\n", sd->file); return 1; }
+  /* lamp mask: emission seen directly */
+  job em = {stat, "path", NULL, sd->w, sd->h, 64, 0, 0, 0, 1, 0, NULL, {NULL}, 0};
+  if (run(&em)) return 1;
+  g_ok = malloc((size_t)n);
+  for (int y = 0; y < sd->h; y++)
+    for (int x = 0; x < sd->w; x++) {
+      int bad = 0;
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= sd->w || yy >= sd->h) continue;
+          const float *p = &em.px[3 * (yy * sd->w + xx)];
+          if (p[0] + p[1] + p[2] > 0) bad = 1;
+        }
+      g_ok[y * sd->w + x] = !bad;
+    }
+  job_free(&em);
+  for (int gi = 0; gi < 2; gi++) {
+    const char *refp = gi ? sd->ref_path : sd->ref_direct;
+    if (!refp) continue;
+    image ref;
+    valo_error err;
+    if (image_read(refp, &ref, &err) || ref.w != sd->w || ref.h != sd->h) { fprintf(stderr, "%s: %s\n", refp, err.message); return 1; }
+    const char *integ = gi ? "restir-gi" : "restir-di";
+    int depth = gi ? -1 : 1;
+    printf("\n%s, %s against path%s (%dx%d, 2 threads)\n", sd->name, integ, gi ? "" : " --max-depth 1", sd->w, sd->h);
+    /* time per frame (still, static camera) and per baseline sample */
+    int nf = quick ? 4 : 16;
+    job rt = {stat, integ, NULL, sd->w, sd->h, nf, 0, -1, 0, 3, 0, NULL, {NULL}, 0};
+    job pt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0};
+    if (run(&rt) || run(&pt)) return 1;
+    double t_frame = rt.secs / nf, t_spp = pt.secs / nf;
+    int base_spp = (int)lround(t_frame / t_spp);
+    if (base_spp < 1) base_spp = 1;
+    job_free(&rt); job_free(&pt);
+    /* per frame: a static-camera sequence; the last frame (history built) */
+    int seqn = quick ? 8 : 24;
+    job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0};
+    job rs0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0};
+    job ris = {stat, integ, "temporal=0 iterations=0", sd->w, sd->h, 1, 1, -1, 0, 7, 0, NULL, {NULL}, 0};
+    job ps = {stat, "path", NULL, sd->w, sd->h, base_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0};
+    if (run(&rs) || run(&rs0) || run(&ris) || run(&ps)) return 1;
+    double e_rs = 0, e_rs0 = 0, e_ps = 0;
+    int last = 4 < rs.nseq ? 4 : rs.nseq;
+    for (int k = rs.nseq - last; k < rs.nseq; k++) {
+      e_rs += relmse(rs.seq[k], ref.rgb, n) / last;
+      e_rs0 += relmse(rs0.seq[k], ref.rgb, n) / last;
+      e_ps += relmse(ps.seq[k], ref.rgb, n) / last;
+    }
+    double e_ris = relmse(ris.seq[0], ref.rgb, n);
+    printf("  time per frame: %s %.3f s; path %.3f s per spp -> baseline %d spp per frame\n", integ, t_frame, t_spp, base_spp);
+    printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g; path %d spp %.4g\n",
+           last, seqn, integ, e_rs, e_rs0, e_ris, base_spp, e_ps);
+    printf("  per-frame ratio path / %s: %.2f (spatial only: %.2f)\n", integ, e_ps / e_rs, e_ps / e_rs0);
+    printf("  temporal stability (mean relative frame-to-frame change): %s %.4f, without temporal %.4f, path %.4f\n", integ, flicker(&rs, n),
+           flicker(&rs0, n), flicker(&ps, n));
+    job_free(&rs); job_free(&rs0); job_free(&ris); job_free(&ps);
+    /* accumulated at equal time: a still (frames averaged) against path with the same budget */
+    double T = seconds > 0 ? seconds : (quick ? 2.0 : 10.0);
+    job ra = {stat, integ, NULL, sd->w, sd->h, 1048576, 0, -1, T, 11, 0, NULL, {NULL}, 0};
+    job pa = {stat, "path", NULL, sd->w, sd->h, 1048576, 0, depth, T, 11, 0, NULL, {NULL}, 0};
+    if (run(&ra) || run(&pa)) return 1;
+    double ea = relmse(ra.px, ref.rgb, n), epa = relmse(pa.px, ref.rgb, n);
+    printf("  accumulated over %.0f s: %s relMSE %.4g (mean ratio %.4f), path %.4g (mean ratio %.4f); ratio path / %s %.2f\n", T, integ, ea,
+           mean_ratio(ra.px, ref.rgb, n), epa, mean_ratio(pa.px, ref.rgb, n), integ, epa / ea);
+    job_free(&ra); job_free(&pa);
+    image_free(&ref);
+  }
+  remove(stat);
+  free(g_ok);
+  g_ok = NULL;
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  int quick = 0;
+  const char *only = NULL;
+  double seconds = 0;
+  for (int i = 1; i < argc; i++) {
+    if (!strcmp(argv[i], "--quick")) quick = 1;
+    else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
+    else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
+    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza] [--seconds S]\n"); return 2; }
+  }
+  const scene_def scenes[2] = {
+      {"room (scenes/manylight.json, 1 024 lamps)", VALO_SOURCE_DIR "/scenes/manylight.json", VALO_SOURCE_DIR "/bench/references/manylight-room-direct.exr",
+       VALO_SOURCE_DIR "/bench/references/manylight-room-path.exr", 160, 120},
+      {"Sponza with 1 200 lamps (bench/sponza-lamps.json)", VALO_SOURCE_DIR "/bench/sponza-lamps.json",
+       VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", NULL, 320, 180}};
+  for (int s = 0; s < 2; s++) {
+    if (only && strcmp(only, s ? "sponza" : "room")) continue;
+    if (bench_scene(&scenes[s], quick, seconds)) return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,402 @@
+/* test_restir.c — restir-di and restir-gi (digest 001, src/integrator/restir.c) and the
+ * frames they run on:
+ *  - streaming reservoir sampling keeps w_sum, M and each candidate's selection
+ *    probability exact (enumeration of every decision on a grid where the ratios are
+ *    exact);
+ *  - RIS with M = 1 and no reuse is light sampling: the same mean as path's next-event
+ *    estimation (max-depth 1) within 4 standard errors (false failure ~ 6e-5);
+ *  - on the many-light room (scenes/manylight.json, 1 024 lamps; 80x60) the unbiased
+ *    restir-di converges to Mitsuba 3's direct-light image and restir-gi to Mitsuba's
+ *    path image (tests/data/manylight-{direct,path}-mitsuba.exr, made by
+ *    scripts/mitsuba-reference.py): mean per channel within 1 %, lit 16x16 blocks within
+ *    3 %, pixels that see a lamp (and their neighbours) left out, since lamps smaller than
+ *    a pixel make those the noisiest of both; the biased restir-di is darker, by an amount
+ *    printed and bounded;
+ *  - the GI Jacobian equals the solid-angle ratio measured on a small patch, and resampling
+ *    directions found from one point for another point is unbiased with it and biased
+ *    without it;
+ *  - a moving camera: temporal reuse gives per-frame error no worse than spatial reuse
+ *    alone; the reuse test rejects other surfaces (normal and depth);
+ *  - camera keyframes interpolate; --frames calls back once per frame;
+ *  - bit-identical images for 1, 2 and 7 threads; bad parameters are refused by name. */
+#include "harness.h"
+#include "integrator/restir.h"
+#include "scene/scene.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef VALO_SOURCE_DIR
+#define VALO_SOURCE_DIR "."
+#endif
+#define ROOM VALO_SOURCE_DIR "/scenes/manylight.json"
+#define W 80
+#define H 60
+
+static float *render_room_depth(const char *integ, const char *params, int spp, int threads, uint64_t seed, int max_depth) {
+  valo_options o;
+  valo_options_init(&o);
+  if (max_depth >= 0) o.max_depth = max_depth;
+  snprintf(o.integrator, sizeof o.integrator, "%s", integ);
+  if (params) snprintf(o.params, sizeof o.params, "%s", params);
+  o.width = W; o.height = H; o.spp = spp; o.threads = threads; o.seed = (int64_t)seed;
+  valo_scene *sc;
+  valo_render *r = render_file(ROOM, &o, &sc);
+  if (!r) return NULL;
+  float *px = malloc((size_t)W * H * 3 * sizeof *px);
+  valo_render_pixels(r, px);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return px;
+}
+static float *render_room(const char *integ, const char *params, int spp, int threads, uint64_t seed) {
+  return render_room_depth(integ, params, spp, threads, seed, -1);
+}
+
+/* Pixels that see no lamp, nor do their neighbours (from the emission-only image). */
+static unsigned char *lamp_free_mask(void) {
+  float *em = render_room_depth("path", NULL, 256, 2, 1, 0); /* emission seen directly */
+  if (!em) return NULL;
+  unsigned char *ok = malloc(W * H);
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      int bad = 0;
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+          const float *p = &em[3 * (yy * W + xx)];
+          if (p[0] + p[1] + p[2] > 0) bad = 1;
+        }
+      ok[y * W + x] = !bad;
+    }
+  free(em);
+  return ok;
+}
+
+typedef struct cmp { double ratio[3], worst; } cmp;
+static void compare(const float *img, const float *ref, const unsigned char *ok, cmp *c) {
+  double a[3] = {0}, b[3] = {0};
+  for (int i = 0; i < W * H; i++)
+    if (ok[i])
+      for (int k = 0; k < 3; k++) { a[k] += img[3 * i + k]; b[k] += ref[3 * i + k]; }
+  for (int k = 0; k < 3; k++) c->ratio[k] = a[k] / b[k];
+  double mean = (b[0] + b[1] + b[2]) / (3.0 * W * H);
+  c->worst = 0;
+  for (int by = 0; by + 16 <= H; by += 16)
+    for (int bx = 0; bx + 16 <= W; bx += 16) {
+      double sa = 0, sb = 0;
+      int n = 0;
+      for (int y = by; y < by + 16; y++)
+        for (int x = bx; x < bx + 16; x++) {
+          int i = y * W + x;
+          if (!ok[i]) continue;
+          n++;
+          for (int k = 0; k < 3; k++) { sa += img[3 * i + k]; sb += ref[3 * i + k]; }
+        }
+      if (n < 64 || sb / (3.0 * n) < 0.2 * mean) continue; /* lit blocks, mostly lamp-free */
+      double e = fabs(sa / sb - 1);
+      if (e > c->worst) c->worst = e;
+    }
+}
+
+static int read_ref(const char *name, image *im) {
+  char path[1024];
+  snprintf(path, sizeof path, VALO_SOURCE_DIR "/tests/data/%s", name);
+  valo_error err;
+  CHECK(image_read(path, im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im->w == W && im->h == H, "%s is %dx%d", name, im->w, im->h);
+  return 0;
+}
+
+static int converges(const char *integ, const char *params, const char *ref_name, int frames, double tol_mean, double tol_block,
+                     cmp *out) {
+  image ref;
+  if (read_ref(ref_name, &ref)) return 1;
+  unsigned char *ok = lamp_free_mask();
+  float *img = render_room(integ, params, frames, 2, 7);
+  CHECK(ok && img, "render failed");
+  compare(img, ref.rgb, ok, out);
+  fprintf(stderr, "%s %s, %d frames vs %s: mean ratio %.4f %.4f %.4f, worst lit block %.2f %%\n", integ, params ? params : "", frames,
+          ref_name, out->ratio[0], out->ratio[1], out->ratio[2], 100 * out->worst);
+  free(ok);
+  free(img);
+  image_free(&ref);
+  if (tol_mean > 0) {
+    for (int k = 0; k < 3; k++) CHECK(fabs(out->ratio[k] - 1) < tol_mean, "channel %d mean ratio %.4f", k, out->ratio[k]);
+    CHECK(out->worst < tol_block, "worst lit block off by %.2f %%", 100 * out->worst);
+  }
+  return 0;
+}
+
+/* ---- reservoirs */
+static int reservoir_enumeration(void) {
+  /* weights 3, 1, 4, 8: the take probabilities w / w_sum are 1, 1/4, 1/2, 1/2, exact on a
+   * grid of 4 values of u per step; every path of decisions is enumerated */
+  const float w[4] = {3, 1, 4, 8};
+  double count[4] = {0};
+  int total = 0;
+  for (int c = 0; c < 256; c++) {
+    float w_sum = 0;
+    int kept = -1;
+    for (int i = 0; i < 4; i++) {
+      float u = ((float)((c >> (2 * i)) & 3) + 0.5f) / 4.0f;
+      if (restir_wrs_take(&w_sum, w[i], u)) kept = i;
+    }
+    CHECK(w_sum == 16, "w_sum %g", w_sum);
+    CHECK(kept >= 0, "nothing kept");
+    count[kept]++;
+    total++;
+  }
+  for (int i = 0; i < 4; i++) CHECK(count[i] / total == w[i] / 16.0, "candidate %d kept with probability %g, not %g", i, count[i] / total, w[i] / 16.0);
+  /* zero and non-finite weights are never kept and add nothing */
+  float ws = 2;
+  CHECK(!restir_wrs_take(&ws, 0, 0) && !restir_wrs_take(&ws, NAN, 0) && !restir_wrs_take(&ws, INFINITY, 0) && ws == 2, "bad weight taken");
+  return 0;
+}
+
+/* RIS with one candidate and no reuse is next-event estimation without MIS. */
+static int ris_m1_is_light_sampling(void) {
+  unsigned char *ok = lamp_free_mask();
+  CHECK(ok, "render failed");
+  enum { RUNS = 8 };
+  double m[2][RUNS];
+  for (int k = 0; k < RUNS; k++) {
+    float *a = render_room("restir-di", "candidates=1 temporal=0 iterations=0", 16, 2, 100 + k);
+    float *b = render_room_depth("path", NULL, 16, 2, 200 + k, 1);
+    CHECK(a && b, "render failed");
+    double sa = 0, sb = 0;
+    for (int i = 0; i < W * H; i++)
+      if (ok[i]) for (int c = 0; c < 3; c++) { sa += a[3 * i + c]; sb += b[3 * i + c]; }
+    m[0][k] = sa; m[1][k] = sb;
+    free(a); free(b);
+  }
+  free(ok);
+  double mean[2], se2[2];
+  for (int j = 0; j < 2; j++) {
+    double s = 0, s2 = 0;
+    for (int k = 0; k < RUNS; k++) { s += m[j][k]; s2 += m[j][k] * m[j][k]; }
+    mean[j] = s / RUNS;
+    se2[j] = (s2 / RUNS - mean[j] * mean[j]) / (RUNS - 1);
+  }
+  double z = (mean[0] - mean[1]) / sqrt(se2[0] + se2[1]);
+  fprintf(stderr, "RIS M=1: %.5g, path NEE: %.5g (ratio %.4f, z = %.2f)\n", mean[0], mean[1], mean[0] / mean[1], z);
+  CHECK(fabs(z) < 4, "RIS with M = 1 differs from light sampling: z = %.2f", z);
+  return 0;
+}
+
+static int di_unbiased_converges(void) {
+  cmp c;
+  return converges("restir-di", NULL, "manylight-direct-mitsuba.exr", test_full() ? 1024 : 256, 0.01, 0.03, &c);
+}
+
+static int di_biased_is_darker(void) {
+  cmp c;
+  if (converges("restir-di", "unbiased=0", "manylight-direct-mitsuba.exr", 128, 0, 0, &c)) return 1;
+  double r = (c.ratio[0] + c.ratio[1] + c.ratio[2]) / 3;
+  fprintf(stderr, "biased restir-di: %.1f %% darker than the reference\n", 100 * (1 - r));
+  CHECK(r < 0.995 && r > 0.80, "the biased estimator's mean ratio %.4f is not the measured darkening (about 0.9)", r);
+  return 0;
+}
+
+static int gi_unbiased_converges(void) {
+  cmp c;
+  return converges("restir-gi", NULL, "manylight-path-mitsuba.exr", test_full() ? 512 : 192, 0.01, 0.03, &c);
+}
+
+/* ---- the Jacobian */
+static int jacobian_solid_angle(void) {
+  /* a small patch of area dA around xs (normal ns) subtends dA |cos phi| / d^2 from a
+   * point: the Jacobian is the ratio of those from x_to and from x_from */
+  vec3 xs = v3(0.2f, 1.0f, -0.3f), ns = v3_norm(v3(0.1f, -1, 0.2f));
+  vec3 from = v3(0, 0, 0), to = v3(0.9f, 0.1f, 0.4f);
+  float J = restir_gi_jacobian(from, to, xs, ns);
+  frame f = frame_from_n(ns);
+  double h = 1e-3, omega[2] = {0};
+  vec3 pts[2] = {from, to};
+  for (int k = 0; k < 2; k++) {
+    /* solid angle of the square patch by summing 20x20 sub-squares */
+    for (int i = 0; i < 20; i++)
+      for (int j = 0; j < 20; j++) {
+        vec3 p = v3_add(xs, v3_add(v3_scale(f.s, (float)(h * ((i + 0.5) / 20 - 0.5))), v3_scale(f.t, (float)(h * ((j + 0.5) / 20 - 0.5)))));
+        vec3 d = v3_sub(pts[k], p);
+        double d2 = v3_len2(d);
+        omega[k] += (h / 20) * (h / 20) * fabs(v3_dot(ns, d)) / sqrt(d2) / d2;
+      }
+  }
+  double expect = omega[1] / omega[0]; /* d omega_to / d omega_from */
+  fprintf(stderr, "Jacobian %.6f, solid-angle ratio %.6f\n", J, expect);
+  CHECK(fabs(J / expect - 1) < 1e-3, "Jacobian %.6f vs %.6f", J, expect);
+  CHECK(restir_gi_jacobian(from, from, xs, ns) > 0.9999f && restir_gi_jacobian(from, from, xs, ns) < 1.0001f, "identity move");
+  return 0;
+}
+
+/* Directions cosine-sampled at A = origin (normal +z) meet the plane z = 1 at xs; an
+ * estimate of the integral at B = (0.6, 0, 0) of L(xs) cos / pi over B's hemisphere,
+ * L(x) = 1 + x (clamped at 0), from A's samples: L cos_B / pi * W_A * J(A -> B), W_A =
+ * pi / cos_A. Unbiased with the Jacobian (the value B's own cosine samples give); far
+ * off without it. */
+static int jacobian_makes_reuse_unbiased(void) {
+  sampler s = sampler_make(11, 0, 0);
+  const int N = 400000;
+  vec3 A = v3(0, 0, 0), B = v3(0.6f, 0, 0), ns = v3(0, 0, -1);
+  double with = 0, without = 0, own = 0;
+  for (int i = 0; i < N; i++) {
+    float u1 = sampler_1d(&s), u2 = sampler_1d(&s);
+    float r = sqrtf(u1), ph = 2 * PI_F * u2;
+    vec3 d = v3(r * cosf(ph), r * sinf(ph), sqrtf(fmaxf(0, 1 - u1)));
+    /* B's own estimate, from the same direction taken at B */
+    vec3 xb = v3_add(B, v3_scale(d, 1 / d.z));
+    own += fmax(0, 1 + xb.x);
+    vec3 xs = v3_add(A, v3_scale(d, 1 / d.z));
+    vec3 db = v3_norm(v3_sub(xs, B));
+    double L = fmax(0, 1 + xs.x), WA = PI_F / d.z, fB = L * db.z / PI_F;
+    with += fB * WA * restir_gi_jacobian(A, B, xs, ns);
+    without += fB * WA;
+  }
+  with /= N; without /= N; own /= N;
+  fprintf(stderr, "B's own estimate %.4f; from A's samples with the Jacobian %.4f, without %.4f\n", own, with, without);
+  CHECK(fabs(with / own - 1) < 0.01, "with the Jacobian: %.4f vs %.4f", with, own);
+  CHECK(fabs(without / own - 1) > 0.05, "without the Jacobian the estimate should be off: %.4f vs %.4f", without, own);
+  return 0;
+}
+
+/* ---- frames and moving cameras */
+static int keyframes_interpolate(void) {
+  valo_scene *vs;
+  valo_error err;
+  CHECK(valo_scene_load(ROOM, &vs, &err) == VALO_OK, "%s", err.message);
+  const scene *s = *(scene *const *)vs; /* valo_scene holds the scene first */
+  camera still = s->cam;
+  camera c0 = scene_camera_at(s, &still, 0), c15 = scene_camera_at(s, &still, 15), c99 = scene_camera_at(s, &still, 99);
+  CHECK(fabsf(c0.pos.x + 0.8f) < 1e-6f, "frame 0 x %g", c0.pos.x);
+  CHECK(fabsf(c15.pos.x + 0.4f) < 1e-5f && fabsf(c15.pos.y - 1.375f) < 1e-5f, "frame 15 (%g, %g)", c15.pos.x, c15.pos.y);
+  CHECK(fabsf(c99.pos.x - 0.8f) < 1e-6f, "after the last key the camera holds: x %g", c99.pos.x);
+  valo_scene_destroy(vs);
+  return 0;
+}
+
+/* Frames [first, first + 4) of a sequence, kept by the frame callback. */
+typedef struct frame_log { int calls, last, first; float *frames[4]; } frame_log;
+static valo_status on_frame(void *user, const valo_render *r, int f, valo_error *err) {
+  (void)err;
+  frame_log *l = user;
+  if (f != l->last + 1) return VALO_ERR_INVALID; /* in order, once each */
+  l->last = f;
+  l->calls++;
+  if (f >= l->first && f < l->first + 4) {
+    l->frames[f - l->first] = malloc((size_t)W * H * 3 * sizeof(float));
+    valo_render_pixels(r, l->frames[f - l->first]);
+  }
+  return VALO_OK;
+}
+/* Renders frames 0..n-1 of the room's camera path (spp per frame) and keeps the last 4. */
+static int run_sequence(const char *integ, const char *params, int max_depth, int spp, int n, frame_log *log) {
+  valo_options o;
+  valo_options_init(&o);
+  snprintf(o.integrator, sizeof o.integrator, "%s", integ);
+  if (params) snprintf(o.params, sizeof o.params, "%s", params);
+  if (max_depth >= 0) o.max_depth = max_depth;
+  o.width = W; o.height = H; o.spp = spp; o.threads = 2; o.frames = n; o.seed = 9;
+  valo_scene *sc;
+  valo_error err;
+  CHECK(valo_scene_load(ROOM, &sc, &err) == VALO_OK, "%s", err.message);
+  valo_render *r;
+  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+  memset(log, 0, sizeof *log);
+  log->last = -1;
+  log->first = n - 4;
+  valo_render_on_frame(r, on_frame, log);
+  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_stats st;
+  valo_render_stats(r, &st);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  CHECK(log->calls == n && st.frames_done == n, "%d frame callbacks, %d frames done, for %d frames", log->calls, st.frames_done, n);
+  return 0;
+}
+static double frames_relmse(const frame_log *a, const frame_log *ref) {
+  double e = 0;
+  for (int k = 0; k < 4; k++)
+    for (int i = 0; i < W * H * 3; i++) {
+      double d = a->frames[k][i] - ref->frames[k][i];
+      e += d * d / (ref->frames[k][i] * ref->frames[k][i] + 0.01);
+    }
+  return e / (4.0 * W * H * 3);
+}
+static void free_log(frame_log *l) { for (int k = 0; k < 4; k++) free(l->frames[k]); }
+
+/* The camera moves along the room's keyframes; the last 4 of 12 frames (1 sample per
+ * pixel each) against 256-spp direct-light frames: temporal reuse (history reprojected
+ * through the motion) must not be worse than spatial reuse alone, as it would be if it
+ * reused the wrong surfaces (ghosting). */
+static int moving_camera_temporal(void) {
+  frame_log ref, tmp, spa;
+  if (run_sequence("path", NULL, 1, 256, 12, &ref) || run_sequence("restir-di", "temporal=1", -1, 1, 12, &tmp) ||
+      run_sequence("restir-di", "temporal=0", -1, 1, 12, &spa))
+    return 1;
+  double et = frames_relmse(&tmp, &ref), es = frames_relmse(&spa, &ref);
+  fprintf(stderr, "moving camera, per-frame relMSE: temporal + spatial %.4g, spatial alone %.4g (ratio %.3f)\n", et, es, et / es);
+  free_log(&ref); free_log(&tmp); free_log(&spa);
+  CHECK(et <= 1.05 * es, "temporal reuse made frames worse: %.4g vs %.4g", et, es);
+  return 0;
+}
+
+static int reuse_rejects_other_surfaces(void) {
+  restir_cfg cfg;
+  memset(&cfg, 0, sizeof cfg);
+  cfg.normal_threshold = 0.9f;
+  cfg.depth_threshold = 0.1f;
+  vec3 n = v3(0, 0, 1);
+  CHECK(restir_similar(&cfg, n, 10, n, 10.5f), "same surface rejected");
+  CHECK(!restir_similar(&cfg, n, 10, n, 11.5f), "a surface 15 %% farther accepted");
+  CHECK(!restir_similar(&cfg, n, 10, v3_norm(v3(0, 1, 1)), 10), "a normal 45 degrees off accepted");
+  CHECK(!restir_similar(&cfg, n, 10, v3(0, 0, -1), 10), "a back face accepted");
+  return 0;
+}
+
+/* ---- determinism and options */
+static int threads_identical(void) {
+  const char *integ[2] = {"restir-di", "restir-gi"};
+  for (int k = 0; k < 2; k++) {
+    float *a = render_room(integ[k], "temporal=1", 3, 1, 4);
+    float *b = render_room(integ[k], "temporal=1", 3, 2, 4);
+    float *c = render_room(integ[k], "temporal=1", 3, 7, 4);
+    CHECK(a && b && c, "render failed");
+    CHECK(!memcmp(a, b, (size_t)W * H * 3 * sizeof(float)) && !memcmp(a, c, (size_t)W * H * 3 * sizeof(float)),
+          "%s: images differ between 1, 2 and 7 threads", integ[k]);
+    free(a); free(b); free(c);
+  }
+  return 0;
+}
+
+static int bad_parameters(void) {
+  const char *bad[4] = {"candidates=0", "radius=-1", "iterations=99", "spatial=1.5"};
+  const char *names[4] = {"candidates", "radius", "iterations", "spatial"};
+  for (int k = 0; k < 4; k++) {
+    valo_error err;
+    CHECK(valo_integrator_check_params("restir-di", bad[k], &err) != VALO_OK, "%s accepted", bad[k]);
+    CHECK(strstr(err.message, names[k]) != NULL, "message does not name %s: %s", names[k], err.message);
+    CHECK(valo_integrator_check_params("restir-gi", bad[k], &err) != VALO_OK, "restir-gi: %s accepted", bad[k]);
+  }
+  valo_error err;
+  CHECK(valo_integrator_check_params("restir-gi", "jacobian=2", &err) != VALO_OK, "jacobian=2 accepted");
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"reservoir_enumeration", reservoir_enumeration},
+                                    {"ris_m1_is_light_sampling", ris_m1_is_light_sampling},
+                                    {"di_unbiased_converges", di_unbiased_converges},
+                                    {"di_biased_is_darker", di_biased_is_darker},
+                                    {"gi_unbiased_converges", gi_unbiased_converges},
+                                    {"jacobian_solid_angle", jacobian_solid_angle},
+                                    {"jacobian_makes_reuse_unbiased", jacobian_makes_reuse_unbiased},
+                                    {"keyframes_interpolate", keyframes_interpolate},
+                                    {"moving_camera_temporal", moving_camera_temporal},
+                                    {"reuse_rejects_other_surfaces", reuse_rejects_other_surfaces},
+                                    {"threads_identical", threads_identical},
+                                    {"bad_parameters", bad_parameters},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
