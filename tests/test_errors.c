@@ -433,6 +433,43 @@ static int render_ok(void) {
   return 0;
 }
 
+/* --frames: a frame pattern gets every frame, a plain name the last; a '%' that is not a
+ * pattern, or a pattern without --frames, is a usage error; restir's bad parameters are
+ * refused by name; a camera animation with a bad key is an error naming it. */
+static int frames_cli(void) {
+  const char *obj = write_file("ok.obj", CUBE_OBJ);
+  const char *js = write_file("anim.json", "{ \"camera\": {\"position\": [0.5,0.5,3], \"look_at\": [0.5,0.5,0], \"up\": [0,1,0],"
+                                            " \"keyframes\": [{\"frame\": 0}, {\"frame\": 2, \"position\": [1,0.5,3]}]},"
+                                            " \"shapes\": [{\"file\": \"ok.obj\"}], \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n");
+  char pat[1200], last[1200], f0[1200], f2[1200], bad[1200];
+  snprintf(pat, sizeof pat, "%s/seq_%%03d.png", scratch_dir());
+  snprintf(last, sizeof last, "%s/seq_last.exr", scratch_dir());
+  snprintf(f0, sizeof f0, "%s/seq_000.png", scratch_dir());
+  snprintf(f2, sizeof f2, "%s/seq_002.png", scratch_dir());
+  snprintf(bad, sizeof bad, "%s/x%%s.png", scratch_dir());
+  EXPECT_FAIL(0, "render", js, "--frames", "3", "--spp", "2", "--res", "16x12", "-o", pat, "-o", last);
+  SAID("3 frames"); NO_SANITIZER();
+  CHECK(access(f0, R_OK) == 0 && access(f2, R_OK) == 0 && access(last, R_OK) == 0, "frame outputs missing");
+  EXPECT_FAIL(0, "render", js, "--frames", "2", "--spp", "1", "--res", "16x12", "--integrator", "restir-di", "-o", last);
+  EXPECT_FAIL(0, "render", js, "--frames", "2", "--spp", "1", "--res", "16x12", "--integrator", "restir-gi", "-o", last);
+  EXPECT_FAIL(2, "render", obj, "-o", pat);
+  SAID("needs --frames");
+  EXPECT_FAIL(2, "render", obj, "--frames", "2", "-o", bad);
+  SAID("frame pattern");
+  EXPECT_FAIL(2, "render", obj, "--frames", "0");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "restir-di", "--param", "candidates=0");
+  SAID("candidates");
+  EXPECT_FAIL(2, "render", obj, "--integrator", "restir-gi", "--param", "radius=-1");
+  SAID("radius");
+  EXPECT_FAIL(1, "render", obj, "--integrator", "restir-di", "-o", "albedo:x.png");
+  SAID("AOV");
+  const char *bk = write_file("badkey.json", "{ \"camera\": {\"keyframes\": [{\"frame\": 1}, {\"frame\": 0}]},"
+                                             " \"shapes\": [{\"file\": \"ok.obj\"}] }\n");
+  EXPECT_FAIL(1, "render", bk);
+  SAID("keyframes[1]"); SAID("increase");
+  return 0;
+}
+
 /* Ctrl-C (a real SIGINT) stops the render, writes every -o with the finished passes, says
  * how many spp they hold and exits 130 (issue 8.2). */
 static int sigint_writes_image(void) {
@@ -471,6 +508,7 @@ int main(int argc, char **argv) {
                                     {"malformed_obj", malformed_obj},
                                     {"no_light", no_light},
                                     {"cli_behaviour", cli_behaviour},
+                                    {"frames_cli", frames_cli},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
