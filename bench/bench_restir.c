@@ -154,7 +154,7 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
   char stat[1024];
   if (static_copy(sd->file, stat, sizeof stat)) { fprintf(stderr, "cannot copy %s\n", sd->file); return 1; }
   /* lamp mask: emission seen directly */
-  job em = {stat, "path", NULL, sd->w, sd->h, 64, 0, 0, 0, 1, 0, NULL, {NULL}, 0};
+  job em = {stat, "path", NULL, sd->w, sd->h, 1024, 0, 0, 0, 1, 0, NULL, {NULL}, 0}; /* every pixel a lamp touches */
   if (run(&em)) return 1;
   g_ok = malloc((size_t)n);
   for (int y = 0; y < sd->h; y++)

@@ -55,7 +55,7 @@ static float *render_room(const char *integ, const char *params, int spp, int th
 
 /* Pixels that see no lamp, nor do their neighbours (from the emission-only image). */
 static unsigned char *lamp_free_mask(void) {
-  float *em = render_room_depth("path", NULL, 256, 2, 1, 0); /* emission seen directly */
+  float *em = render_room_depth("path", NULL, 1024, 2, 1, 0); /* emission seen directly: every pixel a lamp touches */
   if (!em) return NULL;
   unsigned char *ok = malloc(W * H);
   for (int y = 0; y < H; y++)
@@ -202,6 +202,54 @@ static int di_biased_is_darker(void) {
 static int gi_unbiased_converges(void) {
   cmp c;
   return converges("restir-gi", NULL, "manylight-path-mitsuba.exr", test_full() ? 512 : 192, 0.01, 0.03, &c);
+}
+
+/* The environment is one more candidate source (its own pdf, the map's importance
+ * sampling), beside a point light and an area light: restir-di's mean equals path's
+ * direct light (max-depth 1) within 4 standard errors of the difference. */
+static int di_environment_and_point_lights(void) {
+  const char *env = shared_file("scenes/envmaps/sky.exr");
+  if (!env) return TEST_SKIP;
+  /* a floor, a sphere, a small lamp facing down (counter-clockwise seen from below) */
+  scratch_file("floor.obj", "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 4 3 2\n");
+  scratch_file("lamp.obj", "v 1 1.4 0.2\nv 1.3 1.4 0.2\nv 1.3 1.4 0.5\nv 1 1.4 0.5\nf 1 2 3 4\n");
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0, 1.5, 4], \"look_at\": [0, 0.4, 0], \"up\": [0, 1, 0], \"fov\": 45},"
+           "  \"materials\": {\"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": [6, 5, 4]}},"
+           "  \"shapes\": [ {\"file\": \"floor.obj\"}, {\"type\": \"sphere\", \"center\": [0,0.5,0], \"radius\": 0.5},"
+           "                {\"file\": \"lamp.obj\", \"material\": \"lamp\"} ],"
+           "  \"lights\": [ {\"type\": \"point\", \"position\": [-1, 1.2, 1], \"intensity\": [2, 2, 3]} ],"
+           "  \"environment\": {\"type\": \"map\", \"file\": \"%s\"} }\n", env);
+  enum { RUNS = 6 };
+  double m[2][RUNS];
+  for (int k = 0; k < RUNS; k++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.width = 48; o.height = 36; o.spp = 8; o.threads = 2; o.seed = 50 + k;
+    snprintf(o.integrator, sizeof o.integrator, "restir-di");
+    int w, h;
+    float *a = render_json_text(json, &o, &w, &h);
+    snprintf(o.integrator, sizeof o.integrator, "path");
+    o.max_depth = 1; o.seed = 80 + k;
+    float *b = render_json_text(json, &o, &w, &h);
+    CHECK(a && b, "render failed");
+    double sa = 0, sb = 0;
+    for (int i = 0; i < w * h * 3; i++) { sa += a[i]; sb += b[i]; }
+    m[0][k] = sa; m[1][k] = sb;
+    free(a); free(b);
+  }
+  double mean[2], se2[2];
+  for (int j = 0; j < 2; j++) {
+    double s = 0, s2 = 0;
+    for (int k = 0; k < RUNS; k++) { s += m[j][k]; s2 += m[j][k] * m[j][k]; }
+    mean[j] = s / RUNS;
+    se2[j] = (s2 / RUNS - mean[j] * mean[j]) / (RUNS - 1);
+  }
+  double z = (mean[0] - mean[1]) / sqrt(se2[0] + se2[1] + 1e-12 * mean[1] * mean[1]);
+  fprintf(stderr, "environment + point + area light: restir-di %.5g, path direct %.5g (ratio %.4f, z = %.2f)\n", mean[0], mean[1], mean[0] / mean[1], z);
+  CHECK(fabs(z) < 4 && fabs(mean[0] / mean[1] - 1) < 0.02, "restir-di's mean differs: ratio %.4f, z = %.2f", mean[0] / mean[1], z);
+  return 0;
 }
 
 /* ---- the Jacobian */
@@ -407,6 +455,7 @@ int main(int argc, char **argv) {
                                     {"di_unbiased_converges", di_unbiased_converges},
                                     {"di_biased_is_darker", di_biased_is_darker},
                                     {"gi_unbiased_converges", gi_unbiased_converges},
+                                    {"di_environment_and_point_lights", di_environment_and_point_lights},
                                     {"jacobian_solid_angle", jacobian_solid_angle},
                                     {"jacobian_makes_reuse_unbiased", jacobian_makes_reuse_unbiased},
                                     {"keyframes_interpolate", keyframes_interpolate},

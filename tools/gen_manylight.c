@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#define PI 3.14159265358979323846
 static uint64_t st = 0x243f6a8885a308d3ULL;
 static double rnd(void) {
   uint64_t z = (st += 0x9e3779b97f4a7c15ULL);
@@ -68,13 +69,13 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
             c.z < bhi[k].z + edge) inside = 1;
       if (!inside) break;
     }
-    double th = tilt * sqrt(rnd()), ph = 2 * M_PI * rnd();
+    double th = tilt * sqrt(rnd()), ph = 2 * PI * rnd();
     v3 nn = nrm(mk(sin(th) * cos(ph), -cos(th), sin(th) * sin(ph)));
     v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), u = crs(nn, t);
-    double rot = 2 * M_PI * rnd(), r = edge / sqrt(3.0);
+    double rot = 2 * PI * rnd(), r = edge / sqrt(3.0);
     v3 p[3];
     for (int k = 0; k < 3; k++) {
-      double a = rot + 2 * M_PI * k / 3;
+      double a = rot + 2 * PI * k / 3;
       p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
     }
     double R, G, B;

@@ -95,11 +95,8 @@ int restir_wrs_take(float *w_sum, float w, float u) {
 
 /* ---- DI target: unshadowed f * Le * |cos| * g at pixel g for light sample y (in y's
  * measure); p^ is its luminance. */
-float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
-                       light_li *li) {
-  const light *l = &c->s->lights[y->light];
-  float g;
-  if (!light_eval_point(c->s, l, it->p, y->y, li, &g)) return 0;
+/* p^ from a light evaluation li (g: its measure factor). */
+static float di_target_li(const isect *it, const bsdf *b, const frame *fr, vec3 wo, const light_li *li, float g, rgb *contrib) {
   vec3 wi_l = frame_to_local(fr, li->wi), wo_l = frame_to_local(fr, wo);
   int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(li->wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
   if (refl_l != refl_g || v3_dot(li->wi, it->ng) == 0) return 0;
@@ -108,6 +105,13 @@ float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, cons
   *contrib = c3_scale(c3_mul(f, li->L), fabsf(wi_l.z) * g);
   float p = c3_lum(*contrib);
   return p > 0 && isfinite(p) ? p : 0;
+}
+float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
+                       light_li *li) {
+  const light *l = &c->s->lights[y->light];
+  float g;
+  if (!light_eval_point(c->s, l, it->p, y->y, li, &g)) return 0;
+  return di_target_li(it, b, fr, wo, li, g, contrib);
 }
 static float di_target_g(const render_ctx *c, const gpix *g, const di_sample *y, rgb *contrib, light_li *li) {
   return restir_di_target(c, &g->it, &g->b, &g->fr, g->wo, y, contrib, li);
@@ -133,11 +137,11 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
     if (!light_sample(c->s, l, it->p, u1, u2, &ls)) continue;
     di_sample y = {li, l->type == LIGHT_ENV ? ls.wi : ls.p_light};
     rgb contrib;
-    light_li le;
-    float phat = restir_di_target(c, it, b, fr, wo, &y, &contrib, &le);
+    /* y's measure factor (|cos_l| / d^2 for area lights): the target and the source
+     * density pmf * pdf_omega * g in that measure */
+    float g = l->type == LIGHT_AREA ? fabsf(v3_dot(ls.n_light, ls.wi)) / (ls.dist * ls.dist) : 1.0f;
+    float phat = di_target_li(it, b, fr, wo, &ls, g, &contrib);
     if (!(phat > 0)) continue;
-    /* the source density in y's measure: pmf * pdf_omega * (|cos_l| / d^2 for area lights) */
-    float g = l->type == LIGHT_AREA ? fabsf(v3_dot(le.n_light, le.wi)) / (le.dist * le.dist) : 1.0f;
     float pdf = pmf * ls.pdf * g;
     if (!(pdf > 0) || !isfinite(pdf)) continue;
     if (restir_wrs_take(&r->w_sum, phat / pdf, u)) { r->y = y; phat_kept = phat; }
