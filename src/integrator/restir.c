@@ -7,9 +7,9 @@
  *   G-buffer (camera ray through delta lobes to the first surface with a non-delta lobe)
  *   -> candidates (RIS) and their visibility -> temporal reuse (the reprojected pixel of
  *   the previous frame) -> n rounds of spatial reuse (k neighbours) -> shading.
- * Reservoirs follow the digest: {y, w_sum, M}, W = w_sum / (M p^(y)) (biased) or
- * w_sum / (Z p^(y)), Z the candidates of the reservoirs merged whose own target (with
- * visibility) is non-zero at y (unbiased; Bitterli et al. Alg. 6).
+ * Reservoirs follow the digest: {y, w_sum, M} and W = w_sum / (M p^(y)) for the candidates
+ * and the biased reuse; the unbiased reuse weights the merged reservoirs by pairwise MIS
+ * (the digest's Z/M normalisation was built first; it had 1.1-1.9x the error).
  * DI samples are points on lights in the light's own measure (area for triangles, a
  * direction for the environment, the light itself for delta lights), so reuse needs no
  * Jacobian; GI samples are surface points x_s found from x_v in solid angle, so reuse
@@ -264,13 +264,25 @@ typedef struct pw_in {
   float p_here;  /* p_0(y_i): this pixel's target (with visibility) of its sample */
   float p_can;   /* p_i(y_0): its target (with visibility) of the canonical sample */
 } pw_in;
-/* Returns the chosen input (or -1), its resampling weight sum in *w_sum. */
-static int pairwise_select(const pw_in *in, int n, sampler *rng, float *w_sum) {
+/* Resamples one of the inputs: returns the chosen one (or -1) and sets *W, its contribution
+ * weight in the common measure. Unbiased: the pairwise MIS weights above, W = w_sum / p_0(y).
+ * Biased (Bitterli et al.'s 1/M): weights p_0(y_i) W_i M_i, W = w_sum / (sum M p_0(y)); it
+ * needs neither p_own nor p_can. */
+static int reservoir_select(const pw_in *in, int n, int unbiased, sampler *rng, float *W) {
   int k = n - 1, kept = -1;
-  *w_sum = 0;
+  float w_sum = 0;
+  *W = 0;
   float Mt = 0;
   for (int i = 0; i < n; i++) Mt += in[i].M;
   if (!(Mt > 0)) return -1;
+  if (!unbiased) {
+    for (int i = 0; i < n; i++) {
+      float u = rnd(rng);
+      if (in[i].W > 0 && in[i].p_here > 0 && restir_wrs_take(&w_sum, in[i].p_here * in[i].W * in[i].M, u)) kept = i;
+    }
+    if (kept >= 0) *W = w_sum / (Mt * in[kept].p_here);
+    return kept;
+  }
   float Mck = k > 0 ? in[0].M / (float)k : in[0].M;
   for (int i = 0; i < n; i++) {
     float u = rnd(rng);
@@ -287,57 +299,18 @@ static int pairwise_select(const pw_in *in, int n, sampler *rng, float *w_sum) {
       float a = (in[i].M + Mck) / Mt, den = in[i].M * in[i].p_own + Mck * in[i].p_here;
       m = den > 0 ? a * in[i].M * in[i].p_own / den : 0;
     }
-    if (restir_wrs_take(w_sum, m * in[i].p_here * in[i].W, u)) kept = i;
+    if (restir_wrs_take(&w_sum, m * in[i].p_here * in[i].W, u)) kept = i;
   }
+  if (kept >= 0) *W = w_sum / in[kept].p_here;
   return kept;
 }
 
-/* Merges reservoirs in[0..n) (in[0] the pixel's own) into *out at pixel g: each is
- * resampled with weight p^_g(y) V_g(y) W M (M of in[1..] capped by cap_M), M summed. The
- * target includes visibility (Bitterli et al. 2020, sec. 4 and Alg. 6 with V): every
- * reservoir holds a sample its own pixel sees (or W = 0), so in[0]'s needs no test and
- * shading needs no shadow ray. The unbiased normalisation Z counts the M of the inputs
- * whose own pixel (gs[i]) has p^ V > 0 at y. */
-static void di_merge(const render_ctx *c, const restir_cfg *cfg, const gpix *g, const di_res *const *in, const gpix *const *gs, int n,
-                     float cap_M, sampler *rng, thread_stats *ts, di_res *out) {
-  memset(out, 0, sizeof *out);
-  float phat_kept = 0, Msum = 0;
-  int kept = -1;
-  float Ms[72];
-  for (int i = 0; i < n; i++) {
-    const di_res *r = in[i];
-    float M = r->M;
-    if (i > 0 && cap_M > 0 && M > cap_M) M = cap_M;
-    Ms[i] = M;
-    Msum += M;
-    float u = rnd(rng);
-    if (!(r->W > 0)) continue;
-    rgb contrib;
-    light_li li;
-    float phat = di_target_g(c, g, &r->y, &contrib, &li);
-    if (!(phat > 0)) continue;
-    /* the target is p^ V: another pixel's sample counts only if g sees it */
-    if (i > 0 && !di_visible(c, g, &li, ts)) continue;
-    if (restir_wrs_take(&out->w_sum, phat * r->W * M, u)) { out->y = r->y; phat_kept = phat; kept = i; }
-  }
-  out->M = Msum;
-  if (kept < 0) return;
-  float Z = Msum;
-  if (cfg->unbiased) {
-    Z = 0;
-    for (int i = 0; i < n; i++) {
-      if (i == 0 || i == kept) { Z += Ms[i]; continue; } /* g sees its own and the kept sample (tested) */
-      rgb contrib;
-      light_li li;
-      if (di_target_g(c, gs[i], &out->y, &contrib, &li) > 0 && di_visible(c, gs[i], &li, ts)) Z += Ms[i];
-    }
-  }
-  out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
-}
-
-/* Unbiased DI merge (pairwise MIS above); same inputs as di_merge. */
-static void di_merge_pairwise(const render_ctx *c, const gpix *g, const di_res *const *in, const gpix *const *gs, int n, float cap_M,
-                              sampler *rng, thread_stats *ts, di_res *out) {
+/* Merges DI reservoirs in[0..n) (in[0] this pixel's, in[i] from pixel gs[i]; M of in[1..]
+ * capped by cap_M when > 0) into *out at pixel g. The target includes visibility: another
+ * pixel's sample counts only if g sees it (one shadow ray), so every reservoir holds a
+ * sample its own pixel sees (or W = 0) and shading needs no shadow ray. */
+static void di_merge(const render_ctx *c, int unbiased, const gpix *g, const di_res *const *in, const gpix *const *gs, int n, float cap_M,
+                     sampler *rng, thread_stats *ts, di_res *out) {
   memset(out, 0, sizeof *out);
   pw_in pw[72];
   rgb contrib;
@@ -356,21 +329,17 @@ static void di_merge_pairwise(const render_ctx *c, const gpix *g, const di_res *
       continue;
     }
     if (r->W > 0) {
-      p->p_own = di_target_g(c, gs[i], &r->y, &contrib, &li);
       p->p_here = di_target_g(c, g, &r->y, &contrib, &li);
       if (p->p_here > 0 && !di_visible(c, g, &li, ts)) p->p_here = 0;
+      if (unbiased) p->p_own = di_target_g(c, gs[i], &r->y, &contrib, &li);
     }
-    if (can) {
+    if (can && unbiased) {
       p->p_can = di_target_g(c, gs[i], &in[0]->y, &contrib, &li);
       if (p->p_can > 0 && !di_visible(c, gs[i], &li, ts)) p->p_can = 0;
     }
   }
-  float w_sum;
-  int kept = pairwise_select(pw, n, rng, &w_sum);
-  out->w_sum = w_sum;
-  if (kept < 0) return;
-  out->y = in[kept]->y;
-  out->W = w_sum / pw[kept].p_here;
+  int kept = reservoir_select(pw, n, unbiased, rng, &out->W);
+  if (kept >= 0) out->y = in[kept]->y;
 }
 
 static void stage_di_temporal(void *user, int64_t row, int thread) {
@@ -387,8 +356,7 @@ static void stage_di_temporal(void *user, int64_t row, int thread) {
     const gpix *gs[2] = {g, &s->g_prev[q]};
     sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL);
     float cap = (float)(s->dcfg.history * s->dcfg.candidates);
-    if (s->dcfg.unbiased) di_merge_pairwise(j->c, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
-    else di_merge(j->c, &s->dcfg, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
+    di_merge(j->c, s->dcfg.unbiased, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -428,8 +396,7 @@ static void stage_di_spatial(void *user, int64_t row, int thread) {
     const gpix *gs[65];
     in[0] = cur; gs[0] = g;
     for (int i = 0; i < k; i++) { in[i + 1] = &s->di[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    if (s->dcfg.unbiased) di_merge_pairwise(j->c, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
-    else di_merge(j->c, &s->dcfg, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    di_merge(j->c, s->dcfg.unbiased, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -514,46 +481,6 @@ static void stage_gi_initial(void *user, int64_t row, int thread) {
   }
 }
 
-/* GI merge: like di_merge, each reused reservoir's W carried into this pixel's solid
- * angle by the Jacobian from its pixel (xs_from) to this one. */
-static void gi_merge(const render_ctx *c, const restir_cfg *cfg, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs,
-                     int n, float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
-  memset(out, 0, sizeof *out);
-  float phat_kept = 0, Msum = 0;
-  int kept = -1;
-  float Ms[72];
-  for (int i = 0; i < n; i++) {
-    const gi_res *r = in[i];
-    float M = r->M;
-    if (i > 0 && cap_M > 0 && M > cap_M) M = cap_M;
-    Ms[i] = M;
-    Msum += M;
-    float u = rnd(rng);
-    if (!(r->W > 0)) continue;
-    rgb contrib;
-    vec3 wi;
-    float phat = gi_target(g, r, &contrib, &wi);
-    if (!(phat > 0)) continue;
-    float J = i == 0 || !use_jacobian ? 1.0f : restir_gi_jacobian(gs[i]->it.p, g->it.p, r->xs, r->ns);
-    if (!(J > 0)) continue;
-    if (i > 0 && !gi_visible(c, g, r, ts)) continue;
-    if (restir_wrs_take(&out->w_sum, phat * r->W * J * M, u)) { out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo; phat_kept = phat; kept = i; }
-  }
-  out->M = Msum;
-  if (kept < 0) return;
-  float Z = Msum;
-  if (cfg->unbiased) {
-    Z = 0;
-    for (int i = 0; i < n; i++) {
-      if (i == 0 || i == kept) { Z += Ms[i]; continue; }
-      rgb contrib;
-      vec3 wi;
-      if (gi_target(gs[i], out, &contrib, &wi) > 0 && gi_visible(c, gs[i], out, ts)) Z += Ms[i];
-    }
-  }
-  out->W = Z > 0 ? out->w_sum / (Z * phat_kept) : 0;
-}
-
 /* Area-measure factor at pixel g for GI sample point xs: |cos phi_g| / |x_g - xs|^2 (1
  * when the Jacobian is switched off, to show what leaving it out does). */
 static float gi_area(const gpix *g, const gi_res *r, int use_jacobian) {
@@ -564,10 +491,12 @@ static float gi_area(const gpix *g, const gi_res *r, int use_jacobian) {
   float f = fabsf(v3_dot(r->ns, d)) / (d2 * sqrtf(d2));
   return isfinite(f) ? f : 0;
 }
-/* Unbiased GI merge (pairwise MIS), in the area measure at the sample points: a target
- * p^_omega times gi_area, W divided by the owner's gi_area (the Jacobian of the shift). */
-static void gi_merge_pairwise(const render_ctx *c, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs, int n,
-                              float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
+/* Merges GI reservoirs as di_merge does, in the area measure at the sample points: a
+ * target p^_omega times gi_area, a W divided by its owner's gi_area, so a reused W carries
+ * the Jacobian of the shift (restir_gi_jacobian); g traces a visibility ray to each reused
+ * sample point. */
+static void gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs, int n,
+                     float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
   memset(out, 0, sizeof *out);
   pw_in pw[72];
   rgb contrib;
@@ -587,23 +516,21 @@ static void gi_merge_pairwise(const render_ctx *c, int use_jacobian, const gpix 
       continue;
     }
     if (p->W > 0) {
-      p->p_own = gi_target(gs[i], r, &contrib, &wi) * a_own;
       p->p_here = gi_target(g, r, &contrib, &wi) * gi_area(g, r, use_jacobian);
       if (p->p_here > 0 && !gi_visible(c, g, r, ts)) p->p_here = 0;
+      if (unbiased) p->p_own = gi_target(gs[i], r, &contrib, &wi) * a_own;
     }
-    if (can) {
+    if (can && unbiased) {
       p->p_can = gi_target(gs[i], in[0], &contrib, &wi) * gi_area(gs[i], in[0], use_jacobian);
       if (p->p_can > 0 && !gi_visible(c, gs[i], in[0], ts)) p->p_can = 0;
     }
   }
-  float w_sum;
-  int kept = pairwise_select(pw, n, rng, &w_sum);
-  out->w_sum = w_sum;
+  float W;
+  int kept = reservoir_select(pw, n, unbiased, rng, &W);
   if (kept < 0) return;
   const gi_res *r = in[kept];
   out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo;
-  /* W in this pixel's solid angle: w_sum / p^_area(y) * area factor = w_sum / p^_omega(y) */
-  out->W = w_sum / pw[kept].p_here * gi_area(g, r, use_jacobian);
+  out->W = W * gi_area(g, r, use_jacobian); /* from the area measure to this pixel's solid angle */
 }
 
 static void stage_gi_temporal(void *user, int64_t row, int thread) {
@@ -619,8 +546,7 @@ static void stage_gi_temporal(void *user, int64_t row, int thread) {
     const gi_res *in[2] = {cur, &s->gr_prev[q]};
     const gpix *gs[2] = {g, &s->g_prev[q]};
     sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7);
-    if (s->gcfg.unbiased) gi_merge_pairwise(j->c, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
-    else gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
+    gi_merge(j->c, s->gcfg.unbiased, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
   }
 }
 
@@ -641,8 +567,7 @@ static void stage_gi_spatial(void *user, int64_t row, int thread) {
     const gpix *gs[65];
     in[0] = cur; gs[0] = g;
     for (int i = 0; i < k; i++) { in[i + 1] = &s->gr[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    if (s->gcfg.unbiased) gi_merge_pairwise(j->c, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
-    else gi_merge(j->c, &s->gcfg, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    gi_merge(j->c, s->gcfg.unbiased, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
   }
 }
 

@@ -8,8 +8,9 @@
 /* A DI sample: light index and a point on it (area: on the triangle; environment: a
  * direction; delta lights: unused). */
 typedef struct di_sample { uint32_t light; vec3 y; } di_sample;
-/* Reservoir: the kept sample, the sum of resampling weights, the candidate count M and
- * the unbiased contribution weight W (an estimate of 1 / pdf(y)). */
+/* Reservoir: the kept sample, the sum of resampling weights (of the candidates; merges
+ * keep only W), the candidate count M and the contribution weight W (an estimate of
+ * 1 / pdf(y)). */
 typedef struct di_res { di_sample y; float w_sum, M, W; } di_res;
 /* A GI sample: the sample point x_s, its normal n_s (facing the pixel that found it) and
  * the radiance L^ it sends towards that pixel. */
