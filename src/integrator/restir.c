@@ -342,24 +342,6 @@ static void di_merge(const render_ctx *c, int unbiased, const gpix *g, const di_
   if (kept >= 0) out->y = in[kept]->y;
 }
 
-static void stage_di_temporal(void *user, int64_t row, int thread) {
-  stage_job *j = user;
-  restir_state *s = j->s;
-  for (int x = 0; x < s->width; x++) {
-    size_t pix = (size_t)row * s->width + x;
-    const gpix *g = &s->g[pix];
-    const di_res *cur = &s->di[j->src][pix];
-    di_res *out = &s->di[j->dst][pix];
-    int64_t q = reproject(s, &s->dcfg, j->f, g);
-    if (q < 0) { *out = *cur; continue; }
-    const di_res *in[2] = {cur, &s->di_prev[q]};
-    const gpix *gs[2] = {g, &s->g_prev[q]};
-    sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL);
-    float cap = (float)(s->dcfg.history * s->dcfg.candidates);
-    di_merge(j->c, s->dcfg.unbiased, g, in, gs, 2, cap, &rng, &j->f->ts[thread], out);
-  }
-}
-
 /* k distinct-ish neighbours of (x, y) in a disc of radius R, similar to g; returns how
  * many were found (indices in nb). */
 static int neighbours(const restir_state *s, const restir_cfg *cfg, int x, int y, const gpix *g, sampler *rng, size_t *nb) {
@@ -376,28 +358,6 @@ static int neighbours(const restir_state *s, const restir_cfg *cfg, int x, int y
     nb[n++] = q;
   }
   return n;
-}
-
-typedef struct spatial_job { stage_job j; int round; } spatial_job;
-static void stage_di_spatial(void *user, int64_t row, int thread) {
-  spatial_job *sj = user;
-  stage_job *j = &sj->j;
-  restir_state *s = j->s;
-  for (int x = 0; x < s->width; x++) {
-    size_t pix = (size_t)row * s->width + x;
-    const gpix *g = &s->g[pix];
-    di_res *out = &s->di[j->dst][pix];
-    const di_res *cur = &s->di[j->src][pix];
-    if (!g->valid) { *out = *cur; continue; }
-    sampler rng = pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)sj->round);
-    size_t nb[64];
-    int k = neighbours(s, &s->dcfg, x, (int)row, g, &rng, nb);
-    const di_res *in[65];
-    const gpix *gs[65];
-    in[0] = cur; gs[0] = g;
-    for (int i = 0; i < k; i++) { in[i + 1] = &s->di[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    di_merge(j->c, s->dcfg.unbiased, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
-  }
 }
 
 /* Direct light of pixel g from its final reservoir: f Le |cos| g W (the sample is visible:
@@ -533,41 +493,47 @@ static void gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const 
   out->W = W * gi_area(g, r, use_jacobian); /* from the area measure to this pixel's solid angle */
 }
 
-static void stage_gi_temporal(void *user, int64_t row, int thread) {
-  stage_job *j = user;
+/* A reuse pass over the DI (gi = 0) or GI reservoirs: temporal (round < 0: each pixel
+ * merges its reservoir with the history at its reprojected pixel, M of the history capped)
+ * or spatial round `round` (with k similar neighbours). Reads buffer src and the history,
+ * writes dst. */
+typedef struct reuse_job { stage_job j; int gi, round; } reuse_job;
+static void stage_reuse(void *user, int64_t row, int thread) {
+  reuse_job *rj = user;
+  stage_job *j = &rj->j;
   restir_state *s = j->s;
+  const restir_cfg *cfg = rj->gi ? &s->gcfg : &s->dcfg;
+  int temporal = rj->round < 0;
   for (int x = 0; x < s->width; x++) {
-    size_t pix = (size_t)row * s->width + x;
-    const gpix *g = &s->g[pix];
-    const gi_res *cur = &s->gr[j->src][pix];
-    gi_res *out = &s->gr[j->dst][pix];
-    int64_t q = reproject(s, &s->gcfg, j->f, g);
-    if (q < 0) { *out = *cur; continue; }
-    const gi_res *in[2] = {cur, &s->gr_prev[q]};
-    const gpix *gs[2] = {g, &s->g_prev[q]};
-    sampler rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7);
-    gi_merge(j->c, s->gcfg.unbiased, s->gcfg.jacobian, g, in, gs, 2, (float)s->gcfg.history, &rng, &j->f->ts[thread], out);
-  }
-}
-
-static void stage_gi_spatial(void *user, int64_t row, int thread) {
-  spatial_job *sj = user;
-  stage_job *j = &sj->j;
-  restir_state *s = j->s;
-  for (int x = 0; x < s->width; x++) {
-    size_t pix = (size_t)row * s->width + x;
-    const gpix *g = &s->g[pix];
-    gi_res *out = &s->gr[j->dst][pix];
-    const gi_res *cur = &s->gr[j->src][pix];
-    if (!g->valid) { *out = *cur; continue; }
-    sampler rng = pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)sj->round + 7);
-    size_t nb[64];
-    int k = neighbours(s, &s->gcfg, x, (int)row, g, &rng, nb);
-    const gi_res *in[65];
-    const gpix *gs[65];
-    in[0] = cur; gs[0] = g;
-    for (int i = 0; i < k; i++) { in[i + 1] = &s->gr[j->src][nb[i]]; gs[i + 1] = &s->g[nb[i]]; }
-    gi_merge(j->c, s->gcfg.unbiased, s->gcfg.jacobian, g, in, gs, k + 1, 0, &rng, &j->f->ts[thread], out);
+    size_t pix = (size_t)row * s->width + x, from[65];
+    const gpix *g = &s->g[pix], *gs[65];
+    int n = 1;
+    float cap = 0;
+    sampler rng;
+    if (temporal) {
+      rng = pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7 * (uint32_t)rj->gi);
+      int64_t q = reproject(s, cfg, j->f, g);
+      if (q >= 0) { from[1] = (size_t)q; gs[1] = &s->g_prev[q]; n = 2; }
+      cap = rj->gi ? cfg->history : cfg->history * (float)cfg->candidates;
+    } else if (g->valid) {
+      rng = pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)rj->round + 7 * (uint32_t)rj->gi);
+      n += neighbours(s, cfg, x, (int)row, g, &rng, from + 1);
+      for (int i = 1; i < n; i++) gs[i] = &s->g[from[i]];
+    }
+    gs[0] = g;
+    if (rj->gi) {
+      const gi_res *in[65];
+      in[0] = &s->gr[j->src][pix];
+      for (int i = 1; i < n; i++) in[i] = temporal ? &s->gr_prev[from[i]] : &s->gr[j->src][from[i]];
+      if (n == 1) s->gr[j->dst][pix] = *in[0];
+      else gi_merge(j->c, cfg->unbiased, cfg->jacobian, g, in, gs, n, cap, &rng, &j->f->ts[thread], &s->gr[j->dst][pix]);
+    } else {
+      const di_res *in[65];
+      in[0] = &s->di[j->src][pix];
+      for (int i = 1; i < n; i++) in[i] = temporal ? &s->di_prev[from[i]] : &s->di[j->src][from[i]];
+      if (n == 1) s->di[j->dst][pix] = *in[0];
+      else di_merge(j->c, cfg->unbiased, g, in, gs, n, cap, &rng, &j->f->ts[thread], &s->di[j->dst][pix]);
+    }
   }
 }
 
@@ -619,29 +585,19 @@ static valo_status restir_frame(void *state, const render_ctx *c, const frame_ct
   stage_job j = {s, c, f, 0, 0};
 #define STAGE(fn, job) do { if (run_stage(c, f, fn, job)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled"); } while (0)
   STAGE(stage_gbuffer, &j);
-  if (!s->gi || s->direct_restir) {
-    j.dst = 0;
-    STAGE(stage_di_initial, &j);
-    int cur = 0;
-    if (temporal_on(s->dcfg.temporal, f)) { j.src = cur; j.dst = 1 - cur; STAGE(stage_di_temporal, &j); cur = 1 - cur; }
-    for (int it = 0; it < s->dcfg.iterations && s->dcfg.spatial > 0; it++) {
-      spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
-      STAGE(stage_di_spatial, &sj);
-      cur = 1 - cur;
-    }
-    s->di_final = cur;
-  }
-  if (s->gi) {
+  for (int gi = 0; gi < 2; gi++) {
+    if (gi ? !s->gi : (s->gi && !s->direct_restir)) continue;
+    const restir_cfg *cfg = gi ? &s->gcfg : &s->dcfg;
     j.src = 0; j.dst = 0;
-    STAGE(stage_gi_initial, &j);
+    STAGE(gi ? stage_gi_initial : stage_di_initial, &j);
     int cur = 0;
-    if (temporal_on(s->gcfg.temporal, f)) { j.src = cur; j.dst = 1 - cur; STAGE(stage_gi_temporal, &j); cur = 1 - cur; }
-    for (int it = 0; it < s->gcfg.iterations && s->gcfg.spatial > 0; it++) {
-      spatial_job sj = {{s, c, f, cur, 1 - cur}, it};
-      STAGE(stage_gi_spatial, &sj);
+    for (int round = temporal_on(cfg->temporal, f) ? -1 : 0; round < (cfg->spatial > 0 ? cfg->iterations : 0); round++) {
+      reuse_job rj = {{s, c, f, cur, 1 - cur}, gi, round};
+      STAGE(stage_reuse, &rj);
       cur = 1 - cur;
     }
-    s->gi_final = cur;
+    if (gi) s->gi_final = cur;
+    else s->di_final = cur;
   }
   STAGE(stage_shade, &j);
 #undef STAGE
