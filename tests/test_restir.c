@@ -53,23 +53,24 @@ static float *render_room(const char *integ, const char *params, int spp, int th
   return render_room_depth(integ, params, spp, threads, seed, -1);
 }
 
-/* Pixels that see no lamp, nor do their neighbours (from the emission-only image). */
+/* Does pixel (x, y) or a neighbour see a lamp in the emission-only image em? */
+static int near_lamp(const float *em, int x, int y) {
+  for (int dy = -1; dy <= 1; dy++)
+    for (int dx = -1; dx <= 1; dx++) {
+      int xx = x + dx, yy = y + dy;
+      if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+      const float *p = &em[3 * (yy * W + xx)];
+      if (p[0] + p[1] + p[2] > 0) return 1;
+    }
+  return 0;
+}
+/* Pixels that see no lamp, nor do their neighbours. */
 static unsigned char *lamp_free_mask(void) {
   float *em = render_room_depth("path", NULL, 1024, 2, 1, 0); /* emission seen directly: every pixel a lamp touches */
   if (!em) return NULL;
   unsigned char *ok = malloc(W * H);
   for (int y = 0; y < H; y++)
-    for (int x = 0; x < W; x++) {
-      int bad = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int xx = x + dx, yy = y + dy;
-          if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-          const float *p = &em[3 * (yy * W + xx)];
-          if (p[0] + p[1] + p[2] > 0) bad = 1;
-        }
-      ok[y * W + x] = !bad;
-    }
+    for (int x = 0; x < W; x++) ok[y * W + x] = !near_lamp(em, x, y);
   free(em);
   return ok;
 }
@@ -371,15 +372,7 @@ static double frames_relmse(const frame_log *a, const frame_log *ref, const fram
   for (int k = 0; k < 4; k++)
     for (int y = 0; y < H; y++)
       for (int x = 0; x < W; x++) {
-        int lamp = 0;
-        for (int dy = -1; dy <= 1; dy++)
-          for (int dx = -1; dx <= 1; dx++) {
-            int xx = x + dx, yy = y + dy;
-            if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-            const float *p = &em->frames[k][3 * (yy * W + xx)];
-            if (p[0] + p[1] + p[2] > 0) lamp = 1;
-          }
-        if (lamp) continue;
+        if (near_lamp(em->frames[k], x, y)) continue;
         for (int c = 0; c < 3; c++) {
           size_t i = 3 * ((size_t)y * W + x) + c;
           double d = a->frames[k][i] - ref->frames[k][i];
