@@ -241,7 +241,7 @@ int main(int argc, char **argv) {
       {"room (scenes/manylight.json, 1 024 lamps)", VALO_SOURCE_DIR "/scenes/manylight.json", VALO_SOURCE_DIR "/bench/references/manylight-room-direct.exr",
        VALO_SOURCE_DIR "/bench/references/manylight-room-path.exr", 160, 120},
       {"Sponza with 1 200 lamps (bench/sponza-lamps.json)", VALO_SOURCE_DIR "/bench/sponza-lamps.json",
-       VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", NULL, 320, 180}};
+       VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", VALO_SOURCE_DIR "/bench/references/sponza-lamps-path.exr", 320, 180}};
   for (int s = 0; s < 2; s++) {
     if (only && strcmp(only, s ? "sponza" : "room")) continue;
     if (bench_scene(&scenes[s], quick, seconds)) return 1;
