@@ -34,7 +34,7 @@ enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIA
   {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
   {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"}, \
   {"iterations", IPARAM_INT, 2, 0, 8, "n: rounds of spatial reuse"},                                                                   \
-  {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased, darker at contact)"},         \
+  {"unbiased", IPARAM_INT, 1, 0, 1, "1: pairwise MIS with visibility (unbiased); 0: 1/M (biased, darker)"},                        \
   {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"}, \
   {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"}
 static const integrator_param di_params[] = {DI_PARAMS_COMMON, {NULL, IPARAM_INT, 0, 0, 0, NULL}};
@@ -45,10 +45,10 @@ static const integrator_param gi_params[] = {
     {"spatial", IPARAM_INT, 3, 0, 64, "k: neighbours merged per spatial round"},
     {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"},
     {"iterations", IPARAM_INT, 1, 0, 8, "n: rounds of spatial reuse"},
-    {"unbiased", IPARAM_INT, 1, 0, 1, "1: the Z normalisation with visibility (unbiased); 0: 1/M (biased)"},
+    {"unbiased", IPARAM_INT, 1, 0, 1, "1: pairwise MIS with visibility (unbiased); 0: 1/M (biased)"},
     {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"},
     {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"},
-    {"direct", IPARAM_INT, 1, 0, 1, "direct light at the camera hit: 1 restir-di (its defaults), 0 plain next-event estimation"},
+    {"direct", IPARAM_INT, 1, 0, 1, "direct light at the camera hit: 1 restir-di (direct_spatial, direct_iterations), 0 plain next-event estimation"},
     {"jacobian", IPARAM_INT, 1, 0, 1, "1: reused samples carry the solid-angle Jacobian (0 only to show the bias without it)"},
     {"direct_spatial", IPARAM_INT, 3, 0, 64, "direct=1: k of the direct-light reservoirs' spatial rounds"},
     {"direct_iterations", IPARAM_INT, 1, 0, 8, "direct=1: n, rounds of spatial reuse of the direct-light reservoirs"},
