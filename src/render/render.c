@@ -396,24 +396,29 @@ typedef struct pass_job {
   thread_stats *ts;    /* one per thread */
 } pass_job;
 
+/* Adds one sample's radiance to pixel pix of the film: NaN, infinite and negative ones
+ * count as taken but are dropped (counted in ts). */
+static void film_add(valo_render *r, size_t pix, rgb L, thread_stats *ts) {
+  r->count[pix]++;
+  if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; return; }
+  double *acc = &r->sum[3 * pix];
+  acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
+  if (r->lum) {
+    double l = c3_lum(L);
+    r->lum[2 * pix] += l;
+    r->lum[2 * pix + 1] += l * l;
+  }
+}
+
 /* Takes samples [s0, s1) of pixel (x, y) in order. */
 static void sample_pixel(valo_render *r, int x, int y, int s0, int s1, thread_stats *ts) {
   uint64_t pix = (uint64_t)y * (uint64_t)r->opt.width + (uint64_t)x;
-  double *acc = &r->sum[3 * pix];
   for (int si = s0; si < s1; si++) {
     sampler smp = sampler_make_kind((uint64_t)r->opt.seed, pix, (uint64_t)si, r->sampler_kind);
     ray ry = camera_ray(r, x, y, &smp);
     ts->rays++;
     if (r->aov) record_aovs(r, ry, &r->aov[AOV_FLOATS * pix], &smp, ts);
-    rgb L = r->integ->li(&r->ctx, ry, &smp, ts);
-    r->count[pix]++;
-    if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; continue; }
-    acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
-    if (r->lum) {
-      double l = c3_lum(L);
-      r->lum[2 * pix] += l;
-      r->lum[2 * pix + 1] += l * l;
-    }
+    film_add(r, pix, r->integ->li(&r->ctx, ry, &smp, ts), ts);
   }
 }
 
@@ -507,12 +512,7 @@ static valo_status image_frame(valo_render *r, thread_stats *ts, valo_error *err
   r->image_frames++;
   r->view_prev = r->view;
   size_t np = (size_t)r->opt.width * r->opt.height;
-  for (size_t i = 0; i < np; i++) {
-    rgb L = c3(r->frame_rgb[3 * i], r->frame_rgb[3 * i + 1], r->frame_rgb[3 * i + 2]);
-    r->count[i]++;
-    if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts[0].bad_samples++; continue; }
-    r->sum[3 * i] += L.r; r->sum[3 * i + 1] += L.g; r->sum[3 * i + 2] += L.b;
-  }
+  for (size_t i = 0; i < np; i++) film_add(r, i, c3(r->frame_rgb[3 * i], r->frame_rgb[3 * i + 1], r->frame_rgb[3 * i + 2]), &ts[0]);
   return VALO_OK;
 }
 
@@ -575,22 +575,23 @@ static valo_status run_sequence(valo_render *r, valo_progress_fn progress, void 
 
 VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user) { r->on_frame = fn; r->on_frame_user = user; }
 
+/* The end of valo_render_run: time and per-thread counters into the render's totals, and
+ * a warning when samples were dropped. Frees ts; returns st. */
+static valo_status run_finish(valo_render *r, thread_stats *ts, double t0, valo_status st) {
+  r->render_seconds += now_seconds() - t0;
+  for (int t = 0; t < r->opt.threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
+  free(ts);
+  if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
+  return st;
+}
+
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
   if (err) { err->status = VALO_OK; err->message[0] = 0; }
   int threads = r->opt.threads;
   thread_stats *ts = calloc((size_t)threads, sizeof *ts);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  if (r->opt.frames > 0) {
-    double t0 = now_seconds();
-    valo_status sst = run_sequence(r, progress, user, ts, err);
-    r->render_seconds += now_seconds() - t0;
-    for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
-    free(ts);
-    if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
-    return sst;
-  }
-  int tiles_x = (r->opt.width + TILE - 1) / TILE, tiles_y = (r->opt.height + TILE - 1) / TILE;
   double t0 = now_seconds();
+  if (r->opt.frames > 0) return run_finish(r, ts, t0, run_sequence(r, progress, user, ts, err));
   double budget = r->opt.time_budget > 0 ? r->opt.time_budget : 0;
   int pass_spp = 1;
   valo_status st = VALO_OK;
@@ -603,22 +604,12 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
   while (r->spp_done < uniform_spp) {
     int n = pass_spp;
     if (r->spp_done + n > uniform_spp) n = uniform_spp - r->spp_done;
-    if (r->integ->prepare) {
-      /* one sample index per pass: its light paths are shot first */
-      n = 1;
-      valo_status pst = r->integ->prepare(r->istate, &r->ctx, r->spp_done, err);
-      if (pst) { st = pst; break; }
-    }
+    /* One sample index per pass for integrators with prepare (its light paths are shot
+     * first) and for image-wide ones (a still is frames on the static camera, averaged). */
+    if (r->integ->prepare || r->integ->render_frame) n = 1;
     double p0 = now_seconds();
-    if (r->integ->render_frame) {
-      /* a still image from an image-wide integrator: frames on the static camera, averaged */
-      n = 1;
-      valo_status fst = image_frame(r, ts, err);
-      if (fst && fst != VALO_ERR_CANCELLED) { st = fst; break; }
-    } else {
-      pass_job job = {r, r->spp_done, r->spp_done + n, tiles_x, ts};
-      parallel_for(threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
-    }
+    valo_status pst = r->integ->render_frame ? image_frame(r, ts, err) : tile_samples(r, r->spp_done, r->spp_done + n, ts, err);
+    if (pst && pst != VALO_ERR_CANCELLED) { st = pst; break; }
     double pt = now_seconds() - p0;
     if (atomic_load(&r->cancel)) {
       /* A cancelled pass stops between tiles: every tile holds whole samples (a tile
@@ -694,11 +685,7 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     free(pr);
     free(raw);
   }
-  r->render_seconds += now_seconds() - t0;
-  for (int t = 0; t < threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
-  free(ts);
-  if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
-  return st;
+  return run_finish(r, ts, t0, st);
 }
 
 VALO_API void valo_render_cancel(valo_render *r) { atomic_store(&r->cancel, 1); }
