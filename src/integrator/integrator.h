@@ -203,6 +203,15 @@ int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, 
 typedef rgb (*surface_shade_fn)(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
                                 thread_stats *ts);
 rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, surface_shade_fn shade);
+/* The two steps of such a camera path (li_shade_through_delta, restir's G-buffer). One
+ * vertex: traces r and adds beta x the emission found to *L (fully: no MIS along a delta
+ * chain); at a surface with depth < max_depth fills it, its BSDF, the shading frame and
+ * wo and returns 1. Continuing: samples a lobe (the sampler's current dimension); returns
+ * 1 with *r and *beta updated when a delta lobe was taken and beta is still finite and
+ * non-black, 0 to end the chain. */
+int delta_chain_vertex(const render_ctx *c, const ray *r, rgb beta, int depth, int max_depth, thread_stats *ts, rgb *L, isect *it, bsdf *b,
+                       frame *fr, vec3 *wo);
+int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, rgb *beta, ray *r);
 /* Russian roulette (pbrt-v4) after depth 2: survive with probability
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */

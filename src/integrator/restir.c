@@ -124,7 +124,7 @@ static int di_visible(const render_ctx *c, const gpix *g, const light_li *li, th
 }
 
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
-                         sampler *rng, di_res *r) {
+                         sampler *rng, di_res *r, light_li *kept) {
   memset(r, 0, sizeof *r);
   float phat_kept = 0;
   for (int i = 0; i < M; i++) {
@@ -147,7 +147,11 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
     if (!(phat > 0)) continue;
     float pdf = pmf * ls.pdf * g;
     if (!(pdf > 0) || !isfinite(pdf)) continue;
-    if (restir_wrs_take(&r->w_sum, phat / pdf, u)) { r->y = y; phat_kept = phat; }
+    if (restir_wrs_take(&r->w_sum, phat / pdf, u)) {
+      r->y = y;
+      phat_kept = phat;
+      if (kept) *kept = ls;
+    }
   }
   r->M = (float)M;
   r->W = phat_kept > 0 ? r->w_sum / (r->M * phat_kept) : 0;
@@ -168,26 +172,17 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
   int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
   for (int depth = 0;; depth++) {
     isect it;
-    rgb Le;
-    float w;
-    path_state st0 = path_state_start(r.o);
-    int surface = path_trace_vertex(c, &r, &st0, ts, &it, &Le, &w);
-    L = c3_add(L, c3_mul(beta, Le));
-    if (!surface || depth >= max_depth) break;
-    vec3 wo = v3_neg(r.d);
+    bsdf b;
+    frame fr;
+    vec3 wo;
+    if (!delta_chain_vertex(c, &r, beta, depth, max_depth, ts, &L, &it, &b, &fr, &wo)) break;
     if (depth == 0) g->depth = v3_len(v3_sub(it.p, f->cam.o));
-    bsdf b = bsdf_at(c->s, &it);
-    frame fr = shading_frame(&it, &b, wo);
     if (bsdf_has_smooth(&b)) {
       g->it = it; g->fr = fr; g->b = b; g->wo = wo; g->beta = beta; g->valid = 1; g->chain = depth > 0;
       break;
     }
     sampler_set_dim(&smp, RD_DELTA + depth);
-    path_state st = path_state_start(r.o);
-    rgb wgt;
-    if (!path_continue(&it, &b, &fr, wo, &smp, &st, &wgt, &r) || !st.specular) break;
-    beta = c3_mul(beta, wgt);
-    if (c3_black(beta) || !c3_finite(beta) || depth >= 16) break;
+    if (!delta_chain_continue(&it, &b, &fr, wo, &smp, &beta, &r) || depth >= 16) break;
   }
   g->Le = L;
 }
@@ -224,12 +219,10 @@ static void stage_di_initial(void *user, int64_t row, int thread) {
     sampler smp = sampler_make_kind(j->c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)j->c->sampler_kind);
     sampler_set_dim(&smp, RD_CAND);
     sampler rng = pixel_stream(j->c, j->f, pix, RD_CAND);
-    if (restir_di_candidates(j->c, &g->it, &g->b, &g->fr, g->wo, s->dcfg.candidates, &smp, &rng, r)) {
-      /* visibility reuse: a shadowed survivor passes nothing on */
-      rgb contrib;
-      light_li li;
-      if (!(di_target_g(j->c, g, &r->y, &contrib, &li) > 0) || !di_visible(j->c, g, &li, &j->f->ts[thread])) r->W = 0;
-    }
+    light_li li;
+    /* visibility reuse: a shadowed survivor passes nothing on */
+    if (restir_di_candidates(j->c, &g->it, &g->b, &g->fr, g->wo, s->dcfg.candidates, &smp, &rng, r, &li) && !di_visible(j->c, g, &li, &j->f->ts[thread]))
+      r->W = 0;
   }
 }
 

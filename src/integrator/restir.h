@@ -29,10 +29,11 @@ typedef struct restir_cfg {
 /* RIS at a surface point: M candidates from the power-proportional light selection and
  * light sampling (stream smp, child j of M for candidate j), kept by streaming weighted
  * reservoir sampling (uniform numbers from rng), target p^ = luminance of the unshadowed
- * f Le |cos| g. Fills *r (W = w_sum / (M p^(y)), no visibility); returns 1 when a sample
- * was kept. */
+ * f Le |cos| g. Fills *r (W = w_sum / (M p^(y)), no visibility) and, when a sample was
+ * kept, *kept (if not NULL) with its light evaluation (for the shadow ray); returns 1
+ * when a sample was kept. */
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
-                         sampler *rng, di_res *r);
+                         sampler *rng, di_res *r, light_li *kept);
 /* p^ of DI sample y at a surface point, with the unshadowed contribution in *contrib and
  * the light's evaluation in *li (for the shadow ray). */
 float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,
