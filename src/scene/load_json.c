@@ -126,6 +126,16 @@ static valo_status get_bool(jctx *c, const cJSON *o, const char *key, const char
 
 #define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
+/* A view is usable: position and look_at differ, up is not along the view direction. */
+static valo_status check_view(jctx *c, const char *where, vec3 pos, vec3 look_at, vec3 up) {
+  vec3 fwd = v3_sub(look_at, pos);
+  if (!(v3_len2(fwd) > 0)) return bad(c, where, "position and look_at must differ");
+  char w[96];
+  snprintf(w, sizeof w, "%s.up", where);
+  if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(up))) > 1e-12f)) return bad(c, w, "must not be parallel to the view direction");
+  return VALO_OK;
+}
+
 /* camera.keyframes: [{"frame": F, "position", "look_at", "up", "fov"}, ...], frames
  * increasing; a key's missing fields take the camera's. */
 static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
@@ -152,9 +162,7 @@ static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
     TRY(get_vec(c, e, "look_at", where, 0, &k[i].look_at));
     TRY(get_vec(c, e, "up", where, 0, &k[i].up));
     d = k[i].fov_deg; TRY(get_num(c, e, "fov", where, 1e-3, 179.9, &d)); k[i].fov_deg = (float)d;
-    vec3 fwd = v3_sub(k[i].look_at, k[i].pos);
-    if (!(v3_len2(fwd) > 0)) return bad(c, where, "position and look_at must differ");
-    if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(k[i].up))) > 1e-12f)) return bad(c, where, "up must not be parallel to the view direction");
+    TRY(check_view(c, where, k[i].pos, k[i].look_at, k[i].up));
   }
   return VALO_OK;
 }
@@ -187,9 +195,8 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
   d = cam->fov_deg; TRY(get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); cam->fov_deg = (float)d;
   d = 0; TRY(get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); cam->aperture_radius = (float)d;
   d = -1; TRY(get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); cam->focus_distance = (float)d;
+  TRY(check_view(c, "camera", cam->pos, cam->look_at, cam->up));
   vec3 fwd = v3_sub(cam->look_at, cam->pos);
-  if (!(v3_len2(fwd) > 0)) return bad(c, "camera", "position and look_at must differ");
-  if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(cam->up))) > 1e-12f)) return bad(c, "camera.up", "must not be parallel to the view direction");
   if (cam->focus_distance <= 0) cam->focus_distance = v3_len(fwd);
   c->s->has_camera = 1;
   const cJSON *kf = cJSON_GetObjectItemCaseSensitive(o, "keyframes");
