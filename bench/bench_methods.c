@@ -12,6 +12,7 @@
  *     relMSE at each budget.
  * Usage: bench_methods [--quick] [--only ao|photon|manylight] */
 #include "valo/valo.h"
+#include "bench_util.h"
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/pointtree.h"
@@ -31,11 +32,6 @@
 #define VALO_SOURCE_DIR "."
 #endif
 
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static const char *shared(void) { const char *r = getenv("VALO_SHARED"); return r && *r ? r : VALO_SHARED_DIR; }
 
@@ -55,11 +51,11 @@ static float *render_budget(const char *path, const char *integ, int spp, double
   o.threads = 2;
   o.seed = 5;
   valo_render *r;
-  double t0 = now();
+  double t0 = bench_now();
   if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
   valo_stats st;
   valo_render_stats(r, &st);
-  *secs = now() - t0 - st.build_seconds; /* the ray-tracing structure is common to all */
+  *secs = bench_now() - t0 - st.build_seconds; /* the ray-tracing structure is common to all */
   float *px = malloc((size_t)w * h * 3 * sizeof *px);
   valo_render_pixels(r, px);
   valo_render_destroy(r);
@@ -97,13 +93,13 @@ static void breakdown(const char *json_path, int w, int h, double *t_splat, doub
   if (load_json(s, json_path, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return; }
   float r = 0.1f * s->radius, d = r / 6;
   splat_points sp;
-  double t0 = now();
+  double t0 = bench_now();
   splat_scene(s, d, 50000000, 2, &sp);
-  *t_splat = now() - t0;
+  *t_splat = bench_now() - t0;
   point_tree t;
-  t0 = now();
+  t0 = bench_now();
   point_tree_build(&t, sp.p, sp.n_pts);
-  *t_build = now() - t0;
+  *t_build = bench_now() - t0;
   *npts = sp.n_pts;
   accel *acc;
   accel_create("kdtree", s->pos, s->idx, s->ntris, 2, NULL, &acc, &err);
@@ -124,9 +120,9 @@ static void breakdown(const char *json_path, int w, int h, double *t_splat, doub
       }
     }
   visit_count vc = {0};
-  t0 = now();
+  t0 = bench_now();
   for (int i = 0; i < nh; i++) point_tree_radius_halfspace(&t, hits[i], r * r, nrm[i], 1e-3f * r, count_visit, &vc);
-  *t_search = now() - t0; /* one thread: the render uses two */
+  *t_search = bench_now() - t0; /* one thread: the render uses two */
   *per_query = nh ? (double)vc.n / nh : 0;
   free(hits);
   free(nrm);
@@ -206,11 +202,6 @@ static int bench_ao(int quick) {
   return 0;
 }
 
-static double relmse(const float *a, const float *b, int n) {
-  double e = 0;
-  for (int i = 0; i < 3 * n; i++) e += (a[i] - b[i]) * (a[i] - b[i]) / (b[i] * b[i] + 0.01);
-  return e / (3.0 * n);
-}
 
 /* A scene file for CornellBox-Original with the reference's camera (in the working
  * folder; remove it after) and the path of that reference. */
@@ -231,7 +222,7 @@ static int curve(const char *scene_path, const char *integ, const int *spp, int 
   for (int i = 0; i < n; i++) {
     float *px = render(scene_path, integ, spp[i], NULL, w, w, &t[i]);
     if (!px) return 1;
-    e[i] = relmse(px, ref->rgb, w * w);
+    e[i] = bench_relmse(px, ref->rgb, w * w, NULL);
     printf("| %s | %d | %.2f | %.5f |\n", integ, spp[i], t[i], e[i]);
     fflush(stdout);
     free(px);
@@ -301,7 +292,7 @@ static int bench_manylight(int quick) {
         double t;
         float *px = render_budget(scenes[k], m[i].integ, 1000000, budgets[b], m[i].params, ws[k], hs[k], &t);
         if (!px) return 1;
-        printf(" %.5f |", relmse(px, ref.rgb, ws[k] * hs[k]));
+        printf(" %.5f |", bench_relmse(px, ref.rgb, ws[k] * hs[k], NULL));
         fflush(stdout);
         free(px);
       }

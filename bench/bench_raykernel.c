@@ -6,6 +6,7 @@
  * ../shared/scenes (or VALO_SHARED). --classes instead times camera misses, camera hits
  * and bounce rays apart. Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table]
  * [--classes] */
+#include "bench_util.h"
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/offset.h"
@@ -21,7 +22,6 @@
 #define VALO_SHARED_DIR "../shared"
 #endif
 
-static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
 static const char *shared(const char *rel, char *buf, size_t n) {
   const char *root = getenv("VALO_SHARED");
   snprintf(buf, n, "%s/%s", root && *root ? root : VALO_SHARED_DIR, rel);
@@ -61,9 +61,9 @@ static void trace_pair(accel *const a[2], const ray *rays, long n, int threads, 
       chunk_arg c;
       memset(&c, 0, sizeof c);
       c.j = &j;
-      double t0 = now();
+      double t0 = bench_now();
       parallel_for(threads, (n + CHUNK - 1) / CHUNK, trace_chunk, &c);
-      double dt = now() - t0;
+      double dt = bench_now() - t0;
       if (dt < best[k]) best[k] = dt;
       hits[k] = 0;
       for (int t = 0; t < 64; t++) hits[k] += c.hits[t];
@@ -150,9 +150,9 @@ static void bench_scene(const char *name, scene *s) {
   double build[2];
   const char *kinds[2] = {"kdtree", "embree"};
   for (int k = 0; k < 2; k++) {
-    double t0 = now();
+    double t0 = bench_now();
     if (accel_create(kinds[k], s->pos, s->idx, s->ntris, 2, NULL, &acc[k], &err)) { fprintf(stderr, "%s\n", err.message); acc[k] = NULL; }
-    build[k] = now() - t0;
+    build[k] = bench_now() - t0;
   }
   if (!acc[0] || !acc[1]) { accel_destroy(acc[0]); accel_destroy(acc[1]); return; }
   long n, ns;
@@ -230,9 +230,9 @@ int main(int argc, char **argv) {
     valo_error err;
     if (load(s, res[i], NULL) == 0 && scene_commit(s, &err) == 0) {
       accel *a;
-      double t0 = now();
+      double t0 = bench_now();
       if (kdtree_create(s->pos, s->idx, s->ntris, NULL, &a, &err) == 0) {
-        double dt = now() - t0;
+        double dt = bench_now() - t0;
         kd_stats st;
         kdtree_stats(a, &st);
         double nlogn = s->ntris * log2((double)s->ntris);

@@ -13,6 +13,7 @@
  * References (bench/references, commands in docs/performance.md): path at high spp.
  * Usage: bench_restir [--quick] [--only room|sponza] [--seconds S] */
 #include "valo/valo.h"
+#include "bench_util.h"
 #include "image/image_io.h"
 #include <math.h>
 #include <stdio.h>
@@ -24,11 +25,6 @@
 #define VALO_SOURCE_DIR "."
 #endif
 
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 typedef struct scene_def { const char *name, *file, *ref_direct, *ref_path; int w, h; } scene_def;
 
@@ -69,14 +65,14 @@ static int run(job *j) {
   if (j->budget > 0) o.time_budget = j->budget;
   if (j->frames > 0) o.frames = j->frames;
   valo_render *r;
-  double t0 = now();
+  double t0 = bench_now();
   if (valo_render_create(sc, &o, &r, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
   j->nseq = 0;
   if (j->frames > 0) valo_render_on_frame(r, grab, j);
   if (valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
   valo_stats st;
   valo_render_stats(r, &st);
-  j->secs = now() - t0 - st.build_seconds;
+  j->secs = bench_now() - t0 - st.build_seconds;
   j->px = malloc((size_t)j->w * j->h * 3 * sizeof(float));
   valo_render_pixels(r, j->px);
   valo_render_destroy(r);
@@ -89,16 +85,6 @@ static void job_free(job *j) {
 }
 
 static unsigned char *g_ok;
-static double relmse(const float *a, const float *b, int n) {
-  double e = 0;
-  long cnt = 0;
-  for (int i = 0; i < n; i++) {
-    if (g_ok && !g_ok[i]) continue;
-    for (int c = 0; c < 3; c++) { double d = a[3 * i + c] - b[3 * i + c]; e += d * d / (b[3 * i + c] * b[3 * i + c] + 0.01); }
-    cnt += 3;
-  }
-  return cnt ? e / (double)cnt : 0;
-}
 static double mean_ratio(const float *a, const float *b, int n) {
   double sa = 0, sb = 0;
   for (int i = 0; i < n; i++)
@@ -198,11 +184,11 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
     double e_rs = 0, e_rs0 = 0, e_ps = 0;
     int last = 4 < rs.nseq ? 4 : rs.nseq;
     for (int k = rs.nseq - last; k < rs.nseq; k++) {
-      e_rs += relmse(rs.seq[k], ref.rgb, n) / last;
-      e_rs0 += relmse(rs0.seq[k], ref.rgb, n) / last;
-      e_ps += relmse(ps.seq[k], ref.rgb, n) / last;
+      e_rs += bench_relmse(rs.seq[k], ref.rgb, n, g_ok) / last;
+      e_rs0 += bench_relmse(rs0.seq[k], ref.rgb, n, g_ok) / last;
+      e_ps += bench_relmse(ps.seq[k], ref.rgb, n, g_ok) / last;
     }
-    double e_ris = relmse(ris.seq[0], ref.rgb, n);
+    double e_ris = bench_relmse(ris.seq[0], ref.rgb, n, g_ok);
     printf("  time per frame: %s %.3f s; path %.3f s per spp -> baseline %d spp per frame\n", integ, t_frame, t_spp, base_spp);
     printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g; path %d spp %.4g\n",
            last, seqn, integ, e_rs, e_rs0, e_ris, base_spp, e_ps);
@@ -215,7 +201,7 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
     job ra = {stat, integ, NULL, sd->w, sd->h, 1048576, 0, -1, T, 11, 0, NULL, {NULL}, 0};
     job pa = {stat, "path", NULL, sd->w, sd->h, 1048576, 0, depth, T, 11, 0, NULL, {NULL}, 0};
     if (run(&ra) || run(&pa)) return 1;
-    double ea = relmse(ra.px, ref.rgb, n), epa = relmse(pa.px, ref.rgb, n);
+    double ea = bench_relmse(ra.px, ref.rgb, n, g_ok), epa = bench_relmse(pa.px, ref.rgb, n, g_ok);
     printf("  accumulated over %.0f s: %s relMSE %.4g (mean ratio %.4f), path %.4g (mean ratio %.4f); ratio path / %s %.2f\n", T, integ, ea,
            mean_ratio(ra.px, ref.rgb, n), epa, mean_ratio(pa.px, ref.rgb, n), integ, epa / ea);
     job_free(&ra); job_free(&pa);

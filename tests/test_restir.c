@@ -156,6 +156,20 @@ static int reservoir_enumeration(void) {
   return 0;
 }
 
+/* Means of two sets of n independent runs (into mean[0], mean[1]) and the z-score of their
+ * difference (a tiny floor on the variance keeps identical runs finite). */
+static double mean_z(const double *a, const double *b, int n, double *mean) {
+  const double *runs[2] = {a, b};
+  double se2[2];
+  for (int j = 0; j < 2; j++) {
+    double s = 0, s2 = 0;
+    for (int k = 0; k < n; k++) { s += runs[j][k]; s2 += runs[j][k] * runs[j][k]; }
+    mean[j] = s / n;
+    se2[j] = (s2 / n - mean[j] * mean[j]) / (n - 1);
+  }
+  return (mean[0] - mean[1]) / sqrt(se2[0] + se2[1] + 1e-12 * mean[1] * mean[1]);
+}
+
 /* RIS with one candidate and no reuse is next-event estimation without MIS. */
 static int ris_m1_is_light_sampling(void) {
   unsigned char *ok = lamp_free_mask();
@@ -173,14 +187,7 @@ static int ris_m1_is_light_sampling(void) {
     free(a); free(b);
   }
   free(ok);
-  double mean[2], se2[2];
-  for (int j = 0; j < 2; j++) {
-    double s = 0, s2 = 0;
-    for (int k = 0; k < RUNS; k++) { s += m[j][k]; s2 += m[j][k] * m[j][k]; }
-    mean[j] = s / RUNS;
-    se2[j] = (s2 / RUNS - mean[j] * mean[j]) / (RUNS - 1);
-  }
-  double z = (mean[0] - mean[1]) / sqrt(se2[0] + se2[1]);
+  double mean[2], z = mean_z(m[0], m[1], RUNS, mean);
   fprintf(stderr, "RIS M=1: %.5g, path NEE: %.5g (ratio %.4f, z = %.2f)\n", mean[0], mean[1], mean[0] / mean[1], z);
   CHECK(fabs(z) < 4, "RIS with M = 1 differs from light sampling: z = %.2f", z);
   return 0;
@@ -240,14 +247,7 @@ static int di_environment_and_point_lights(void) {
     m[0][k] = sa; m[1][k] = sb;
     free(a); free(b);
   }
-  double mean[2], se2[2];
-  for (int j = 0; j < 2; j++) {
-    double s = 0, s2 = 0;
-    for (int k = 0; k < RUNS; k++) { s += m[j][k]; s2 += m[j][k] * m[j][k]; }
-    mean[j] = s / RUNS;
-    se2[j] = (s2 / RUNS - mean[j] * mean[j]) / (RUNS - 1);
-  }
-  double z = (mean[0] - mean[1]) / sqrt(se2[0] + se2[1] + 1e-12 * mean[1] * mean[1]);
+  double mean[2], z = mean_z(m[0], m[1], RUNS, mean);
   fprintf(stderr, "environment + point + area light: restir-di %.5g, path direct %.5g (ratio %.4f, z = %.2f)\n", mean[0], mean[1], mean[0] / mean[1], z);
   CHECK(fabs(z) < 4 && fabs(mean[0] / mean[1] - 1) < 0.02, "restir-di's mean differs: ratio %.4f, z = %.2f", mean[0] / mean[1], z);
   return 0;
