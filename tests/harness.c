@@ -52,11 +52,39 @@ const char *scratch_file(const char *name, const char *text) {
   return b;
 }
 
+/* VALO_TEST_KEEP=1 keeps the scratch folder (to render a test's scene by hand). */
 static void cleanup_scratch(void) {
   char cmd[1200];
   const char *d = scratch_dir();
+  const char *keep = getenv("VALO_TEST_KEEP");
+  if (keep && *keep && strcmp(keep, "0")) { fprintf(stderr, "kept %s\n", d); return; }
   snprintf(cmd, sizeof cmd, "rm -rf '%s'", d);
   if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", d);
+}
+
+/* Every render a test makes must lose nothing: no NaN, infinite or negative sample, no
+ * non-finite BSDF sample, and at most this fraction of surface samples refused for
+ * shading normals (interpolated normals; a case with bump or normal maps raises it). */
+#define SHADING_LOSS_DEFAULT 1e-2
+static double g_shading_bound = SHADING_LOSS_DEFAULT;
+void allow_shading_loss(double fraction) { g_shading_bound = fraction; }
+
+int check_losses(const valo_render *r) {
+  valo_stats st;
+  valo_render_stats(r, &st);
+  int bad = 0;
+  for (int k = 0; k < VALO_LOSS_COUNT; k++) {
+    if (!st.lost[k]) continue;
+    if (k == VALO_LOSS_SHADING_NORMAL) {
+      double f = st.bsdf_samples ? (double)st.lost[k] / (double)st.bsdf_samples : 1;
+      if (f <= g_shading_bound) continue;
+      fprintf(stderr, "render lost %.3g%% of its surface samples to shading normals (bound %.3g%%)\n", 100 * f, 100 * g_shading_bound);
+    } else {
+      fprintf(stderr, "render lost %llu samples: %s\n", (unsigned long long)st.lost[k], valo_loss_name(k));
+    }
+    bad = 1;
+  }
+  return bad;
 }
 
 int test_main(int argc, char **argv, const test_case *cases) {
@@ -67,6 +95,7 @@ int test_main(int argc, char **argv, const test_case *cases) {
     ran++;
     fprintf(stderr, "== %s\n", c->name);
     g_shared_missing = 0;
+    g_shading_bound = SHADING_LOSS_DEFAULT;
     int rc = c->fn();
     /* Under CI a case that needs ../shared fails instead of skipping. */
     if (rc == TEST_SKIP && g_shared_missing && under_ci()) rc = 1;
@@ -89,8 +118,8 @@ valo_render *render_file(const char *path, const valo_options *opt, valo_scene *
   if (!path) { fprintf(stderr, "no scene file\n"); return NULL; }
   if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "load: %s\n", err.message); return NULL; }
   if (valo_render_create(sc, opt, &r, &err)) { fprintf(stderr, "create: %s\n", err.message); valo_scene_destroy(sc); return NULL; }
-  if (valo_render_run(r, NULL, NULL, &err)) {
-    fprintf(stderr, "run: %s\n", err.message);
+  if (valo_render_run(r, NULL, NULL, &err) || check_losses(r)) {
+    if (err.status) fprintf(stderr, "run: %s\n", err.message);
     valo_render_destroy(r);
     valo_scene_destroy(sc);
     return NULL;

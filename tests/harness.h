@@ -36,6 +36,13 @@ float *render_json_text(const char *json, const valo_options *opt, int *w, int *
  * returns the finished render and its scene in *scene (destroy both), or NULL with the
  * message printed. */
 valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene);
+/* 1 (with a message) when render r lost samples: any NaN, infinite or negative sample
+ * or non-finite BSDF sample, or more shading-normal refusals than the case allows
+ * (1 % of surface samples, what interpolated normals on coarse spheres refuse, unless
+ * allow_shading_loss raised it). render_file checks
+ * every render it makes. */
+int check_losses(const valo_render *r);
+void allow_shading_loss(double fraction);
 /* Writes AOV `name` ("albedo", "normal", "depth") of a render made with aovs set to a PFM
  * in the scratch folder and reads it back into *out (image_free it); 0 on success. */
 #include "image/image_io.h"

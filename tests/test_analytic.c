@@ -417,6 +417,7 @@ static int adaptive_sampling(void) {
     CHECK(valo_scene_load(path, &sc, &err) == VALO_OK, "%s", err.message);
     CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
     CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    CHECK(!check_losses(r), "samples lost");
     char mp[1200], out[1300];
     snprintf(mp, sizeof mp, "%s/spp%d.pfm", scratch_dir(), pass);
     snprintf(out, sizeof out, "spp:%s", mp);
@@ -478,6 +479,7 @@ static int frame_coverage(const char *path, const char *up, int w, int h, double
   o.aovs = 1; o.spp = 1; o.width = w; o.height = h;
   valo_render *r;
   if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
+  if (check_losses(r)) return -1;
   image d;
   if (read_aov(r, "depth", &d)) return -1;
   int n = 0, x0 = w, x1 = -1, y0 = h, y1 = -1;

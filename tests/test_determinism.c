@@ -141,6 +141,7 @@ static int cancel_keeps_passes(void) {
   int calls = 0;
   valo_status st = valo_render_run(r, cancel_after, &calls, &err);
   CHECK(st == VALO_ERR_CANCELLED, "status %d after cancelling", (int)st);
+  CHECK(!check_losses(r), "samples lost");
   valo_stats s;
   valo_render_stats(r, &s);
   fprintf(stderr, "cancelled after %d passes: %d spp, %llu samples (%s)\n", calls, s.spp_done, (unsigned long long)s.samples, err.message);
@@ -210,6 +211,7 @@ static int cancel_mid_pass(void) {
   valo_status st = valo_render_run(r, count_pass, &c, &err);
   pthread_join(th, NULL);
   CHECK(st == VALO_ERR_CANCELLED, "status %d", (int)st);
+  CHECK(!check_losses(r), "samples lost");
   valo_stats s;
   valo_render_stats(r, &s);
   fprintf(stderr, "cancelled mid-render: %d spp, %llu samples\n", s.spp_done, (unsigned long long)s.samples);

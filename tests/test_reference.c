@@ -50,6 +50,7 @@ static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int 
   valo_render *r;
   CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);
   CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(!check_losses(r), "samples lost");
   float *img = malloc(256 * 256 * 3 * sizeof(float));
   valo_render_pixels(r, img);
   image ref;

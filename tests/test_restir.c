@@ -357,6 +357,7 @@ static int run_sequence(const char *integ, const char *params, int max_depth, in
   log->first = n - 4;
   valo_render_on_frame(r, on_frame, log);
   CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(!check_losses(r), "samples lost");
   valo_stats st;
   valo_render_stats(r, &st);
   valo_render_destroy(r);

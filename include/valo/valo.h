@@ -151,6 +151,24 @@ VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user)
  * Thread-safe and async-signal-safe (one atomic store). */
 VALO_API void valo_render_cancel(valo_render *r);
 
+/* Why samples or path vertices were lost (valo_stats.lost). The first three are camera
+ * samples whose radiance was not a finite non-negative number: they count as taken and
+ * add nothing (darkening their pixel). BSDF_NONFINITE: a BSDF sample whose weight or pdf
+ * was not finite, ending its path. SHADING_NORMAL: a BSDF or light sample refused because
+ * the shading normal and the geometric normal disagree about reflection vs transmission
+ * (it would leak light through the surface); nonzero only where shading normals differ
+ * from the geometry (interpolated or mapped normals). */
+typedef enum valo_loss {
+  VALO_LOSS_NAN,
+  VALO_LOSS_INF,
+  VALO_LOSS_NEGATIVE,
+  VALO_LOSS_BSDF_NONFINITE,
+  VALO_LOSS_SHADING_NORMAL,
+  VALO_LOSS_COUNT
+} valo_loss;
+/* A short name for a loss cause ("NaN", "infinite", ...). */
+VALO_API const char *valo_loss_name(int cause);
+
 typedef struct valo_stats {
   uint64_t triangles;
   double build_seconds;   /* acceleration structure */
@@ -160,6 +178,9 @@ typedef struct valo_stats {
                              a sequence: the current frame's) */
   int frames_done;        /* a sequence: frames finished (and given to the callback) */
   uint64_t samples;       /* camera samples taken over the whole film */
+  uint64_t lost[VALO_LOSS_COUNT]; /* by cause (valo_loss), over every run of this render */
+  uint64_t bsdf_samples;  /* BSDF and light samples drawn at surfaces: the base of the
+                             SHADING_NORMAL and BSDF_NONFINITE fractions */
   int width, height;
   int threads;
   char integrator[32];

@@ -203,14 +203,18 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
   if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return 0;
   vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
   rgb f = bsdf_eval(b, wo_l, wi_l);
+  ts->surface_samples++;
+  if (!c3_finite(f)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; return 0; }
   if (c3_black(f)) return 0;
   /* Reflection vs transmission must agree between the shading frame and the true
    * surface (no leaks through shading normals). */
   int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(ls.wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) return 0;
+  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
+  float bpdf = (ls.delta || !mis) ? 0 : bsdf_pdf(b, wo_l, wi_l);
+  if (!isfinite(bpdf)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; return 0; }
   if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return 0;
   float light_pdf = pmf * ls.pdf;
-  float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bsdf_pdf(b, wo_l, wi_l));
+  float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bpdf);
   out->f_cos = c3_scale(f, fabsf(wi_l.z));
   out->Li = ls.L;
   out->scale = w / light_pdf;
@@ -286,22 +290,28 @@ int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, t
   return 1;
 }
 
-int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, bsdf_sample *bs, vec3 *wi) {
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
   vec3 wo_l = frame_to_local(fr, wo);
-  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, bs)) return 0;
+  ts->surface_samples++;
+  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, bs)) {
+    if (bs->nonfinite) ts->lost[VALO_LOSS_BSDF_NONFINITE]++;
+    return 0;
+  }
   *wi = v3_norm(frame_to_world(fr, bs->wi));
   /* The sampled direction must agree with the geometric normal about reflection vs
    * transmission, or shading normals would leak light. */
   int refl_l = (bs->wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(*wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  return refl_l == refl_g;
+  if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
+  return 1;
 }
 
-int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r) {
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, path_state *st, rgb *weight,
+                  ray *r) {
   bsdf_sample bs;
   vec3 wi;
-  if (!sample_bsdf_world(it, b, fr, wo, smp, &bs, &wi)) return 0;
+  if (!sample_bsdf_world(it, b, fr, wo, smp, ts, &bs, &wi)) return 0;
   *weight = bs.weight;
   st->specular = bs.delta;
   st->prev_pdf = bs.pdf;
@@ -325,10 +335,10 @@ int delta_chain_vertex(const render_ctx *c, const ray *r, rgb beta, int depth, i
   return 1;
 }
 
-int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, rgb *beta, ray *r) {
+int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, rgb *beta, ray *r) {
   path_state st = path_state_start(r->o);
   rgb wgt;
-  if (!path_continue(it, b, fr, wo, smp, &st, &wgt, r) || !st.specular) return 0;
+  if (!path_continue(it, b, fr, wo, smp, ts, &st, &wgt, r) || !st.specular) return 0;
   *beta = c3_mul(*beta, wgt);
   return !c3_black(*beta) && c3_finite(*beta);
 }
@@ -345,7 +355,7 @@ rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stat
     if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, shade(c, &it, &b, &fr, wo, depth, smp, ts)));
     /* delta lobes carry the camera path on; a non-delta sample ends it */
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    if (!delta_chain_continue(&it, &b, &fr, wo, smp, &beta, &r)) break;
+    if (!delta_chain_continue(&it, &b, &fr, wo, smp, ts, &beta, &r)) break;
   }
   return L;
 }

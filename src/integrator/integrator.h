@@ -12,7 +12,26 @@
 #include "core/rng.h"
 #include "geometry/offset.h"
 
-typedef struct thread_stats { uint64_t rays; uint64_t bad_samples; char pad[48]; } thread_stats;
+/* Per-thread counters, 64 bytes each: rays traced, losses by cause (valo_loss) and
+ * surface samples drawn (the base of the per-vertex loss fractions). */
+typedef struct thread_stats {
+  uint64_t rays;
+  uint64_t lost[VALO_LOSS_COUNT];
+  uint64_t surface_samples;
+  char pad[64 - (2 + VALO_LOSS_COUNT) * sizeof(uint64_t)]; /* arrays of these: no false sharing */
+} thread_stats;
+static inline void thread_stats_add(thread_stats *into, const thread_stats *from) {
+  into->rays += from->rays;
+  into->surface_samples += from->surface_samples;
+  for (int k = 0; k < VALO_LOSS_COUNT; k++) into->lost[k] += from->lost[k];
+}
+/* Counts L's loss cause and returns 0 when L is NaN, infinite or negative; 1 if usable. */
+static inline int sample_usable(thread_stats *ts, rgb L) {
+  if (c3_finite(L) && L.r >= 0 && L.g >= 0 && L.b >= 0) return 1;
+  int nan = isnan(L.r) || isnan(L.g) || isnan(L.b);
+  ts->lost[nan ? VALO_LOSS_NAN : !c3_finite(L) ? VALO_LOSS_INF : VALO_LOSS_NEGATIVE]++;
+  return 0;
+}
 
 /* Parameters an integrator declares (docs/integrators.md lists the same tables): read
  * from the scene file ("render": {"photon": {"count": 200000}}) and from the command
@@ -37,6 +56,8 @@ typedef struct render_ctx {
   int threads;
   int width, height;       /* the film */
   int sampler_kind;        /* sampler_kind of the render (Sobol or independent) */
+  thread_stats *prep;      /* where create/prepare add the counters of their own rays
+                              (light paths), from the calling thread; may be NULL */
 } render_ctx;
 #define PATH_HARD_CAP 1024
 
@@ -191,11 +212,12 @@ int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, t
 /* Samples the BSDF at it to continue the path: on success returns 1 with the weight
  * f |cos| / pdf in *weight, the state updated and *r the next ray. 0 ends the path
  * (no direction, or one on which shading and geometric normals disagree). */
-int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, path_state *st, rgb *weight, ray *r);
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, path_state *st, rgb *weight,
+                  ray *r);
 /* Samples the BSDF at it for viewer direction wo (the sampler's next 1D and 2D values):
  * returns 1 with *bs and the world direction *wi, or 0 when no direction came out or it
  * disagrees with the geometric normal about reflection vs transmission. */
-int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, bsdf_sample *bs, vec3 *wi);
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi);
 /* The camera side of the integrators that shade a surface their own way (photon, vpl,
  * vsl): follows delta lobes from r, counting the emission found, and adds beta *
  * shade(...) at each surface with a non-delta lobe; a sampled non-delta lobe ends the
@@ -211,7 +233,7 @@ rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stat
  * non-black, 0 to end the chain. */
 int delta_chain_vertex(const render_ctx *c, const ray *r, rgb beta, int depth, int max_depth, thread_stats *ts, rgb *L, isect *it, bsdf *b,
                        frame *fr, vec3 *wo);
-int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, rgb *beta, ray *r);
+int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, rgb *beta, ray *r);
 /* Russian roulette (pbrt-v4) after depth 2: survive with probability
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */

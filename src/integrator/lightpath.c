@@ -66,7 +66,7 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
     rgb w;
     ray next;
     float eta_before = st.eta_acc;
-    if (!path_continue(&it, &b, &fr, wo, &smp, &st, &w, &next)) return;
+    if (!path_continue(&it, &b, &fr, wo, &smp, ts, &st, &w, &next)) return;
     if (j->only_specular && !st.specular) return;
     specular_path = specular_path && st.specular;
     /* adjoint transport: undo the radiance scale across refraction, and correct for
@@ -149,6 +149,7 @@ static valo_status shoot(const render_ctx *c, uint64_t key, uint64_t target, uin
       if (round > cap - (emitted < cap ? emitted : cap)) round = cap > emitted ? cap - emitted : CHUNK;
     }
   }
+  for (int t = 0; t < c->threads && c->prep; t++) thread_stats_add(c->prep, &ts[t]);
   free(ts);
   if (st) { free(all); return st; }
   out->rec = all;

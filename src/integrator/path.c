@@ -28,7 +28,7 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
 
     rgb weight;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
+    if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
     beta = c3_mul(beta, weight);
     if (c3_black(beta) || !c3_finite(beta)) break;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));

@@ -44,7 +44,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
     if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl)));
     rgb weight;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    if (!path_continue(&it, &b, &fr, wo, smp, &st, &weight, &r)) break;
+    if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
     beta = spec_mul(beta, spec_from_rgb(weight, &wl));
     if (spec_black(beta)) break;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));

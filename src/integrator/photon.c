@@ -280,7 +280,7 @@ static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, s
     if (bsdf_has_smooth(&b)) return c3_mul(beta, radiance_lookup(&ps->rad, it.p, fr.n, ps->r2_global));
     path_state st = path_state_start(r.o);
     rgb w;
-    if (!path_continue(&it, &b, &fr, wo, smp, &st, &w, &r)) return c3(0, 0, 0);
+    if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &w, &r)) return c3(0, 0, 0);
     beta = c3_mul(beta, w);
   }
   return c3(0, 0, 0);
@@ -301,7 +301,7 @@ static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, con
     sampler gs = sampler_child(smp, (uint32_t)g, (uint32_t)n);
     bsdf_sample bs;
     vec3 wi;
-    if (!sample_bsdf_world(it, b, fr, wo, &gs, &bs, &wi) || bs.delta) continue; /* delta lobes: the camera chain */
+    if (!sample_bsdf_world(it, b, fr, wo, &gs, ts, &bs, &wi) || bs.delta) continue; /* delta lobes: the camera chain */
     G = c3_add(G, c3_mul(bs.weight, gather_radiance(c, ps, spawn_ray(it, wi), &gs, ts)));
   }
   sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));

@@ -182,7 +182,7 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
       break;
     }
     sampler_set_dim(&smp, RD_DELTA + depth);
-    if (!delta_chain_continue(&it, &b, &fr, wo, &smp, &beta, &r) || depth >= 16) break;
+    if (!delta_chain_continue(&it, &b, &fr, wo, &smp, ts, &beta, &r) || depth >= 16) break;
   }
   g->Le = L;
 }
@@ -415,7 +415,7 @@ static void stage_gi_initial(void *user, int64_t row, int thread) {
     bsdf_sample bs;
     vec3 wi;
     isect it = g->it;
-    if (!sample_bsdf_world(&it, &g->b, &g->fr, g->wo, &smp, &bs, &wi) || bs.delta || !(bs.pdf > 0)) continue;
+    if (!sample_bsdf_world(&it, &g->b, &g->fr, g->wo, &smp, ts, &bs, &wi) || bs.delta || !(bs.pdf > 0)) continue;
     ray ry = spawn_ray(&it, wi);
     hit h;
     if (!ctx_intersect(c, &ry, &h, ts)) continue; /* the environment is direct light */
@@ -424,7 +424,7 @@ static void stage_gi_initial(void *user, int64_t row, int thread) {
     sampler_set_dim(&smp, RD_GI_PATH);
     sampler ps = sampler_child(&smp, 0, 1);
     rgb Lo = path_radiance(c, ry, &ps, ts, 0);
-    if (!c3_finite(Lo) || Lo.r < 0 || Lo.g < 0 || Lo.b < 0) { ts->bad_samples++; continue; } /* never kept: it would live on as history */
+    if (!sample_usable(ts, Lo)) continue; /* never kept: it would live on as history */
     r->xs = hs.p;
     r->ns = v3_dot(hs.ng, wi) > 0 ? v3_neg(hs.ng) : hs.ng; /* facing x_v */
     r->Lo = Lo;

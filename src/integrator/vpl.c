@@ -220,7 +220,7 @@ static rgb compensate(const render_ctx *c, const vpl_state *vs, const isect *it,
   sampler_set_dim(&cs, SDIM_EXTRA);
   bsdf_sample bs;
   vec3 wi, wo_l = frame_to_local(fr, wo);
-  if (!sample_bsdf_world(it, b, fr, wo, &cs, &bs, &wi) || bs.delta || !(bs.pdf > 0)) return c3(0, 0, 0);
+  if (!sample_bsdf_world(it, b, fr, wo, &cs, ts, &bs, &wi) || bs.delta || !(bs.pdf > 0)) return c3(0, 0, 0);
   rgb f = bsdf_eval(b, wo_l, bs.wi);
   float cos_x = fabsf(bs.wi.z), fmax = c3_max(f);
   if (!(fmax > 0)) return c3(0, 0, 0);

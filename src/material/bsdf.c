@@ -68,7 +68,6 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   wm = v3_norm(wm);
   float s5 = schlick_weight(fabsf(v3_dot(wo, wm)));
   float spec = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
-  if (!isfinite(spec)) spec = 0;
   /* Dielectric: F0 = 0.04 (ior 1.5). The specular layer takes F(v.h) as in the spec;
    * the diffuse base is weighted by 1 - F(n.v) instead of the spec's 1 - F(v.h), which
    * returns up to 35 % more energy than arrives at grazing angles (test_chi2 furnace). */
@@ -82,7 +81,6 @@ static float pbr_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (!(v3_len2(wm) > 0)) return 0;
   wm = v3_norm(wm);
   float ps = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
-  if (!isfinite(ps)) ps = 0;
   return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps;
 }
 
@@ -114,7 +112,7 @@ static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
     float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap) * wi.z * wo.z;
     v = D * G * (1 - F) * fabsf(v3_dot(wi, wm) * v3_dot(wo, wm) / denom) / (etap * etap);
   }
-  return isfinite(v) ? c3(v, v, v) : c3(0, 0, 0);
+  return c3(v, v, v);
 }
 static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   vec3 wm;
@@ -127,7 +125,7 @@ static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
     float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap);
     pdf = ggx_D_visible(b->alpha, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
   }
-  return isfinite(pdf) ? pdf : 0;
+  return pdf;
 }
 
 static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
@@ -152,7 +150,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float dg = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
     rgb F = fresnel_conductor(fabsf(v3_dot(wo, wm)), b->cond_eta, b->cond_k);
-    return isfinite(dg) ? c3_scale(F, dg) : c3(0, 0, 0);
+    return c3_scale(F, dg);
   }
   }
   return c3(0, 0, 0);
@@ -171,14 +169,24 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float p = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
-    return isfinite(p) ? p : 0;
+    return p;
   }
   }
   return 0;
 }
 
+/* The end of a non-delta sample: 1 when its pdf is positive and pdf and weight are
+ * finite; a NaN or infinite one sets s->nonfinite (a zero pdf is simply no sample). */
+static int sample_finite(bsdf_sample *s) {
+  if (s->pdf == 0) return 0;
+  if (s->pdf > 0 && isfinite(s->pdf) && c3_finite(s->weight)) return 1;
+  s->nonfinite = 1;
+  return 0;
+}
+
 int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
   s->delta = 0;
+  s->nonfinite = 0;
   s->eta_scale = 1;
   switch (b->type) {
   case BSDF_DIFFUSE:
@@ -201,9 +209,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     }
     if (s->wi.z <= 0) return 0; /* Phong lobe below the surface: rejected (digest 000) */
     s->pdf = bsdf_pdf(b, wo, s->wi);
-    if (!(s->pdf > 0)) return 0;
     s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
-    return 1;
+    return sample_finite(s);
   }
   case BSDF_CONDUCTOR: {
     if (wo.z <= 0) return 0;
@@ -237,9 +244,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
     if (s->wi.z <= 0) return 0;
     s->pdf = pbr_pdf(b, wo, s->wi);
-    if (!(s->pdf > 0)) return 0;
     s->weight = c3_scale(pbr_eval(b, wo, s->wi), s->wi.z / s->pdf);
-    return c3_finite(s->weight);
+    return sample_finite(s);
   }
   case BSDF_ROUGH_CONDUCTOR: {
     if (wo.z <= 0) return 0;
@@ -247,9 +253,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     s->wi = v3_reflect(wo, wm);
     if (s->wi.z <= 0) return 0;
     s->pdf = bsdf_pdf(b, wo, s->wi);
-    if (!(s->pdf > 0)) return 0;
     s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
-    return c3_finite(s->weight);
+    return sample_finite(s);
   }
   case BSDF_ROUGH_DIELECTRIC: {
     if (wo.z == 0) return 0;
@@ -269,10 +274,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
       s->eta_scale = 1 / (etap * etap);
     }
     s->pdf = bsdf_pdf(b, wo, s->wi);
-    if (!(s->pdf > 0)) return 0;
-    rgb f = bsdf_eval(b, wo, s->wi);
-    s->weight = c3_scale(f, fabsf(s->wi.z) / s->pdf);
-    return c3_finite(s->weight);
+    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), fabsf(s->wi.z) / s->pdf);
+    return sample_finite(s);
   }
   }
   return 0;

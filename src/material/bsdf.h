@@ -31,6 +31,8 @@ typedef struct bsdf_sample {
   float pdf;          /* solid-angle pdf (of the whole mixture); 0 for a delta lobe */
   int delta;          /* sampled a specular (Dirac) lobe */
   float eta_scale;    /* radiance scale across refraction (1 otherwise) */
+  int nonfinite;      /* set when no sample was made because its pdf or weight was NaN
+                         or infinite (valo_stats counts these: VALO_LOSS_BSDF_NONFINITE) */
 } bsdf_sample;
 
 bsdf bsdf_from_material(const material *m);

@@ -48,7 +48,8 @@ struct valo_render {
   double *lum;            /* adaptive: per pixel sum of luminance and of its square */
   int spp_done;
   double build_seconds, render_seconds;
-  uint64_t rays, bad_samples;
+  uint64_t rays, lost[VALO_LOSS_COUNT], surface_samples;
+  thread_stats prep; /* create's and prepare's rays and losses, added at run_finish */
   atomic_int cancel;
   camera cam_still;       /* the scene camera fitted to the film (frame 0 of an animation) */
   cam_view view, view_prev;/* this frame's pinhole basis and the previous frame's */
@@ -310,6 +311,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->ctx.width = o.width;
   r->ctx.height = o.height;
   r->ctx.sampler_kind = r->sampler_kind;
+  r->ctx.prep = &r->prep;
   r->ao_dist = ao_ray_length(s, ao_param[0]);
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
   r->cam_still = scene_camera_fit(s, (float)o.width / (float)o.height);
@@ -397,10 +399,10 @@ typedef struct pass_job {
 } pass_job;
 
 /* Adds one sample's radiance to pixel pix of the film: NaN, infinite and negative ones
- * count as taken but are dropped (counted in ts). */
+ * count as taken but are dropped (counted by cause in ts). */
 static void film_add(valo_render *r, size_t pix, rgb L, thread_stats *ts) {
   r->count[pix]++;
-  if (!c3_finite(L) || L.r < 0 || L.g < 0 || L.b < 0) { ts->bad_samples++; return; }
+  if (!sample_usable(ts, L)) return;
   double *acc = &r->sum[3 * pix];
   acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
   if (r->lum) {
@@ -575,13 +577,30 @@ static valo_status run_sequence(valo_render *r, valo_progress_fn progress, void 
 
 VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user) { r->on_frame = fn; r->on_frame_user = user; }
 
+VALO_API const char *valo_loss_name(int cause) {
+  static const char *names[VALO_LOSS_COUNT] = {"NaN", "infinite", "negative", "BSDF non-finite", "shading normal"};
+  return cause >= 0 && cause < VALO_LOSS_COUNT ? names[cause] : "unknown";
+}
+
 /* The end of valo_render_run: time and per-thread counters into the render's totals, and
- * a warning when samples were dropped. Frees ts; returns st. */
+ * a warning naming each cause of dropped camera samples or BSDF failures (shading-normal
+ * refusals are expected with interpolated normals: valo_stats reports them). Frees ts. */
 static valo_status run_finish(valo_render *r, thread_stats *ts, double t0, valo_status st) {
   r->render_seconds += now_seconds() - t0;
-  for (int t = 0; t < r->opt.threads; t++) { r->rays += ts[t].rays; r->bad_samples += ts[t].bad_samples; }
+  thread_stats sum = r->prep;
+  memset(&r->prep, 0, sizeof r->prep);
+  for (int t = 0; t < r->opt.threads; t++) thread_stats_add(&sum, &ts[t]);
   free(ts);
-  if (r->bad_samples) log_warning("%llu samples were NaN, infinite or negative and were dropped", (unsigned long long)r->bad_samples);
+  r->rays += sum.rays;
+  r->surface_samples += sum.surface_samples;
+  const uint64_t *run = sum.lost;
+  for (int k = 0; k < VALO_LOSS_COUNT; k++) {
+    r->lost[k] += run[k];
+    if (run[k] && k <= VALO_LOSS_NEGATIVE)
+      log_warning("%llu samples were %s and were dropped (their pixels are darker)", (unsigned long long)run[k], valo_loss_name(k));
+    else if (run[k] && k == VALO_LOSS_BSDF_NONFINITE)
+      log_warning("%llu BSDF samples had a non-finite weight or pdf and ended their paths", (unsigned long long)run[k]);
+  }
   return st;
 }
 
@@ -696,6 +715,8 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   o->build_seconds = r->build_seconds;
   o->render_seconds = r->render_seconds;
   o->rays = r->rays;
+  memcpy(o->lost, r->lost, sizeof o->lost);
+  o->bsdf_samples = r->surface_samples;
   o->spp_done = r->spp_done;
   o->frames_done = r->frames_done;
   size_t np = (size_t)r->opt.width * r->opt.height;
