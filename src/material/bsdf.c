@@ -70,7 +70,8 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   float spec = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
   /* Dielectric: F0 = 0.04 (ior 1.5). The specular layer takes F(v.h) as in the spec;
    * the diffuse base is weighted by 1 - F(n.v) instead of the spec's 1 - F(v.h), which
-   * returns up to 35 % more energy than arrives at grazing angles (test_chi2 furnace). */
+   * returns up to 35 % more energy than arrives at grazing angles (test_chi2 furnace).
+   * The price: this diffuse base is not reciprocal (test_chi2 bsdf_reciprocity). */
   float Fd = 0.04f + 0.96f * s5, Fo = 0.04f + 0.96f * schlick_weight(wo.z);
   rgb Fm = b->metal_flat ? b->kd : c3_add(b->kd, c3_scale(c3_sub(c3(1, 1, 1), b->kd), s5));
   rgb diel = c3_add(c3_scale(b->kd, (1 - Fo) * INV_PI_F), c3(Fd * spec, Fd * spec, Fd * spec));
