@@ -52,6 +52,20 @@ const char *scratch_file(const char *name, const char *text) {
   return b;
 }
 
+/* Warnings captured between warnings_capture(1) and warnings_capture(0) (still printed). */
+static char g_warnings[8192];
+static void capture_warning(void *user, const char *msg) {
+  (void)user;
+  fprintf(stderr, "valo: warning: %s\n", msg);
+  size_t n = strlen(g_warnings);
+  snprintf(g_warnings + n, sizeof g_warnings - n, "%s\n", msg);
+}
+void warnings_capture(int on) {
+  g_warnings[0] = 0;
+  valo_set_warning_handler(on ? capture_warning : NULL, NULL);
+}
+const char *warnings_text(void) { return g_warnings; }
+
 /* VALO_TEST_KEEP=1 keeps the scratch folder (to render a test's scene by hand). */
 static void cleanup_scratch(void) {
   char cmd[1200];

@@ -43,6 +43,10 @@ valo_render *render_file(const char *path, const valo_options *opt, valo_scene *
  * every render it makes. */
 int check_losses(const valo_render *r);
 void allow_shading_loss(double fraction);
+/* warnings_capture(1) starts collecting library warnings (they are still printed; the
+ * text is cleared), warnings_capture(0) stops; warnings_text() is what was collected. */
+void warnings_capture(int on);
+const char *warnings_text(void);
 /* Writes AOV `name` ("albedo", "normal", "depth") of a render made with aovs set to a PFM
  * in the scratch folder and reads it back into *out (image_free it); 0 on success. */
 #include "image/image_io.h"

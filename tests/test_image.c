@@ -6,6 +6,9 @@
 #include "harness.h"
 #include "image/image_io.h"
 #include "image/tonemap.h"
+#include <OpenEXR/openexr.h>
+#include <OpenEXR/ImfCRgbaFile.h>
+#include <stb_image.h>
 #include <dirent.h>
 #include <math.h>
 #include <stdlib.h>
@@ -140,6 +143,136 @@ static int real_exr_files(void) {
   return 0;
 }
 
+/* Writes a w x h EXR (no compression) whose channels `names` hold the constants `vals`,
+ * through OpenEXRCore directly (valo's writer makes only R, G, B). 0 on success. */
+static int write_layered_exr(const char *path, int w, int h, int n, const char *const *names, const float *vals) {
+  exr_context_t ctx = NULL;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  int part = 0;
+  exr_result_t rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_add_part(ctx, "layers", EXR_STORAGE_SCANLINE, &part);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_NONE);
+  for (int c = 0; c < n && rv == EXR_ERR_SUCCESS; c++) rv = exr_add_channel(ctx, part, names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_set_version(ctx, part, 1);
+  if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
+  float *planes = malloc((size_t)n * w * h * sizeof(float));
+  for (int c = 0; c < n; c++)
+    for (int i = 0; i < w * h; i++) planes[(size_t)c * w * h + i] = vals[c];
+  exr_encode_pipeline_t enc;
+  memset(&enc, 0, sizeof enc);
+  int have = 0;
+  for (int y = 0; y < h && rv == EXR_ERR_SUCCESS; y++) { /* uncompressed: one line per chunk */
+    exr_chunk_info_t ci;
+    rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
+    if (rv == EXR_ERR_SUCCESS) {
+      if (!have) { rv = exr_encoding_initialize(ctx, part, &ci, &enc); have = rv == EXR_ERR_SUCCESS; }
+      else rv = exr_encoding_update(ctx, part, &ci, &enc);
+    }
+    for (int c = 0; c < enc.channel_count && rv == EXR_ERR_SUCCESS; c++) {
+      int k = 0;
+      while (k < n && strcmp(names[k], enc.channels[c].channel_name)) k++;
+      enc.channels[c].user_pixel_stride = sizeof(float);
+      enc.channels[c].user_line_stride = w * (int32_t)sizeof(float);
+      enc.channels[c].user_bytes_per_element = sizeof(float);
+      enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+      enc.channels[c].encode_from_ptr = (const uint8_t *)&planes[(size_t)k * w * h + (size_t)y * w];
+    }
+    if (rv == EXR_ERR_SUCCESS && y == 0) rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+    if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, part, &enc);
+  }
+  if (have) exr_encoding_destroy(ctx, &enc);
+  exr_result_t fr = exr_finish(&ctx);
+  free(planes);
+  return rv == EXR_ERR_SUCCESS && fr == EXR_ERR_SUCCESS ? 0 : -1;
+}
+
+/* An EXR with several colour layers is read as one layer, not a mix of all of them, and
+ * the others are named in a warning: the unnamed layer when there is one, else the first. */
+static int exr_layers(void) {
+  static const char *const named[6] = {"diffuse.B", "diffuse.G", "diffuse.R", "specular.B", "specular.G", "specular.R"};
+  static const char *const mixed[6] = {"B", "G", "R", "albedo.B", "albedo.G", "albedo.R"};
+  const float vals[6] = {0.3f, 0.2f, 0.1f, 0.9f, 0.8f, 0.7f};
+  const char *const *sets[2] = {named, mixed};
+  const char *ignored[2] = {"'specular'", "'albedo'"};
+  for (int k = 0; k < 2; k++) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/layers%d.exr", scratch_dir(), k);
+    CHECK(write_layered_exr(path, 4, 3, 6, sets[k], vals) == 0, "could not write %s", path);
+    image im;
+    valo_error err;
+    warnings_capture(1);
+    valo_status st = image_read(path, &im, &err);
+    char said[1024];
+    snprintf(said, sizeof said, "%s", warnings_text());
+    warnings_capture(0);
+    CHECK(st == VALO_OK, "%s", err.message);
+    for (int i = 0; i < 12; i++)
+      CHECK(im.rgb[3 * i] == 0.1f && im.rgb[3 * i + 1] == 0.2f && im.rgb[3 * i + 2] == 0.3f, "pixel %d is (%g %g %g), expected the first layer's (0.1 0.2 0.3)", i,
+            im.rgb[3 * i], im.rgb[3 * i + 1], im.rgb[3 * i + 2]);
+    image_free(&im);
+    CHECK(strstr(said, "several colour layers") && strstr(said, ignored[k]), "no warning naming the ignored layer %s: \"%s\"", ignored[k], said);
+  }
+  return 0;
+}
+
+/* Writers checked by readers valo does not use for them: valo's EXR through OpenEXR's
+ * RGBA interface (ImfCRgbaFile, half precision), its PNG through stb_image (bytes against
+ * the sRGB formula computed here); and a PFM written byte by byte here, bottom row first
+ * with a negative scale (little-endian), read by valo. */
+static int independent_readers(void) {
+  int w = 5, h = 3;
+  float *p = test_pattern(w, h);
+  for (int i = 0; i < w * h * 3; i++) p[i] *= 0.08f; /* 0 .. 1.04: some clip in the PNG */
+  char exr[1200], png[1200], pfm[1200];
+  snprintf(exr, sizeof exr, "%s/ind.exr", scratch_dir());
+  snprintf(png, sizeof png, "%s/ind.png", scratch_dir());
+  snprintf(pfm, sizeof pfm, "%s/hand.pfm", scratch_dir());
+  valo_error err;
+  CHECK(image_write(exr, w, h, p, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(image_write(png, w, h, p, NULL, &err) == VALO_OK, "%s", err.message);
+  ImfInputFile *in = ImfOpenInputFile(exr);
+  CHECK(in, "OpenEXR cannot open valo's EXR: %s", ImfErrorMessage());
+  int x0, y0, x1, y1;
+  ImfHeaderDataWindow(ImfInputHeader(in), &x0, &y0, &x1, &y1);
+  CHECK(x0 == 0 && y0 == 0 && x1 == w - 1 && y1 == h - 1, "data window (%d %d)-(%d %d)", x0, y0, x1, y1);
+  ImfRgba px[15];
+  CHECK(ImfInputSetFrameBuffer(in, px, 1, (size_t)w) && ImfInputReadPixels(in, 0, h - 1), "%s", ImfErrorMessage());
+  ImfCloseInputFile(in);
+  for (int i = 0; i < w * h; i++) {
+    float got[3] = {ImfHalfToFloat(px[i].r), ImfHalfToFloat(px[i].g), ImfHalfToFloat(px[i].b)};
+    for (int c = 0; c < 3; c++) CHECK(fabsf(got[c] - p[3 * i + c]) <= 1e-3f * fmaxf(p[3 * i + c], 1e-2f), "EXR pixel %d channel %d: %g, wrote %g", i, c, got[c], p[3 * i + c]);
+    CHECK(ImfHalfToFloat(px[i].a) == 1.0f, "EXR alpha %g (no alpha channel reads as 1)", ImfHalfToFloat(px[i].a));
+  }
+  int pw, ph, pn;
+  unsigned char *bytes = stbi_load(png, &pw, &ph, &pn, 3);
+  CHECK(bytes && pw == w && ph == h, "stb cannot read valo's PNG");
+  for (int i = 0; i < w * h * 3; i++) {
+    double v = fmin(fmax(p[i], 0), 1), e = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+    CHECK(abs(bytes[i] - (int)lrint(e * 255)) <= 0, "PNG byte %d: %d, expected %ld", i, bytes[i], lrint(e * 255));
+  }
+  stbi_image_free(bytes);
+  /* PFM by hand: 2x2, rows bottom to top, little-endian floats */
+  FILE *f = fopen(pfm, "wb");
+  CHECK(f, "cannot write %s", pfm);
+  fprintf(f, "PF\n2 2\n-1.0\n");
+  const float bottom_top[12] = {1, 2, 3, 4, 5, 6, /* bottom row: (0,1) (1,1) */ 7, 8, 9, 10, 11, 12};
+  for (int i = 0; i < 12; i++) {
+    uint32_t u;
+    memcpy(&u, &bottom_top[i], 4);
+    unsigned char le[4] = {(unsigned char)u, (unsigned char)(u >> 8), (unsigned char)(u >> 16), (unsigned char)(u >> 24)};
+    fwrite(le, 1, 4, f);
+  }
+  fclose(f);
+  image im;
+  CHECK(image_read(pfm, &im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im.w == 2 && im.h == 2, "PFM size %dx%d", im.w, im.h);
+  const float top_first[12] = {7, 8, 9, 10, 11, 12, 1, 2, 3, 4, 5, 6};
+  for (int i = 0; i < 12; i++) CHECK(im.rgb[i] == top_first[i], "PFM value %d: %g, expected %g (top row first)", i, im.rgb[i], top_first[i]);
+  image_free(&im);
+  free(p);
+  return 0;
+}
+
 /* Bloom spreads only what exceeds the threshold, by a normalised Gaussian: a single
  * pixel of 101 on black adds 100 x strength in total, symmetrically, and leaves pixels
  * below the threshold alone when nothing bright is near. */
@@ -161,7 +294,7 @@ static int bloom(void) {
 
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"exr_roundtrip", exr_roundtrip}, {"exr_zip_equal_size", exr_zip_equal_size}, {"pfm_roundtrip", pfm_roundtrip}, {"srgb_png", srgb_png},
-                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files}, {"bloom", bloom},
+                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files}, {"exr_layers", exr_layers}, {"independent_readers", independent_readers}, {"bloom", bloom},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -224,9 +224,76 @@ static int obj_number_forms(void) {
   return 0;
 }
 
+/* Issue 12's silent fallbacks now warn, naming the file and what was done instead: maps
+ * on a mesh without UVs, an unreadable MTL texture, a glTF camera without a usable field
+ * of view, and autofocus whose centre ray hits nothing. */
+static int fallback_warnings(void) {
+  char png[1200];
+  snprintf(png, sizeof png, "%s/paint.png", scratch_dir());
+  const float px[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 1, 1};
+  valo_error err;
+  CHECK(image_write(png, 2, 2, px, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(scratch_file("nouv.mtl", "newmtl painted\nKd 1 1 1\nmap_Kd paint.png\nnewmtl lost\nKd 1 1 1\nmap_Kd missing-texture.png\n"), "write");
+  const char *obj = scratch_file("nouv.obj", "mtllib nouv.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl painted\nf 1 2 3\nusemtl lost\nf 1 2 4\n");
+  scene *s = scene_new(obj);
+  warnings_capture(1);
+  valo_status st = load_mesh(s, obj, NULL, UINT32_MAX, 1, &err);
+  char said[4096];
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  scene_free(s);
+  CHECK(st == VALO_OK, "%s", err.message);
+  CHECK(strstr(said, "missing-texture.png") && strstr(said, "ignored"), "no warning naming the unreadable texture: \"%s\"", said);
+  CHECK(strstr(said, "nouv.obj") && strstr(said, "no texture coordinates") && strstr(said, "painted"), "no warning about maps without UVs: \"%s\"", said);
+  /* a glTF camera with yfov 0 (the triangle of LIGHTS_GLTF, seen by a camera node) */
+  char gl[4096];
+  snprintf(gl, sizeof gl, "%s", LIGHTS_GLTF);
+  char *nodes = strstr(gl, "\"scenes\": [{\"nodes\": [0, 1, 2, 3]}], \"nodes\": [");
+  CHECK(nodes, "template changed");
+  char tail[4096];
+  snprintf(tail, sizeof tail, "%s", nodes + strlen("\"scenes\": [{\"nodes\": [0, 1, 2, 3]}], \"nodes\": ["));
+  snprintf(nodes, sizeof gl - (size_t)(nodes - gl),
+           "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0, \"znear\": 0.1}}], "
+           "\"scenes\": [{\"nodes\": [0, 1, 2, 3, 4]}], \"nodes\": [{\"camera\": 0, \"translation\": [0.3, 0.3, 2]}, %s",
+           tail);
+  const char *cpath = scratch_file("badcam.gltf", gl);
+  s = scene_new(cpath);
+  warnings_capture(1);
+  st = load_mesh(s, cpath, NULL, UINT32_MAX, 1, &err);
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  int has_cam = s->has_camera;
+  scene_free(s);
+  CHECK(st == VALO_OK, "%s", err.message);
+  CHECK(strstr(said, "badcam.gltf") && strstr(said, "field of view"), "no warning about the camera's field of view: \"%s\" (camera %s)", said,
+        has_cam ? "taken" : "not taken");
+  /* autofocus with a lens (file cameras carry no focus distance), the centre ray into
+   * the void: the same glTF, its camera moved off the triangle, with a usable fov */
+  char *fov = strstr(gl, "\"yfov\": 0,"), *tr = strstr(gl, "\"translation\": [0.3, 0.3, 2]");
+  CHECK(fov && tr, "template changed");
+  memcpy(fov, "\"yfov\": 1,", strlen("\"yfov\": 1,"));
+  memcpy(tr, "\"translation\": [3.0, 3.0, 2]", strlen("\"translation\": [3.0, 3.0, 2]"));
+  const char *json = scratch_file("voidcam.gltf", gl);
+  valo_options o;
+  valo_options_init(&o);
+  o.aperture_radius = 0.05;
+  valo_scene *sc;
+  CHECK(valo_scene_load(json, &sc, &err) == VALO_OK, "%s", err.message);
+  valo_render *r = NULL;
+  warnings_capture(1);
+  st = valo_render_create(sc, &o, &r, &err);
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  if (r) valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  CHECK(st == VALO_OK, "%s", err.message);
+  CHECK(strstr(said, "autofocus") && strstr(said, "voidcam.gltf"), "no autofocus warning: \"%s\"", said);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
-                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {NULL, NULL}};
+                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -223,6 +223,51 @@ static valo_status read_exr_rgba(const char *path, image *out, valo_error *err) 
   return VALO_OK;
 }
 
+/* The layer of EXR channel `nm` ("diffuse.R" -> "diffuse", "R" -> "") into buf; returns
+ * its colour offset (R 0, G 1, B 2, Y 3) or -1 for other channels. */
+static int exr_channel(const char *nm, char *layer, size_t cap) {
+  const char *dot = strrchr(nm, '.');
+  const char *base = dot ? dot + 1 : nm;
+  size_t n = dot ? (size_t)(dot - nm) : 0;
+  if (n >= cap) n = cap - 1;
+  memcpy(layer, nm, n);
+  layer[n] = 0;
+  return !strcmp(base, "R") ? 0 : !strcmp(base, "G") ? 1 : !strcmp(base, "B") ? 2 : !strcmp(base, "Y") ? 3 : -1;
+}
+
+/* The colour layer read from part 0: the unnamed one (R, G, B or Y) if present, else the
+ * first named layer with colour channels; a warning names the layers left out and any
+ * further parts. Fills `use` and sets *has_g when that layer has a G channel. */
+static void exr_pick_layer(exr_context_t ctx, const char *path, char *use, size_t cap, int *has_g) {
+  const exr_attr_chlist_t *cl = NULL;
+  char layer[256], others[512] = "";
+  int found = 0;
+  use[0] = 0;
+  *has_g = 0;
+  if (exr_get_channels(ctx, 0, &cl) != EXR_ERR_SUCCESS) return;
+  for (int pass = 0; pass < 2 && !found; pass++)
+    for (int i = 0; i < cl->num_channels; i++) {
+      if (exr_channel(cl->entries[i].name.str, layer, sizeof layer) < 0) continue;
+      if (pass == 0 && layer[0]) continue; /* first look for the unnamed layer */
+      snprintf(use, cap, "%s", layer);
+      found = 1;
+      break;
+    }
+  size_t n = 0;
+  for (int i = 0; i < cl->num_channels; i++) {
+    int off = exr_channel(cl->entries[i].name.str, layer, sizeof layer);
+    if (off < 0) continue;
+    if (!strcmp(layer, use)) { if (off == 1) *has_g = 1; continue; }
+    char quoted[300];
+    snprintf(quoted, sizeof quoted, "'%s'", layer);
+    if (strstr(others, quoted) || n >= sizeof others) continue;
+    n += (size_t)snprintf(others + n, sizeof others - n, "%s%s", n ? ", " : "", quoted);
+  }
+  if (others[0]) log_warning("%s: EXR with several colour layers: reading %s%s%s, ignoring %s", path, use[0] ? "'" : "the unnamed layer", use, use[0] ? "'" : "", others);
+  int parts = 1;
+  if (exr_get_count(ctx, &parts) == EXR_ERR_SUCCESS && parts > 1) log_warning("%s: EXR with %d parts: reading the first only", path, parts);
+}
+
 static valo_status read_exr(const char *path, image *out, valo_error *err) {
   exr_context_t ctx = NULL;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -246,6 +291,9 @@ static valo_status read_exr(const char *path, image *out, valo_error *err) {
   if (w <= 0 || h <= 0 || w > 65536 || h > 65536) { st = err_set(err, VALO_ERR_PARSE, "%s: bad data window", path); goto done; }
   buf = calloc((size_t)w * h * 3, sizeof(float));
   if (!buf) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+  char use[256];
+  int has_g = 0;
+  exr_pick_layer(ctx, path, use, sizeof use, &has_g);
   int32_t lines = 1;
   exr_get_scanlines_per_chunk(ctx, 0, &lines);
   for (int y = dw.min.y; y <= dw.max.y; y += lines) {
@@ -258,11 +306,9 @@ static valo_status read_exr(const char *path, image *out, valo_error *err) {
     if (rv != EXR_ERR_SUCCESS) break;
     int row = ci.start_y - dw.min.y;
     for (int c = 0; c < dec.channel_count; c++) {
-      const char *nm = dec.channels[c].channel_name;
-      const char *base = strrchr(nm, '.');
-      base = base ? base + 1 : nm;
-      int off = !strcmp(base, "R") ? 0 : !strcmp(base, "G") ? 1 : !strcmp(base, "B") ? 2 : !strcmp(base, "Y") ? 3 : -1;
-      if (off < 0 || dec.channels[c].height == 0) { dec.channels[c].decode_to_ptr = NULL; continue; }
+      char layer[256];
+      int off = exr_channel(dec.channels[c].channel_name, layer, sizeof layer);
+      if (off < 0 || strcmp(layer, use) || dec.channels[c].height == 0) { dec.channels[c].decode_to_ptr = NULL; continue; }
       if (off == 3) off = 0; /* luminance: fill R, then copy below */
       dec.channels[c].user_pixel_stride = 3 * sizeof(float);
       dec.channels[c].user_line_stride = w * 3 * (int32_t)sizeof(float);
@@ -276,14 +322,8 @@ static valo_status read_exr(const char *path, image *out, valo_error *err) {
   }
   if (rv == EXR_ERR_FEATURE_NOT_IMPLEMENTED) { st = VALO_ERR_UNSUPPORTED; goto done; }
   if (rv != EXR_ERR_SUCCESS) { st = err_set(err, VALO_ERR_PARSE, "%s: cannot decode EXR: %s", path, exr_get_default_error_message(rv)); goto done; }
-  {
-    const exr_attr_chlist_t *cl = NULL;
-    int has_g = 0;
-    if (exr_get_channels(ctx, 0, &cl) == EXR_ERR_SUCCESS)
-      for (int i = 0; i < cl->num_channels; i++) if (!strcmp(cl->entries[i].name.str, "G")) has_g = 1;
-    if (!has_g)
-      for (size_t i = 0; i < (size_t)w * h; i++) buf[3 * i + 1] = buf[3 * i + 2] = buf[3 * i];
-  }
+  if (!has_g) /* a luminance (Y) or R-only image: grey */
+    for (size_t i = 0; i < (size_t)w * h; i++) buf[3 * i + 1] = buf[3 * i + 2] = buf[3 * i];
   out->w = w; out->h = h; out->rgb = buf; buf = NULL;
 done:
   if (have_dec) exr_decoding_destroy(ctx, &dec);

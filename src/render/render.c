@@ -328,8 +328,12 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
      * centre, or the distance to the look-at point if the centre ray escapes. */
     ray cr = {r->view.o, r->view.fwd, INFINITY};
     hit h;
-    r->focus = accel_intersect(r->acc, &cr, &h) ? h.t : v3_len(v3_sub(c->look_at, c->pos));
+    int hit_centre = accel_intersect(r->acc, &cr, &h);
+    r->focus = hit_centre ? h.t : v3_len(v3_sub(c->look_at, c->pos));
     if (!(r->focus > 0)) r->focus = 1;
+    if (r->aperture > 0 && !hit_centre)
+      log_warning("%s: autofocus: the ray through the image centre hits nothing, so the lens focuses at %g (%s); set --focus", s->path,
+                  (double)r->focus, r->focus == 1 && !(v3_len(v3_sub(c->look_at, c->pos)) > 0) ? "a fallback" : "the look-at distance");
   }
   if (integ->create) {
     valo_status cst = integ->create(&r->ctx, &r->istate, err);

@@ -109,9 +109,15 @@ static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMa
   const char *p = path.data;
   if (p[0] == '*') {
     long k = strtol(p + 1, NULL, 10);
-    if (k < 0 || (unsigned long)k >= ai->mNumTextures) return -1;
+    if (k < 0 || (unsigned long)k >= ai->mNumTextures) {
+      log_warning("the mesh file in %s: a material names embedded image %s, which the file does not hold (the map is ignored)", dir[0] ? dir : "./", p);
+      return -1;
+    }
     const struct aiTexture *t = ai->mTextures[k];
-    if (t->mHeight != 0) return -1; /* raw texel arrays are not produced by the formats we read */
+    if (t->mHeight != 0) { /* raw texel arrays are not produced by the formats we read */
+      log_warning("the mesh file in %s: embedded image %s is a raw texel array, which valo does not read (the map is ignored)", dir[0] ? dir : "./", p);
+      return -1;
+    }
     char key[1200];
     snprintf(key, sizeof key, "%s%s", dir, p);
     return scene_texture_memory(s, key, (const unsigned char *)t->pcData, t->mWidth, srgb);
@@ -276,6 +282,10 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   s->nverts += mesh->mNumVertices;
   uint32_t mat = c->override_mat != UINT32_MAX ? c->override_mat : c->mat_base + mesh->mMaterialIndex;
   if (mat >= s->nmats) return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' names material %u that does not exist", c->path, mesh->mName.data, mesh->mMaterialIndex);
+  const material *mm = &s->mats[mat];
+  if (!mesh->mTextureCoords[0] && (mm->tex_kd >= 0 || mm->tex_ks >= 0 || mm->tex_ke >= 0 || mm->tex_alpha >= 0 || mm->tex_normal >= 0 ||
+                                   mm->tex_ns >= 0 || mm->tex_bump >= 0 || mm->tex_rough >= 0 || mm->tex_metal >= 0 || mm->tex_mr >= 0))
+    log_warning("%s: mesh '%s' has no texture coordinates, so the maps of its material '%s' are ignored", c->path, mesh->mName.data, mm->name);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
     const struct aiFace *face = &mesh->mFaces[f];
     if (face->mNumIndices != 3) continue; /* points and lines */
@@ -341,12 +351,20 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   vec3 pos = m34_point(&full, local);
   vec3 look = m34_vector(&full, v3(cam->mLookAt.x, cam->mLookAt.y, cam->mLookAt.z));
   vec3 up = m34_vector(&full, v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
-  if (!v3_finite(pos) || !(v3_len2(look) > 0) || !(v3_len2(up) > 0)) return;
+  if (!v3_finite(pos) || !(v3_len2(look) > 0) || !(v3_len2(up) > 0) || !(v3_len2(v3_cross(look, up)) > 0)) {
+    log_warning("%s: camera '%s' has a non-finite position or a zero or parallel view and up vector: it is ignored and the view "
+                "is framed automatically", c->path, cam->mName.data);
+    return;
+  }
   float aspect = cam->mAspect > 0 ? cam->mAspect : 1.0f;
   float vfov;
   if (gltf) vfov = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV / (cam->mAspect > 0 ? cam->mAspect : 1.0f) : 0.8f;
   else vfov = 2.0f * atanf(tanf(cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f) / aspect);
-  if (!(vfov > 1e-4f && vfov < 3.1f)) vfov = 0.8f;
+  if (!(cam->mHorizontalFOV > 0) || !(vfov > 1e-4f && vfov < 3.1f)) {
+    log_warning("%s: camera '%s' has no usable field of view (%g): %.1f degrees (vertical) is used", c->path, cam->mName.data,
+                (double)cam->mHorizontalFOV, 0.8 * 180 / M_PI);
+    vfov = 0.8f;
+  }
   c->s->cam.pos = pos;
   c->s->cam.look_at = v3_add(pos, v3_norm(look));
   c->s->cam.up = v3_norm(up);
