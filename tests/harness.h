@@ -51,4 +51,9 @@ const char *warnings_text(void);
  * in the scratch folder and reads it back into *out (image_free it); 0 on success. */
 #include "image/image_io.h"
 int read_aov(const valo_render *r, const char *name, image *out);
+/* An image against a reference: per-channel mean error and the worst relative error over
+ * lit blocks (block x block pixels whose reference luminance is above 5 % of the image's
+ * mean). */
+typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, lit_blocks; } cmp_result;
+void compare_images(const float *img, const float *ref, int w, int h, int block, cmp_result *r);
 #endif

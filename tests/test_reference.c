@@ -9,31 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, lit_blocks; } cmp_result;
-
-/* Compares img to ref: per-channel mean error and worst relative error over lit blocks
- * (block luminance above 5 % of the image's mean luminance). */
-static void compare(const float *img, const float *ref, int w, int h, int block, cmp_result *r) {
-  double s_img[3] = {0}, s_ref[3] = {0};
-  for (int i = 0; i < w * h; i++)
-    for (int c = 0; c < 3; c++) { s_img[c] += img[3 * i + c]; s_ref[c] += ref[3 * i + c]; }
-  double mean_lum = (s_ref[0] + s_ref[1] + s_ref[2]) / (3.0 * w * h);
-  for (int c = 0; c < 3; c++) r->mean_err[c] = fabs(s_img[c] - s_ref[c]) / s_ref[c];
-  r->worst_block = 0; r->lit_blocks = 0; r->worst_bx = r->worst_by = -1;
-  for (int by = 0; by < h / block; by++)
-    for (int bx = 0; bx < w / block; bx++) {
-      double a = 0, b = 0;
-      for (int y = by * block; y < (by + 1) * block; y++)
-        for (int x = bx * block; x < (bx + 1) * block; x++)
-          for (int c = 0; c < 3; c++) { a += img[3 * (y * w + x) + c]; b += ref[3 * (y * w + x) + c]; }
-      double n = 3.0 * block * block;
-      if (b / n < 0.05 * mean_lum) continue;
-      r->lit_blocks++;
-      double e = fabs(a - b) / b;
-      if (e > r->worst_block) { r->worst_block = e; r->worst_bx = bx; r->worst_by = by; }
-    }
-}
-
 static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int block) {
   const char *obj = shared_file(obj_rel), *refp = shared_file(ref_rel);
   if (!obj || !refp) return TEST_SKIP;
@@ -58,7 +33,7 @@ static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int 
   CHECK(ref.w == 256 && ref.h == 256, "reference is %dx%d", ref.w, ref.h);
   for (int i = 0; i < 256 * 256 * 3; i++) CHECK(isfinite(img[i]) && img[i] >= 0, "pixel value %g at %d", img[i], i);
   cmp_result cr;
-  compare(img, ref.rgb, 256, 256, block, &cr);
+  compare_images(img, ref.rgb, 256, 256, block, &cr);
   valo_stats st;
   valo_render_stats(r, &st);
   fprintf(stderr, "%s at %d spp (%.1f s): mean error R %.3f%% G %.3f%% B %.3f%%; worst of %d lit %dx%d blocks %.2f%% at (%d,%d)\n",
