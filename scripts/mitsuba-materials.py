@@ -42,6 +42,14 @@ SCENES = {
 # degrees at 1024 columns, far below a pixel of these renders (0.6 degrees).
 ENV_SOURCE, ENV_ROTATION = "royal_esplanade_1k.hdr", 60.0
 ENV_SCENES = {"env-spheres": [{"type": "diffuse", "reflectance": 0.8}, {"type": "conductor", **GOLD, "roughness": 0.3}]}
+# Lit by one punctual light each, in its units: a spot of 8 W/sr with a hard 25-degree cone
+# (valo's smoothstep edge and Mitsuba's linear one both made 0.01 degrees wide) and a sun of
+# 3 W/m^2; a diffuse sphere (0.7) on the floor.
+LIGHT_SCENES = {
+    "spot-light": [{"type": "spot", "position": [1.2, 2.6, 0.8], "look_at": [0, 0.3, 0], "intensity": [8, 8, 8], "cone_angle": 25,
+                    "cone_delta_angle": 0.01}],
+    "sun-light": [{"type": "directional", "direction": [-0.4, -1, -0.5], "irradiance": [3, 3, 3]}],
+}
 WIDTH, HEIGHT = 96, 96
 SHARED = os.path.join(ROOT, "..", "shared")
 CAMERA = {"position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0], "up": [0, 1, 0], "fov": 32}
@@ -79,6 +87,24 @@ def valo_json(name, mat):
                           "lamp": {"type": "diffuse", "reflectance": 0, "emission": LE}},
             "shapes": [{"file": "sphere.obj", "material": "ball", "transform": {"scale": 0.55, "translate": [0, 0.55, 0]}},
                        {"file": "floor.obj", "material": "floor"}, {"file": "lamp.obj", "material": "lamp"}]}
+
+
+def light_json(name, lights):
+    j = valo_json(name, {"type": "diffuse", "reflectance": 0.7})
+    j["materials"].pop("lamp")
+    j["shapes"].pop()
+    j["lights"] = lights
+    return j
+
+
+def mitsuba_light(mi, l):
+    T = mi.ScalarTransform4f
+    if l["type"] == "spot":
+        up = [0, 0, 1] if abs(l["position"][0] - l["look_at"][0]) + abs(l["position"][2] - l["look_at"][2]) < 1e-6 else [0, 1, 0]
+        return {"type": "spot", "to_world": T().look_at(origin=l["position"], target=l["look_at"], up=up),
+                "intensity": {"type": "rgb", "value": l["intensity"]}, "cutoff_angle": l["cone_angle"],
+                "beam_width": l["cone_angle"] - l["cone_delta_angle"]}
+    return {"type": "directional", "direction": l["direction"], "irradiance": {"type": "rgb", "value": l["irradiance"]}}
 
 
 def env_json(name, mats):
@@ -124,6 +150,12 @@ def scene_dict(mi, name, mat, spp):
             d["s%d" % k] = {"type": "obj", "filename": os.path.join(OUT, "sphere.obj"), "face_normals": False,
                             "to_world": T().translate(tr["translate"]) @ T().scale(tr["scale"]), "bsdf": mitsuba_bsdf(mat[k])}
         return d, j["film"]["width"], j["film"]["height"]
+    if name in LIGHT_SCENES:
+        d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)
+        d.pop("lamp")
+        for k, l in enumerate(LIGHT_SCENES[name]):
+            d["light%d" % k] = mitsuba_light(mi, l)
+        return d, w, h
     return {"type": "scene",
              "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
              "sensor": sensor(mi, CAMERA, WIDTH, HEIGHT, spp),
@@ -168,9 +200,13 @@ def main():
         with open(os.path.join(OUT, name + ".json"), "w") as f:
             json.dump(env_json(name, mats), f, indent=1)
             f.write("\n")
+    for name, lights in LIGHT_SCENES.items():
+        with open(os.path.join(OUT, name + ".json"), "w") as f:
+            json.dump(light_json(name, lights), f, indent=1)
+            f.write("\n")
     import mitsuba as mi
     mi.set_variant(a.variant)
-    for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()):
+    for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()):
         if not a.only or a.only == name:
             render(mi, name, mat, a.spp, a.seed)
 
