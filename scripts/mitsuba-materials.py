@@ -22,7 +22,7 @@
 #    about +y where valo's is `rotation`; both look the map up bilinearly;
 #  - camera: pinhole, vertical fov, box pixel filter one pixel wide; path tracing with no
 #    depth limit (Russian roulette from depth 5); an independent sampler.
-import argparse, json, math, os
+import argparse, json, math, os, struct, zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "tests", "data", "materials")
@@ -50,6 +50,10 @@ LIGHT_SCENES = {
                     "cone_delta_angle": 0.01}],
     "sun-light": [{"type": "directional", "direction": [-0.4, -1, -0.5], "irradiance": [3, 3, 3]}],
 }
+# A quad textured with an sRGB PNG under a uniform white environment (radiance = albedo):
+# quadrants red, green, blue, yellow from the image's top-left, so a flipped u or v shows.
+TEXTURE_SCENES = {"textured-quad": "quad-texture.png"}
+QUADRANTS = [(200, 40, 40), (40, 200, 40), (40, 40, 200), (220, 220, 40)]  # TL, TR, BL, BR
 WIDTH, HEIGHT = 96, 96
 SHARED = os.path.join(ROOT, "..", "shared")
 CAMERA = {"position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0], "up": [0, 1, 0], "fov": 32}
@@ -107,6 +111,32 @@ def mitsuba_light(mi, l):
     return {"type": "directional", "direction": l["direction"], "irradiance": {"type": "rgb", "value": l["irradiance"]}}
 
 
+def write_texture(path, n=16):
+    rows = b""
+    for y in range(n):
+        rows += b"\x00"
+        for x in range(n):
+            q = (2 if y >= n // 2 else 0) + (1 if x >= n // 2 else 0)
+            r, g, b = QUADRANTS[q]
+            shade = 0.85 + 0.15 * ((x + y) % 2)  # a texel checker inside each quadrant
+            rows += bytes((int(r * shade), int(g * shade), int(b * shade)))
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+    png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", n, n, 8, 2, 0, 0, 0)) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+    with open(path, "wb") as f:
+        f.write(png)
+    with open(os.path.join(OUT, "quad-uv.obj"), "w") as f:
+        f.write("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n")
+
+
+def texture_json(name, tex):
+    return {"camera": {"position": [0, 0, 3.2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
+            "film": {"width": 96, "height": 96}, "render": {"spp": 16},
+            "materials": {"tex": {"type": "diffuse", "reflectance": tex}},
+            "shapes": [{"file": "quad-uv.obj", "material": "tex"}],
+            "environment": {"type": "constant", "radiance": 1}}
+
+
 def env_json(name, mats):
     return {"camera": {"position": [0, 0, 4.2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
             "film": {"width": 128, "height": 64}, "render": {"spp": 64},
@@ -150,6 +180,15 @@ def scene_dict(mi, name, mat, spp):
             d["s%d" % k] = {"type": "obj", "filename": os.path.join(OUT, "sphere.obj"), "face_normals": False,
                             "to_world": T().translate(tr["translate"]) @ T().scale(tr["scale"]), "bsdf": mitsuba_bsdf(mat[k])}
         return d, j["film"]["width"], j["film"]["height"]
+    if name in TEXTURE_SCENES:
+        j = texture_json(name, mat)
+        d = {"type": "scene", "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
+             "sensor": sensor(mi, j["camera"], 96, 96, spp),
+             "env": {"type": "constant", "radiance": {"type": "rgb", "value": [1, 1, 1]}},
+             "quad": {"type": "obj", "filename": os.path.join(OUT, "quad-uv.obj"), "face_normals": True,
+                      "bsdf": {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": os.path.join(OUT, mat),
+                                                                  "filter_type": "bilinear"}}}}
+        return d, 96, 96
     if name in LIGHT_SCENES:
         d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)
         d.pop("lamp")
@@ -200,13 +239,18 @@ def main():
         with open(os.path.join(OUT, name + ".json"), "w") as f:
             json.dump(env_json(name, mats), f, indent=1)
             f.write("\n")
+    for name, tex in TEXTURE_SCENES.items():
+        write_texture(os.path.join(OUT, tex))
+        with open(os.path.join(OUT, name + ".json"), "w") as f:
+            json.dump(texture_json(name, tex), f, indent=1)
+            f.write("\n")
     for name, lights in LIGHT_SCENES.items():
         with open(os.path.join(OUT, name + ".json"), "w") as f:
             json.dump(light_json(name, lights), f, indent=1)
             f.write("\n")
     import mitsuba as mi
     mi.set_variant(a.variant)
-    for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()):
+    for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()):
         if not a.only or a.only == name:
             render(mi, name, mat, a.spp, a.seed)
 

@@ -59,6 +59,9 @@ static int gold_rough(void) { return against_mitsuba("gold-rough", 512, 16, 0); 
 static int copper_smooth(void) { return against_mitsuba("copper-smooth", 1024, 16, 0); }
 static int glass_rough(void) { return against_mitsuba("glass-rough", 1536, 16, 0); }
 static int glass_smooth(void) { return against_mitsuba("glass-smooth", 1024, 32, 0); }
+/* an sRGB PNG on an OBJ quad (UVs from the file) under a uniform white sky: decoding,
+ * filtering and the orientation of u and v */
+static int textured_quad(void) { return against_mitsuba("textured-quad", 64, 16, 0); }
 /* punctual lights in their units: a spot (W/sr, hard cone) and a sun (W/m^2) */
 static int spot_light(void) { return against_mitsuba("spot-light", 256, 16, 0); }
 static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
@@ -75,6 +78,7 @@ static int env_spheres(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
-                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {NULL, NULL}};
+                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"textured_quad", textured_quad},
+                                    {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
