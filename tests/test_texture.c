@@ -414,11 +414,118 @@ static int stress_no_nan(void) {
   return 0;
 }
 
+/* Base64 of n bytes into out (NUL-terminated). */
+static void base64(const unsigned char *in, size_t n, char *out) {
+  static const char *a = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  size_t o = 0;
+  for (size_t i = 0; i < n; i += 3) {
+    uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
+    out[o++] = a[v >> 18 & 63];
+    out[o++] = a[v >> 12 & 63];
+    out[o++] = i + 1 < n ? a[v >> 6 & 63] : '=';
+    out[o++] = i + 2 < n ? a[v & 63] : '=';
+  }
+  out[o] = 0;
+}
+
+/* UV orientation (issue 12): the same four-quadrant texture (red, green, blue, yellow from
+ * the image's top-left: tests/data/materials/quad-texture.png) on a quad through OBJ
+ * (v = 0 at the image's bottom), glTF and glb (v = 0 at its top, the image embedded in
+ * the .glb), under a uniform white sky: each quadrant of the render shows its colour. */
+static int uv_orientation(void) {
+  const char *png_src = VALO_SOURCE_DIR "/tests/data/materials/quad-texture.png";
+  FILE *f = fopen(png_src, "rb");
+  CHECK(f, "cannot open %s", png_src);
+  unsigned char png[4096];
+  size_t png_n = fread(png, 1, sizeof png, f);
+  fclose(f);
+  CHECK(png_n > 8 && png_n < sizeof png, "texture of %zu bytes", png_n);
+  char pngp[1200];
+  snprintf(pngp, sizeof pngp, "%s/quad-texture.png", scratch_dir());
+  f = fopen(pngp, "wb");
+  CHECK(f && fwrite(png, 1, png_n, f) == png_n, "write");
+  fclose(f);
+  CHECK(scratch_file("uvq.obj", "mtllib uvq.mtl\nusemtl t\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n") &&
+            scratch_file("uvq.mtl", "newmtl t\nKd 1 1 1\nmap_Kd quad-texture.png\n"),
+        "write");
+  /* glTF buffer: positions, texcoords (v down), indices */
+  unsigned char bin[92 + 4096];
+  const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+  const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  memcpy(bin, pos, 48);
+  memcpy(bin + 48, uv, 32);
+  memcpy(bin + 80, idx, 12);
+  static char b64[256], json[4096];
+  base64(bin, 92, b64);
+  const char *fmt =
+      "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],"
+      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],"
+      " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, \"metallicFactor\": 0, \"roughnessFactor\": 1}}],"
+      " \"textures\": [{\"source\": 0}], \"images\": [%s],"
+      " \"buffers\": [{\"byteLength\": %d%s}],"
+      " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},"
+      " {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}%s],"
+      " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, -1, 0], \"max\": [1, 1, 0]},"
+      " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}";
+  char uri[300];
+  snprintf(uri, sizeof uri, ", \"uri\": \"data:application/octet-stream;base64,%s\"", b64);
+  snprintf(json, sizeof json, fmt, "{\"uri\": \"quad-texture.png\"}", 92, uri, "");
+  CHECK(scratch_file("uvq.gltf", json), "write");
+  /* .glb: the image in the binary chunk after the geometry (4-byte aligned) */
+  memcpy(bin + 92, png, png_n);
+  size_t bin_n = (92 + png_n + 3) & ~(size_t)3;
+  memset(bin + 92 + png_n, 0, bin_n - 92 - png_n);
+  char view[200];
+  snprintf(view, sizeof view, ", {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": %zu}", png_n);
+  snprintf(json, sizeof json, fmt, "{\"bufferView\": 3, \"mimeType\": \"image/png\"}", (int)bin_n, "", view);
+  size_t json_n = (strlen(json) + 3) & ~(size_t)3;
+  while (strlen(json) < json_n) strcat(json, " ");
+  char glb[1200];
+  snprintf(glb, sizeof glb, "%s/uvq.glb", scratch_dir());
+  f = fopen(glb, "wb");
+  CHECK(f, "write");
+  uint32_t head[3] = {0x46546C67u, 2, (uint32_t)(12 + 8 + json_n + 8 + bin_n)}, cj[2] = {(uint32_t)json_n, 0x4E4F534Au},
+           cb[2] = {(uint32_t)bin_n, 0x004E4942u};
+  fwrite(head, 4, 3, f);
+  fwrite(cj, 4, 2, f);
+  fwrite(json, 1, json_n, f);
+  fwrite(cb, 4, 2, f);
+  fwrite(bin, 1, bin_n, f);
+  fclose(f);
+  const char *files[3] = {"uvq.obj", "uvq.gltf", "uvq.glb"};
+  for (int k = 0; k < 3; k++) {
+    char sj[1024];
+    snprintf(sj, sizeof sj,
+             "{ \"camera\": {\"position\": [0,0,3.2], \"look_at\": [0,0,0], \"fov\": 40}, \"film\": {\"width\": 32, \"height\": 32},\n"
+             "  \"render\": {\"spp\": 4}, \"shapes\": [{\"file\": \"%s\"}], \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n",
+             files[k]);
+    int w, h;
+    valo_options o;
+    valo_options_init(&o);
+    float *px = render_json_text(sj, &o, &w, &h);
+    CHECK(px, "%s: render failed", files[k]);
+    /* quadrant centres: (8,8) top-left ... (24,24) bottom-right, image rows from the top */
+    const int at[4][2] = {{9, 9}, {22, 9}, {9, 22}, {22, 22}};
+    const char *want[4] = {"red", "green", "blue", "yellow"};
+    for (int q = 0; q < 4; q++) {
+      const float *c = &px[3 * (at[q][1] * w + at[q][0])];
+      int ok = q == 0 ? c[0] > 3 * c[1] && c[0] > 3 * c[2]
+             : q == 1 ? c[1] > 3 * c[0] && c[1] > 3 * c[2]
+             : q == 2 ? c[2] > 3 * c[0] && c[2] > 3 * c[1]
+                      : c[0] > 3 * c[2] && c[1] > 3 * c[2];
+      fprintf(stderr, "%s: %s quadrant (%.3f %.3f %.3f)\n", files[k], want[q], c[0], c[1], c[2]);
+      CHECK(ok, "%s: the %s quadrant shows (%.3f %.3f %.3f)", files[k], want[q], c[0], c[1], c[2]);
+    }
+    free(px);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
-                                    {"stress_no_nan", stress_no_nan}, {NULL, NULL}};
+                                    {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
