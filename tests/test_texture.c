@@ -428,6 +428,56 @@ static void base64(const unsigned char *in, size_t n, char *out) {
   out[o] = 0;
 }
 
+/* Writes a glTF 2.0 quad (-1..1 in x and y, facing +z, texcoord (0,0) at its top-left
+ * as glTF defines) with PNG `png` as its base-colour texture: a .gltf whose image is
+ * "quad-texture.png" beside it (the caller writes that file), or a .glb holding the image
+ * in its binary chunk. `material_extra` is added to the material (e.g. alphaMode).
+ * Returns 0 on success. */
+static int write_gltf_quad(const char *name, const unsigned char *png, size_t png_n, const char *material_extra, int glb) {
+  static unsigned char bin[92 + 65536];
+  static char b64[256], json[4096];
+  if (png_n > 65536) return -1;
+  const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+  const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  memcpy(bin, pos, 48);
+  memcpy(bin + 48, uv, 32);
+  memcpy(bin + 80, idx, 12);
+  base64(bin, 92, b64);
+  const char *fmt =
+      "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],"
+      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],"
+      " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, \"metallicFactor\": 0, \"roughnessFactor\": 1}%s}],"
+      " \"textures\": [{\"source\": 0}], \"images\": [%s],"
+      " \"buffers\": [{\"byteLength\": %d%s}],"
+      " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},"
+      " {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}%s],"
+      " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, -1, 0], \"max\": [1, 1, 0]},"
+      " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}";
+  if (!glb) {
+    char uri[300];
+    snprintf(uri, sizeof uri, ", \"uri\": \"data:application/octet-stream;base64,%s\"", b64);
+    snprintf(json, sizeof json, fmt, material_extra, "{\"uri\": \"quad-texture.png\"}", 92, uri, "");
+    return scratch_file(name, json) ? 0 : -1;
+  }
+  memcpy(bin + 92, png, png_n);
+  size_t bin_n = (92 + png_n + 3) & ~(size_t)3;
+  memset(bin + 92 + png_n, 0, bin_n - 92 - png_n);
+  char view[200];
+  snprintf(view, sizeof view, ", {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": %zu}", png_n);
+  snprintf(json, sizeof json, fmt, material_extra, "{\"bufferView\": 3, \"mimeType\": \"image/png\"}", (int)bin_n, "", view);
+  size_t json_n = (strlen(json) + 3) & ~(size_t)3;
+  while (strlen(json) < json_n) strcat(json, " ");
+  char path[1200];
+  snprintf(path, sizeof path, "%s/%s", scratch_dir(), name);
+  FILE *f = fopen(path, "wb");
+  if (!f) return -1;
+  uint32_t head[3] = {0x46546C67u, 2, (uint32_t)(12 + 8 + json_n + 8 + bin_n)}, cj[2] = {(uint32_t)json_n, 0x4E4F534Au},
+           cb[2] = {(uint32_t)bin_n, 0x004E4942u};
+  int ok = fwrite(head, 4, 3, f) == 3 && fwrite(cj, 4, 2, f) == 2 && fwrite(json, 1, json_n, f) == json_n && fwrite(cb, 4, 2, f) == 2 &&
+           fwrite(bin, 1, bin_n, f) == bin_n;
+  return fclose(f) == 0 && ok ? 0 : -1;
+}
+
 /* UV orientation (issue 12): the same four-quadrant texture (red, green, blue, yellow from
  * the image's top-left: tests/data/materials/quad-texture.png) on a quad through OBJ
  * (v = 0 at the image's bottom), glTF and glb (v = 0 at its top, the image embedded in
@@ -448,50 +498,7 @@ static int uv_orientation(void) {
   CHECK(scratch_file("uvq.obj", "mtllib uvq.mtl\nusemtl t\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n") &&
             scratch_file("uvq.mtl", "newmtl t\nKd 1 1 1\nmap_Kd quad-texture.png\n"),
         "write");
-  /* glTF buffer: positions, texcoords (v down), indices */
-  unsigned char bin[92 + 4096];
-  const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
-  const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-  memcpy(bin, pos, 48);
-  memcpy(bin + 48, uv, 32);
-  memcpy(bin + 80, idx, 12);
-  static char b64[256], json[4096];
-  base64(bin, 92, b64);
-  const char *fmt =
-      "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],"
-      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],"
-      " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, \"metallicFactor\": 0, \"roughnessFactor\": 1}}],"
-      " \"textures\": [{\"source\": 0}], \"images\": [%s],"
-      " \"buffers\": [{\"byteLength\": %d%s}],"
-      " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},"
-      " {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}%s],"
-      " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, -1, 0], \"max\": [1, 1, 0]},"
-      " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}";
-  char uri[300];
-  snprintf(uri, sizeof uri, ", \"uri\": \"data:application/octet-stream;base64,%s\"", b64);
-  snprintf(json, sizeof json, fmt, "{\"uri\": \"quad-texture.png\"}", 92, uri, "");
-  CHECK(scratch_file("uvq.gltf", json), "write");
-  /* .glb: the image in the binary chunk after the geometry (4-byte aligned) */
-  memcpy(bin + 92, png, png_n);
-  size_t bin_n = (92 + png_n + 3) & ~(size_t)3;
-  memset(bin + 92 + png_n, 0, bin_n - 92 - png_n);
-  char view[200];
-  snprintf(view, sizeof view, ", {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": %zu}", png_n);
-  snprintf(json, sizeof json, fmt, "{\"bufferView\": 3, \"mimeType\": \"image/png\"}", (int)bin_n, "", view);
-  size_t json_n = (strlen(json) + 3) & ~(size_t)3;
-  while (strlen(json) < json_n) strcat(json, " ");
-  char glb[1200];
-  snprintf(glb, sizeof glb, "%s/uvq.glb", scratch_dir());
-  f = fopen(glb, "wb");
-  CHECK(f, "write");
-  uint32_t head[3] = {0x46546C67u, 2, (uint32_t)(12 + 8 + json_n + 8 + bin_n)}, cj[2] = {(uint32_t)json_n, 0x4E4F534Au},
-           cb[2] = {(uint32_t)bin_n, 0x004E4942u};
-  fwrite(head, 4, 3, f);
-  fwrite(cj, 4, 2, f);
-  fwrite(json, 1, json_n, f);
-  fwrite(cb, 4, 2, f);
-  fwrite(bin, 1, bin_n, f);
-  fclose(f);
+  CHECK(write_gltf_quad("uvq.gltf", png, png_n, "", 0) == 0 && write_gltf_quad("uvq.glb", png, png_n, "", 1) == 0, "write glTF");
   const char *files[3] = {"uvq.obj", "uvq.gltf", "uvq.glb"};
   for (int k = 0; k < 3; k++) {
     char sj[1024];
@@ -521,11 +528,67 @@ static int uv_orientation(void) {
   return 0;
 }
 
+/* Alpha cutoff (issue 12): a glTF quad whose base colour has alpha 128/255 = 0.502,
+ * alphaMode MASK at cutoffs 0.25, 0.49 (opaque) and 0.51, 0.75 (cut out), 1 unit above a
+ * floor under a point light. Camera rays: from above, the centre shows the quad (red) or
+ * the floor (grey). Shadow rays: from below the quad's plane, the floor under it is dark
+ * or lit. Both on the kd-tree and on Embree. */
+static int alpha_cutoff(void) {
+  unsigned char rgba[4 * 4 * 4];
+  for (int i = 0; i < 16; i++) { rgba[4 * i] = 220; rgba[4 * i + 1] = 30; rgba[4 * i + 2] = 30; rgba[4 * i + 3] = 128; }
+  char pngp[1200];
+  snprintf(pngp, sizeof pngp, "%s/alpha-half.png", scratch_dir());
+  CHECK(stbi_write_png(pngp, 4, 4, 4, rgba, 16), "png");
+  unsigned char png[4096];
+  FILE *f = fopen(pngp, "rb");
+  CHECK(f, "png");
+  size_t png_n = fread(png, 1, sizeof png, f);
+  fclose(f);
+  CHECK(scratch_file("afloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  const double cut[4] = {0.25, 0.49, 0.51, 0.75};
+  const char *accels[2] = {"kdtree", "embree"};
+  for (int k = 0; k < 4; k++) {
+    char extra[128], name[64];
+    snprintf(extra, sizeof extra, ", \"alphaMode\": \"MASK\", \"alphaCutoff\": %.2f", cut[k]);
+    snprintf(name, sizeof name, "cut%d.glb", k);
+    CHECK(write_gltf_quad(name, png, png_n, extra, 1) == 0, "write glb");
+    int opaque = 128 / 255.0 >= cut[k];
+    for (int a = 0; a < 2; a++)
+      for (int view = 0; view < 2; view++) { /* 0: camera rays from above, 1: shadow rays seen from below */
+        char json[1024];
+        snprintf(json, sizeof json,
+                 "{ \"camera\": {\"position\": %s, \"look_at\": [0,0,0], \"fov\": 20},\n"
+                 "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 4, \"max_depth\": 1, \"accel\": \"%s\"},\n"
+                 "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+                 "  \"shapes\": [{\"file\": \"afloor.obj\", \"material\": \"floor\"},\n"
+                 "             {\"file\": \"%s\", \"transform\": {\"rotate_x\": -90, \"translate\": [0, 1, 0]}}],\n"
+                 "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+                 view ? "[3, 0.4, 0.01]" : "[0, 4, 0.01]", accels[a], name);
+        int w, h;
+        float *px = render_json_text(json, NULL, &w, &h);
+        CHECK(px, "render failed");
+        const float *c = &px[3 * (4 * w + 4)];
+        fprintf(stderr, "cutoff %.2f, %s, %s: centre (%.3f %.3f %.3f)\n", cut[k], accels[a], view ? "floor under the quad" : "from above", c[0], c[1],
+                c[2]);
+        if (!view) {
+          int red = c[0] > 3 * c[1];
+          CHECK(red == opaque, "cutoff %.2f (%s): camera rays %s the quad", cut[k], accels[a], red ? "hit" : "passed through");
+        } else {
+          int lit = c[1] > 0.05f;
+          CHECK(lit == !opaque, "cutoff %.2f (%s): the floor under the quad is %s", cut[k], accels[a], lit ? "lit" : "in shadow");
+        }
+        free(px);
+      }
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
-                                    {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation}, {NULL, NULL}};
+                                    {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
+                                    {"alpha_cutoff", alpha_cutoff}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
