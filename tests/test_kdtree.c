@@ -21,6 +21,14 @@
 
 typedef struct bf_job { const scene *s; const ray *rays; hit *hits; int *found; int *occl; float *occl_tmax; } bf_job;
 
+/* The hit filter under test (NULL: none), given to the structure and applied by brute
+ * force in the same way: a hit on a flagged triangle counts only if it passes. */
+static const accel_filter *g_filter;
+static int filter_passes(uint32_t t, float b1, float b2) {
+  const accel_filter *f = g_filter;
+  return !f || !(f->tri_flags[t] & f->flag_bit) || f->pass(f->user, t, b1, b2);
+}
+
 static void brute(void *user, int64_t i, int thread) {
   (void)thread;
   bf_job *j = user;
@@ -34,7 +42,7 @@ static void brute(void *user, int64_t i, int thread) {
     float v[9];
     for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &s->pos[s->idx[3 * t + k]], sizeof(vec3));
     float tt, b1, b2;
-    if (tri_intersect(&sh, v, INFINITY, &tt, &b1, &b2)) {
+    if (tri_intersect(&sh, v, INFINITY, &tt, &b1, &b2) && filter_passes(t, b1, b2)) {
       if (tt < j->occl_tmax[i]) occl = 1;
       if (tt < best) { best = tt; h.t = tt; h.b1 = b1; h.b2 = b2; h.tri = t; found = 1; }
     }
@@ -101,7 +109,7 @@ static int check_scene_rays(const char *path, int nrays, const char *kind, int a
   CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   accel *a;
-  CHECK(accel_create(kind, s->pos, s->idx, s->ntris, 1, NULL, &a, &err) == VALO_OK, "%s", err.message);
+  CHECK(accel_create(kind, s->pos, s->idx, s->ntris, 1, g_filter, &a, &err) == VALO_OK, "%s", err.message);
   ray *rays = malloc(nrays * sizeof *rays);
   float *stmax = malloc(nrays * sizeof *stmax);
   hit *bh = malloc(nrays * sizeof *bh);
@@ -160,6 +168,28 @@ static int suzanne_kdtree(void) { return check_scene(shared_file("scenes/models/
 static int axis_rays_kdtree(void) {
   int r = check_scene_rays(shared_file("scenes/cornell/CornellBox-Original.obj"), nrays_big(), "kdtree", 1);
   return r ? r : check_scene_rays(shared_file("scenes/models/suzanne.obj"), nrays_big(), "kdtree", 1);
+}
+/* An alpha-like hit filter: on every other triangle (flagged), a pattern of holes that
+ * depends on where the triangle is hit (16 x 16 cells of barycentric space, a third of them
+ * open), as an alpha texture would. The kd-tree (exactly) and Embree (within tolerance)
+ * must find what brute force finds with the same filter, for closest hits and shadows. */
+static int holes(const void *user, uint32_t tri, float b1, float b2) {
+  (void)user;
+  uint32_t h = tri * 2654435761u ^ (uint32_t)(b1 * 16) * 40503u ^ (uint32_t)(b2 * 16) * 9973u;
+  h ^= h >> 15;
+  return h % 3 != 0;
+}
+static int alpha_filtered(void) {
+  const char *path = shared_file("scenes/models/suzanne.obj");
+  if (!path) return TEST_SKIP;
+  static uint8_t flags[1 << 20];
+  for (uint32_t t = 0; t < sizeof flags; t++) flags[t] = (t & 1) ? 4 : 0;
+  accel_filter f = {holes, NULL, flags, 4};
+  g_filter = &f;
+  int r = check_scene_rays(path, nrays_big(), "kdtree", 0);
+  if (!r && embree_available()) r = check_scene_rays(path, nrays_big(), "embree", 0);
+  g_filter = NULL;
+  return r;
 }
 static int bunny_embree(void) { return check_scene(shared_file("scenes/models/stanford-bunny.obj"), 20000, "embree"); }
 static int cornell_embree(void) { return check_scene(shared_file("scenes/cornell/CornellBox-Original.obj"), nrays_big(), "embree"); }
@@ -418,6 +448,6 @@ int main(int argc, char **argv) {
                                     {"cornell_sphere_kdtree", cornell_sphere_kdtree}, {"suzanne_kdtree", suzanne_kdtree},
                                     {"axis_rays_kdtree", axis_rays_kdtree}, {"camera_rays_kdtree", camera_rays_kdtree},
                                     {"bunny_embree", bunny_embree}, {"cornell_embree", cornell_embree},
-                                    {"large_triangles_corner", large_triangles_corner}, {NULL, NULL}};
+                                    {"large_triangles_corner", large_triangles_corner}, {"alpha_filtered", alpha_filtered}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
