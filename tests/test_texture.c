@@ -429,42 +429,48 @@ static void base64(const unsigned char *in, size_t n, char *out) {
 }
 
 /* Writes a glTF 2.0 quad (-1..1 in x and y, facing +z, texcoord (0,0) at its top-left
- * as glTF defines) with PNG `png` as its base-colour texture: a .gltf whose image is
+ * as glTF defines, normals +z and TANGENT (0, 1, 0, 1): along +v, not +u, so a renderer
+ * that recomputes tangents from the UVs shows) with PNG `png` as its base-colour texture: a .gltf whose image is
  * "quad-texture.png" beside it (the caller writes that file), or a .glb holding the image
  * in its binary chunk. `material_extra` is added to the material (e.g. alphaMode).
  * Returns 0 on success. */
 static int write_gltf_quad(const char *name, const unsigned char *png, size_t png_n, const char *material_extra, int glb) {
-  static unsigned char bin[92 + 65536];
-  static char b64[256], json[4096];
+  static unsigned char bin[204 + 65536];
+  static char b64[400], json[4096];
   if (png_n > 65536) return -1;
   const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, uv[8] = {0, 1, 1, 1, 1, 0, 0, 0};
+  const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, tan[16] = {0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, 1};
   const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
   memcpy(bin, pos, 48);
   memcpy(bin + 48, uv, 32);
   memcpy(bin + 80, idx, 12);
-  base64(bin, 92, b64);
+  memcpy(bin + 92, nrm, 48);
+  memcpy(bin + 140, tan, 64);
+  base64(bin, 204, b64);
   const char *fmt =
       "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],"
-      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],"
+      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1, \"NORMAL\": 3, \"TANGENT\": 4}, \"indices\": 2, \"material\": 0}]}],"
       " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}, \"metallicFactor\": 0, \"roughnessFactor\": 1}%s}],"
       " \"textures\": [{\"source\": 0}], \"images\": [%s],"
       " \"buffers\": [{\"byteLength\": %d%s}],"
       " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},"
-      " {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}%s],"
+      " {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}, {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": 48},"
+      " {\"buffer\": 0, \"byteOffset\": 140, \"byteLength\": 64}%s],"
       " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, -1, 0], \"max\": [1, 1, 0]},"
-      " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}";
+      " {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"},"
+      " {\"bufferView\": 3, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\"}, {\"bufferView\": 4, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC4\"}]}";
   if (!glb) {
-    char uri[300];
+    char uri[600];
     snprintf(uri, sizeof uri, ", \"uri\": \"data:application/octet-stream;base64,%s\"", b64);
-    snprintf(json, sizeof json, fmt, material_extra, "{\"uri\": \"quad-texture.png\"}", 92, uri, "");
+    snprintf(json, sizeof json, fmt, material_extra, "{\"uri\": \"quad-texture.png\"}", 204, uri, "");
     return scratch_file(name, json) ? 0 : -1;
   }
-  memcpy(bin + 92, png, png_n);
-  size_t bin_n = (92 + png_n + 3) & ~(size_t)3;
-  memset(bin + 92 + png_n, 0, bin_n - 92 - png_n);
+  memcpy(bin + 204, png, png_n);
+  size_t bin_n = (204 + png_n + 3) & ~(size_t)3;
+  memset(bin + 204 + png_n, 0, bin_n - 204 - png_n);
   char view[200];
-  snprintf(view, sizeof view, ", {\"buffer\": 0, \"byteOffset\": 92, \"byteLength\": %zu}", png_n);
-  snprintf(json, sizeof json, fmt, material_extra, "{\"bufferView\": 3, \"mimeType\": \"image/png\"}", (int)bin_n, "", view);
+  snprintf(view, sizeof view, ", {\"buffer\": 0, \"byteOffset\": 204, \"byteLength\": %zu}", png_n);
+  snprintf(json, sizeof json, fmt, material_extra, "{\"bufferView\": 5, \"mimeType\": \"image/png\"}", (int)bin_n, "", view);
   size_t json_n = (strlen(json) + 3) & ~(size_t)3;
   while (strlen(json) < json_n) strcat(json, " ");
   char path[1200];
@@ -583,12 +589,68 @@ static int alpha_cutoff(void) {
   return 0;
 }
 
+/* Normal maps in shading (issue 12): a map tilting the normal 30 degrees towards +T on a
+ * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
+ * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
+ * from 30 degrees off towards where the normal should tilt: 0.5 * 2 / pi (60 degrees
+ * off if it tilted the other way: half that). T is +x for plain UVs, -x for mirrored UVs
+ * (u -> 1 - u) and +y for the glTF quad, whose TANGENT attribute says +y. Within 1e-3. */
+static int normal_map_shading(void) {
+  allow_shading_loss(TILT_LOSS);
+  unsigned char bytes[4 * 4 * 3];
+  const double th = 30 * M_PI / 180, nt[3] = {sin(th), 0, cos(th)};
+  for (int i = 0; i < 16; i++)
+    for (int c = 0; c < 3; c++) bytes[3 * i + c] = (unsigned char)lrint((nt[c] * 0.5 + 0.5) * 255);
+  char png[1200];
+  snprintf(png, sizeof png, "%s/tilt30.png", scratch_dir());
+  CHECK(stbi_write_png(png, 4, 4, 3, bytes, 12), "png");
+  /* the 8-bit map's own tilt: what the expected values use */
+  double m[3], len = 0;
+  for (int c = 0; c < 3; c++) { m[c] = bytes[c] / 255.0 * 2 - 1; len += m[c] * m[c]; }
+  double cos_t = m[2] / sqrt(len), sin_t = m[0] / sqrt(len);
+  CHECK(scratch_file("nq_plain.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n") &&
+            scratch_file("nq_mirror.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"),
+        "write");
+  unsigned char dummy[64];
+  memset(dummy, 200, sizeof dummy);
+  char dp[1200];
+  snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
+  CHECK(stbi_write_png(dp, 4, 4, 4, dummy, 16), "png");
+  CHECK(write_gltf_quad("nq_tangent.gltf", NULL, 0, "", 0) == 0, "write glTF");
+  const struct { const char *file; double tx, ty; } quads[3] = {{"nq_plain.obj", 1, 0}, {"nq_mirror.obj", -1, 0}, {"nq_tangent.gltf", 0, 1}};
+  for (int q = 0; q < 3; q++)
+    for (int tilted = 0; tilted < 2; tilted++) {
+      /* light travelling down -z, or from 30 degrees towards the expected tilt */
+      double d[3] = {tilted ? -sin(th) * quads[q].tx : 0, tilted ? -sin(th) * quads[q].ty : 0, -(tilted ? cos(th) : 1)};
+      char json[1024];
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0,0,4], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 10}, \"film\": {\"width\": 8, \"height\": 8},\n"
+               "  \"render\": {\"spp\": 1, \"max_depth\": 1},\n"
+               "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"normal_map\": \"tilt30.png\"}},\n"
+               "  \"shapes\": [{\"file\": \"%s\", \"material\": \"m\"}],\n"
+               "  \"lights\": [{\"type\": \"directional\", \"direction\": [%.9f, %.9f, %.9f], \"irradiance\": 2}] }\n",
+               quads[q].file, d[0], d[1], d[2]);
+      int w, h;
+      float *px = render_json_text(json, NULL, &w, &h);
+      CHECK(px, "%s: render failed", quads[q].file);
+      double got = px[3 * (4 * w + 4)];
+      free(px);
+      /* cos between the tilted normal (sin_t along T, cos_t along z) and the light */
+      double cosl = -(sin_t * (quads[q].tx * d[0] + quads[q].ty * d[1]) + cos_t * d[2]);
+      double want = 0.5 * 2 * cosl / M_PI;
+      fprintf(stderr, "%s, light %s: radiance %.5f, expected %.5f\n", quads[q].file, tilted ? "30 degrees off" : "along the normal", got, want);
+      CHECK(fabs(got - want) <= 1e-3 * want, "%s: %.5f, expected %.5f", quads[q].file, got, want);
+    }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {NULL, NULL}};
+                                    {"alpha_cutoff", alpha_cutoff},
+                                    {"normal_map_shading", normal_map_shading}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

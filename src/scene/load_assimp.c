@@ -274,6 +274,17 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
       if (!v3_finite(n)) n = v3(0, 0, 0);
     }
     s->nrm[base + v] = n;
+    float *tf = &s->tan_file[4 * (size_t)(base + v)];
+    tf[0] = tf[1] = tf[2] = tf[3] = 0;
+    if (c->gltf && mesh->mTangents && mesh->mBitangents && mesh->mNormals && v3_len2(n) > 0) {
+      /* glTF TANGENT (xyz, w): Assimp gives the tangent and the bitangent w (n x t) */
+      vec3 t = m34_vector(xf, v3(mesh->mTangents[v].x, mesh->mTangents[v].y, mesh->mTangents[v].z));
+      vec3 bt = m34_vector(xf, v3(mesh->mBitangents[v].x, mesh->mBitangents[v].y, mesh->mBitangents[v].z));
+      if (v3_finite(t) && v3_finite(bt) && v3_len2(t) > 0) {
+        tf[0] = t.x; tf[1] = t.y; tf[2] = t.z;
+        tf[3] = v3_dot(v3_cross(n, t), bt) < 0 ? -1.0f : 1.0f;
+      }
+    }
     float u = 0, w = 0;
     if (mesh->mTextureCoords[0]) { u = mesh->mTextureCoords[0][v].x; w = mesh->mTextureCoords[0][v].y; }
     s->uv[2 * (base + v)] = isfinite(u) ? u : 0;

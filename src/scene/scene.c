@@ -18,7 +18,7 @@ scene *scene_new(const char *path) {
 
 void scene_free(scene *s) {
   if (!s) return;
-  free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->idx); free(s->tri_mat); free(s->tri_flags);
+  free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys);
   if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
@@ -43,10 +43,11 @@ int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris) {
   uint64_t nv = (uint64_t)s->nverts + more_verts, nt = (uint64_t)s->ntris + more_tris;
   if (nv > 0xFFFFFFF0u || nt > 0xFFFFFFF0u) return -1;
   if (nv > s->cap_verts) {
-    uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts;
+    uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts, c4 = s->cap_verts;
     if (grow((void **)&s->pos, &c, nv, sizeof(vec3)) || grow((void **)&s->nrm, &c2, nv, sizeof(vec3)) ||
-        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)))
+        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)) || grow((void **)&s->tan_file, &c4, nv, 4 * sizeof(float)))
       return -1;
+    memset(s->tan_file + 4 * (size_t)s->cap_verts, 0, (size_t)(c4 - s->cap_verts) * 4 * sizeof(float)); /* none given */
     s->cap_verts = c;
   }
   if (nt > s->cap_tris) {
@@ -136,9 +137,10 @@ int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2) {
   return (m->alpha_channel ? px[3] : px[0]) >= m->alpha_cutoff;
 }
 
-/* Per-vertex tangents from UV derivatives (dp/du), accumulated area-weighted over the
- * triangles that share a vertex and made orthogonal to the vertex normal (digest 000);
- * the sign of the bitangent follows the UV handedness. */
+/* Per-vertex tangents: the file's where it gave them (glTF TANGENT), else from UV
+ * derivatives (dp/du), accumulated area-weighted over the triangles that share a vertex
+ * and made orthogonal to the vertex normal (digest 000); the sign of the bitangent
+ * follows the UV handedness. */
 static int compute_tangents(scene *s) {
   float *acc = calloc((size_t)s->nverts * 7, sizeof(float)); /* t xyz, b xyz, count */
   s->tan = malloc((size_t)s->nverts * 4 * sizeof(float));
@@ -164,9 +166,18 @@ static int compute_tangents(scene *s) {
     }
   }
   for (uint32_t v = 0; v < s->nverts; v++) {
-    const float *a = &acc[7 * v];
+    const float *a = &acc[7 * v], *given = &s->tan_file[4 * v];
     vec3 n = s->nrm[v], t = v3(a[0], a[1], a[2]), b = v3(a[3], a[4], a[5]);
     float *o = &s->tan[4 * v];
+    if (given[3] != 0 && v3_len2(n) > 0) {
+      vec3 g = v3(given[0], given[1], given[2]);
+      g = v3_sub(g, v3_scale(n, v3_dot(n, g)));
+      if (v3_len2(g) > 1e-12f) {
+        g = v3_norm(g);
+        o[0] = g.x; o[1] = g.y; o[2] = g.z; o[3] = given[3] < 0 ? -1.0f : 1.0f;
+        continue;
+      }
+    }
     if (!(v3_len2(n) > 0) || !(v3_len2(t) > 0)) { o[0] = o[1] = o[2] = 0; o[3] = 1; continue; }
     t = v3_sub(t, v3_scale(n, v3_dot(n, t)));
     t = v3_norm(t);

@@ -80,6 +80,8 @@ typedef struct scene {
   float *tan;              /* 4 per vertex (tangent xyz, bitangent sign), after commit when
                               a material has a normal map; else NULL */
   float *uv;               /* 2 per vertex */
+  float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and
+                              the bitangent sign); w = 0 where it gave none */
   uint32_t nverts, cap_verts;
   uint32_t *idx;           /* 3 per triangle */
   uint32_t *tri_mat;
