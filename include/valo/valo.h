@@ -68,8 +68,9 @@ typedef struct valo_options {
                              also ambient occlusion and the bent normal (one more ray
                              per camera sample); VALO_UNSET = no */
   int adaptive;           /* adaptive sampling (docs/integrators.md): spp is then the average
-                             budget per pixel. VALO_ADAPTIVE_ERROR (1, default rule) or
-                             VALO_ADAPTIVE_DIGEST (2, the digest's priority); 0 or
+                             budget per pixel. VALO_ADAPTIVE_ERROR (1, default rule,
+                             unbiased) or VALO_ADAPTIVE_DIGEST (2, the digest's priority,
+                             biased dark where paths are rare and bright); 0 or
                              VALO_UNSET = no */
   double noise_threshold; /* adaptive: stop when every pixel's relative standard error is
                              below this (e.g. 0.01); VALO_UNSET or <= 0: use the budget */

@@ -445,11 +445,13 @@ static void render_tile(void *user, int64_t item, int thread) {
  * budget (half the samples, or half the time with --time); then rounds give ADAPT_BATCH
  * more samples to the 1/ADAPT_FRACTION of pixels with the highest priority. The
  * priority ("error", the default) is the pixel mean's estimated squared error relative
- * to its brightness, var(L)/N / (mean^2 + 0.01) in luminance (the relMSE that
- * time-to-error is measured in), taken as the larger of the pixel's own and its 3x3
- * neighbourhood's mean: a pixel's few samples miss rare bright paths, which show as one
- * firefly among quiet pixels. "digest" is the digest's priority N sum s^2/(sum s)^2,
- * minus 1 and over N so that it falls as a pixel gets samples, on the pixel alone.
+ * to its brightness, v/N with v = var(L) / (mean^2 + 0.01) in luminance (the relMSE that
+ * time-to-error is measured in); v is measured in the uniform pass on the pixel's 5x5
+ * neighbourhood without the pixel itself (so its mean stays unbiased), N is its own
+ * count, and pixels are ranked by sqrt(v)/N, so N grows as sqrt(v) (the allocation that
+ * minimises the summed relMSE). "digest" is the digest's priority N sum s^2/(sum s)^2, minus 1
+ * and over N so that it falls as a pixel gets samples, on the pixel alone (biased: a
+ * pixel that missed a rare bright path stops early).
  * Measured (docs/performance.md): the old rule gave 5 % at equal time because with
  * --time the uniform pass took the whole budget; a first pass of an eighth of the budget
  * starved quiet pixels on CornellBox-Original. Selection happens between rounds from
@@ -458,6 +460,7 @@ static void render_tile(void *user, int64_t item, int thread) {
 #define ADAPT_FRACTION 8
 #define ADAPT_UNIFORM 0.5
 #define ADAPT_EPS 0.01
+#define ADAPT_RADIUS 2 /* the neighbourhood whose variance sets a pixel's priority */
 
 static double pixel_priority(const valo_render *r, size_t i) {
   double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
@@ -666,34 +669,42 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     double *raw = malloc(np * sizeof *raw);
     if (!raw) { free(pr); free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
     int W = r->opt.width, H = r->opt.height;
+    /* "error": each pixel's relative variance per sample, var(L) / (mean^2 + eps), from
+     * the uniform pass alone and then frozen; a pixel's priority comes from its
+     * neighbours' (5x5 without itself) and its own sample count. A pixel's own samples never decide how many
+     * samples it gets, so its mean stays unbiased (a pixel that happened to miss a rare
+     * bright path is not left with too few samples to find it: test_analytic
+     * adaptive_unbiased); the neighbours share the rare paths a caustic spreads. */
+    int digest = r->opt.adaptive == VALO_ADAPTIVE_DIGEST;
+    if (!digest)
+      for (size_t i = 0; i < np; i++) { double n = r->count[i]; raw[i] = pixel_priority(r, i) * n; }
     while (taken < total) {
-      for (size_t i = 0; i < np; i++) raw[i] = pixel_priority(r, i);
-      /* Each pixel's error estimate from a few samples misses rare bright paths (a caustic
-       * shows as one firefly among quiet pixels): take the 3x3 neighbourhood's mean as well,
-       * so a firefly's neighbours are sampled too. */
       for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
+          size_t i = (size_t)y * W + x;
+          pr[i].i = (uint32_t)i;
+          if (digest) { double pd = pixel_priority(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
           double acc = 0;
           int cnt = 0;
-          for (int dy = -1; dy <= 1; dy++)
-            for (int dx = -1; dx <= 1; dx++) {
+          for (int dy = -ADAPT_RADIUS; dy <= ADAPT_RADIUS; dy++)
+            for (int dx = -ADAPT_RADIUS; dx <= ADAPT_RADIUS; dx++) {
               int xx = x + dx, yy = y + dy;
-              if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+              if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
               acc += raw[(size_t)yy * W + xx];
               cnt++;
             }
-          size_t i = (size_t)y * W + x;
-          double nb = acc / cnt;
-          pr[i].p = r->opt.adaptive == VALO_ADAPTIVE_DIGEST ? raw[i] : (raw[i] > nb ? raw[i] : nb);
-          pr[i].i = (uint32_t)i;
+          /* N grows as the neighbours' relative standard deviation (the allocation that
+           * minimises the summed relMSE), until var/N is below the noise threshold */
+          double v = cnt ? acc / cnt : 0, n = (double)r->count[i];
+          pr[i].p = v / n > thr2 ? sqrt(v) / n : 0;
         }
       size_t sel = k;
       if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
       if (sel == 0) break;
       prio_select(pr, np, sel);
       qsort(pr, sel, sizeof *pr, prio_cmp);
-      if (!(pr[0].p > thr2)) break; /* every pixel below the noise threshold */
-      while (sel > 0 && !(pr[sel - 1].p > thr2)) sel--;
+      if (!(pr[0].p > 0)) break; /* every pixel below the noise threshold */
+      while (sel > 0 && !(pr[sel - 1].p > 0)) sel--;
       adapt_job aj = {r, pr, (int64_t)sel, ts};
       parallel_for(threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
       if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
