@@ -6,6 +6,7 @@
 #   pip install mitsuba
 #   DRJIT_LIBLLVM_PATH=~/.rustup/toolchains/stable-x86_64-unknown-linux-gnu/lib/libLLVM.so.22.1-rust-1.95.0-stable \
 #   python3 scripts/mitsuba-materials.py [--spp 16384] [--only gold-rough]
+#   ... --variant llvm_ad_spectral --only glass-rough   (writes NAME-mitsuba-spectral.exr)
 #
 # Conventions matched (docs/testing.md, "Issue 12"):
 #  - geometry: the OBJ files written here, read by both (valo through Assimp, Mitsuba's own
@@ -215,7 +216,7 @@ def render(mi, name, mat, spp, seed):
     for k in range(passes):
         part = mi.render(s, seed=seed + k, spp=min(spp, 4096))
         img = part if img is None else img + part
-    out = os.path.join(OUT, name + "-mitsuba.exr")
+    out = os.path.join(OUT, name + ("-mitsuba-spectral.exr" if "spectral" in mi.variant() else "-mitsuba.exr"))
     mi.Bitmap(img / passes).write(out)
     print("wrote %s (%dx%d, %d spp, mitsuba %s)" % (out, w, h, passes * min(spp, 4096), mi.__version__), flush=True)
 

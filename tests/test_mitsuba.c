@@ -13,12 +13,12 @@
 
 #define DATA VALO_SOURCE_DIR "/tests/data/materials/"
 
-/* Renders DATA name.json at spp (options: spectral) and compares it with
- * name-mitsuba.exr. */
+/* Renders DATA name.json at spp and compares it with name-mitsuba.exr, or with
+ * `--spectral` against name-mitsuba-spectral.exr (Mitsuba's llvm_ad_spectral). */
 static int against_mitsuba(const char *name, int spp, int block, int spectral) {
   char scene[1024], refp[1024];
   snprintf(scene, sizeof scene, DATA "%s.json", name);
-  snprintf(refp, sizeof refp, DATA "%s-mitsuba.exr", name);
+  snprintf(refp, sizeof refp, DATA "%s-mitsuba%s.exr", name, spectral ? "-spectral" : "");
   valo_options o;
   valo_options_init(&o);
   o.spp = test_full() ? 4 * spp : spp;
@@ -62,6 +62,12 @@ static int glass_smooth(void) { return against_mitsuba("glass-smooth", 1024, 32,
 /* an sRGB PNG on an OBJ quad (UVs from the file) under a uniform white sky: decoding,
  * filtering and the orientation of u and v */
 static int textured_quad(void) { return against_mitsuba("textured-quad", 64, 16, 0); }
+/* spectral mode against Mitsuba's spectral variant (llvm_ad_spectral), rough glass on a
+ * grey floor. Not gold: valo's spectral mode evaluates a conductor's Fresnel term on its
+ * RGB eta and k and uplifts the result, Mitsuba uplifts eta and k and evaluates per
+ * wavelength; from RGB data neither is the physical answer and they differ by 13-18 %
+ * (a spectral comparison needs measured spectral eta, k in valo: not yet). */
+static int glass_rough_spectral(void) { return against_mitsuba("glass-rough", 1536, 16, 1); }
 /* punctual lights in their units: a spot (W/sr, hard cone) and a sun (W/m^2) */
 static int spot_light(void) { return against_mitsuba("spot-light", 256, 16, 0); }
 static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
@@ -79,6 +85,7 @@ int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
                                     {"spot_light", spot_light}, {"sun_light", sun_light}, {"textured_quad", textured_quad},
+                                    {"glass_rough_spectral", glass_rough_spectral},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
