@@ -245,6 +245,19 @@ static int fallback_warnings(void) {
   CHECK(st == VALO_OK, "%s", err.message);
   CHECK(strstr(said, "missing-texture.png") && strstr(said, "ignored"), "no warning naming the unreadable texture: \"%s\"", said);
   CHECK(strstr(said, "nouv.obj") && strstr(said, "no texture coordinates") && strstr(said, "painted"), "no warning about maps without UVs: \"%s\"", said);
+  /* a JSON sphere (no UVs) with a textured material */
+  const char *sj = scratch_file("texsphere.json", "{ \"materials\": {\"painted\": {\"type\": \"diffuse\", \"reflectance\": \"paint.png\"}},\n"
+                                                  "  \"shapes\": [{\"type\": \"sphere\", \"material\": \"painted\"}],\n"
+                                                  "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n");
+  valo_scene *vs = NULL;
+  warnings_capture(1);
+  st = valo_scene_load(sj, &vs, &err);
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  if (vs) valo_scene_destroy(vs);
+  CHECK(st == VALO_OK, "%s", err.message);
+  CHECK(strstr(said, "texsphere.json") && strstr(said, "no texture coordinates") && strstr(said, "painted"), "no warning about a textured sphere: \"%s\"",
+        said);
   /* a glTF camera with yfov 0 (the triangle of LIGHTS_GLTF, seen by a camera node) */
   char gl[4096];
   snprintf(gl, sizeof gl, "%s", LIGHTS_GLTF);

@@ -294,8 +294,7 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   uint32_t mat = c->override_mat != UINT32_MAX ? c->override_mat : c->mat_base + mesh->mMaterialIndex;
   if (mat >= s->nmats) return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' names material %u that does not exist", c->path, mesh->mName.data, mesh->mMaterialIndex);
   const material *mm = &s->mats[mat];
-  if (!mesh->mTextureCoords[0] && (mm->tex_kd >= 0 || mm->tex_ks >= 0 || mm->tex_ke >= 0 || mm->tex_alpha >= 0 || mm->tex_normal >= 0 ||
-                                   mm->tex_ns >= 0 || mm->tex_bump >= 0 || mm->tex_rough >= 0 || mm->tex_metal >= 0 || mm->tex_mr >= 0))
+  if (!mesh->mTextureCoords[0] && material_has_maps(mm))
     log_warning("%s: mesh '%s' has no texture coordinates, so the maps of its material '%s' are ignored", c->path, mesh->mName.data, mm->name);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
     const struct aiFace *face = &mesh->mFaces[f];

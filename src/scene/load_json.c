@@ -495,6 +495,8 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       mat = scene_add_material(c->s, &d);
       if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     }
+    if (material_has_maps(&c->s->mats[mat]))
+      log_warning("%s: %s: a sphere has no texture coordinates, so the maps of material '%s' are ignored", c->s->path, where, c->s->mats[mat].name);
     return scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err);
   }
   return bad(c, where, "unknown shape type (mesh, sphere)");

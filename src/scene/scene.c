@@ -128,6 +128,11 @@ void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, floa
   *v = b0 * s->uv[2 * ix[0] + 1] + b1 * s->uv[2 * ix[1] + 1] + b2 * s->uv[2 * ix[2] + 1];
 }
 
+int material_has_maps(const material *m) {
+  return m->tex_kd >= 0 || m->tex_ks >= 0 || m->tex_ke >= 0 || m->tex_alpha >= 0 || m->tex_normal >= 0 || m->tex_ns >= 0 || m->tex_bump >= 0 ||
+         m->tex_rough >= 0 || m->tex_metal >= 0 || m->tex_mr >= 0;
+}
+
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2) {
   const material *m = &s->mats[s->tri_mat[t]];
   if (m->tex_alpha < 0) return 1;

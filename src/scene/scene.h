@@ -126,6 +126,8 @@ int scene_texture_memory(scene *s, const char *key, const unsigned char *data, s
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);
 /* Alpha-cutout test: 1 if the hit on triangle t at (b1, b2) counts. */
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2);
+/* 1 if the material reads any texture map (which needs texture coordinates). */
+int material_has_maps(const material *m);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
 valo_status scene_commit(scene *s, valo_error *err);
 /* Geometric (unnormalised cross product) normal of triangle t. */
