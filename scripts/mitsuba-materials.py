@@ -232,23 +232,14 @@ def main():
     global SHARED
     SHARED = a.shared
     write_meshes()
-    for name, mat in SCENES.items():
-        with open(os.path.join(OUT, name + ".json"), "w") as f:
-            json.dump(valo_json(name, mat), f, indent=1)
-            f.write("\n")
-    for name, mats in ENV_SCENES.items():
-        with open(os.path.join(OUT, name + ".json"), "w") as f:
-            json.dump(env_json(name, mats), f, indent=1)
-            f.write("\n")
-    for name, tex in TEXTURE_SCENES.items():
+    for tex in TEXTURE_SCENES.values():
         write_texture(os.path.join(OUT, tex))
-        with open(os.path.join(OUT, name + ".json"), "w") as f:
-            json.dump(texture_json(name, tex), f, indent=1)
-            f.write("\n")
-    for name, lights in LIGHT_SCENES.items():
-        with open(os.path.join(OUT, name + ".json"), "w") as f:
-            json.dump(light_json(name, lights), f, indent=1)
-            f.write("\n")
+    kinds = [(SCENES, valo_json), (ENV_SCENES, env_json), (TEXTURE_SCENES, texture_json), (LIGHT_SCENES, light_json)]
+    for table, to_json in kinds:
+        for name, what in table.items():
+            with open(os.path.join(OUT, name + ".json"), "w") as f:
+                json.dump(to_json(name, what), f, indent=1)
+                f.write("\n")
     import mitsuba as mi
     mi.set_variant(a.variant)
     for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()):
