@@ -7,6 +7,7 @@
 #   DRJIT_LIBLLVM_PATH=~/.rustup/toolchains/stable-x86_64-unknown-linux-gnu/lib/libLLVM.so.22.1-rust-1.95.0-stable \
 #   python3 scripts/mitsuba-materials.py [--spp 16384] [--only gold-rough]
 #   ... --variant llvm_ad_spectral --only glass-rough   (writes NAME-mitsuba-spectral.exr)
+#   ... --max-depth 2 --only gold-rough   (valo's max_depth 2 = Mitsuba's 3: NAME-mitsuba-depth2.exr)
 #
 # Conventions matched (docs/testing.md, "Issue 12"):
 #  - geometry: the OBJ files written here, read by both (valo through Assimp, Mitsuba's own
@@ -57,6 +58,8 @@ TEXTURE_SCENES = {"textured-quad": "quad-texture.png"}
 QUADRANTS = [(200, 40, 40), (40, 200, 40), (40, 40, 200), (220, 220, 40)]  # TL, TR, BL, BR
 WIDTH, HEIGHT = 96, 96
 SHARED = os.path.join(ROOT, "..", "shared")
+INTEGRATOR = {"type": "path", "max_depth": -1, "rr_depth": 5}
+SUFFIX = ""
 CAMERA = {"position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0], "up": [0, 1, 0], "fov": 32}
 LE = 12.0
 
@@ -172,7 +175,7 @@ def scene_dict(mi, name, mat, spp):
     T = mi.ScalarTransform4f
     if name in ENV_SCENES:
         j = env_json(name, mat)
-        d = {"type": "scene", "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
+        d = {"type": "scene", "integrator": INTEGRATOR,
              "sensor": sensor(mi, j["camera"], j["film"]["width"], j["film"]["height"], spp),
              "env": {"type": "envmap", "filename": os.path.join(SHARED, "scenes", "envmaps", ENV_SOURCE),
                      "to_world": T().rotate([0, 1, 0], 180 + ENV_ROTATION)}}
@@ -183,7 +186,7 @@ def scene_dict(mi, name, mat, spp):
         return d, j["film"]["width"], j["film"]["height"]
     if name in TEXTURE_SCENES:
         j = texture_json(name, mat)
-        d = {"type": "scene", "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
+        d = {"type": "scene", "integrator": INTEGRATOR,
              "sensor": sensor(mi, j["camera"], 96, 96, spp),
              "env": {"type": "constant", "radiance": {"type": "rgb", "value": [1, 1, 1]}},
              "quad": {"type": "obj", "filename": os.path.join(OUT, "quad-uv.obj"), "face_normals": True,
@@ -197,7 +200,7 @@ def scene_dict(mi, name, mat, spp):
             d["light%d" % k] = mitsuba_light(mi, l)
         return d, w, h
     return {"type": "scene",
-             "integrator": {"type": "path", "max_depth": -1, "rr_depth": 5},
+             "integrator": INTEGRATOR,
              "sensor": sensor(mi, CAMERA, WIDTH, HEIGHT, spp),
              "ball": {"type": "obj", "filename": os.path.join(OUT, "sphere.obj"), "face_normals": False,
                       "to_world": T().translate([0, 0.55, 0]) @ T().scale(0.55), "bsdf": mitsuba_bsdf(mat)},
@@ -216,7 +219,7 @@ def render(mi, name, mat, spp, seed):
     for k in range(passes):
         part = mi.render(s, seed=seed + k, spp=min(spp, 4096))
         img = part if img is None else img + part
-    out = os.path.join(OUT, name + ("-mitsuba-spectral.exr" if "spectral" in mi.variant() else "-mitsuba.exr"))
+    out = os.path.join(OUT, name + "-mitsuba" + ("-spectral" if "spectral" in mi.variant() else "") + SUFFIX + ".exr")
     mi.Bitmap(img / passes).write(out)
     print("wrote %s (%dx%d, %d spp, mitsuba %s)" % (out, w, h, passes * min(spp, 4096), mi.__version__), flush=True)
 
@@ -228,9 +231,13 @@ def main():
     ap.add_argument("--variant", default="llvm_ad_rgb")
     ap.add_argument("--seed", type=int, default=11)
     ap.add_argument("--shared", default=os.path.join(ROOT, "..", "shared"))
+    ap.add_argument("--max-depth", type=int, default=-1, help="valo's max_depth D (bounces); Mitsuba's max_depth is D + 1")
     a = ap.parse_args()
-    global SHARED
+    global SHARED, INTEGRATOR, SUFFIX
     SHARED = a.shared
+    if a.max_depth >= 0:
+        INTEGRATOR = {"type": "path", "max_depth": a.max_depth + 1, "rr_depth": 1000}
+        SUFFIX = "-depth%d" % a.max_depth
     write_meshes()
     for tex in TEXTURE_SCENES.values():
         write_texture(os.path.join(OUT, tex))

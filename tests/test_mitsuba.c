@@ -13,14 +13,22 @@
 
 #define DATA VALO_SOURCE_DIR "/tests/data/materials/"
 
-/* Renders DATA name.json at spp and compares it with name-mitsuba.exr, or with
- * `--spectral` against name-mitsuba-spectral.exr (Mitsuba's llvm_ad_spectral). */
-static int against_mitsuba(const char *name, int spp, int block, int spectral) {
-  char scene[1024], refp[1024];
+/* Renders DATA name.json at spp and compares it with name-mitsuba.exr; with `--spectral`
+ * against name-mitsuba-spectral.exr (Mitsuba's llvm_ad_spectral); with max_depth D >= 0
+ * against name-mitsuba-depthD.exr (Mitsuba's path at max_depth D + 1, its count of the
+ * same paths). integrator NULL: path. */
+static int against(const char *name, int spp, int block, int spectral, const char *integrator, int max_depth);
+static int against_mitsuba(const char *name, int spp, int block, int spectral) { return against(name, spp, block, spectral, NULL, -1); }
+
+static int against(const char *name, int spp, int block, int spectral, const char *integrator, int max_depth) {
+  char scene[1024], refp[1024], depth[32] = "";
+  if (max_depth >= 0) snprintf(depth, sizeof depth, "-depth%d", max_depth);
   snprintf(scene, sizeof scene, DATA "%s.json", name);
-  snprintf(refp, sizeof refp, DATA "%s-mitsuba%s.exr", name, spectral ? "-spectral" : "");
+  snprintf(refp, sizeof refp, DATA "%s-mitsuba%s%s.exr", name, spectral ? "-spectral" : "", depth);
   valo_options o;
   valo_options_init(&o);
+  if (integrator) snprintf(o.integrator, sizeof o.integrator, "%s", integrator);
+  if (max_depth >= 0) o.max_depth = max_depth;
   o.spp = test_full() ? 4 * spp : spp;
   o.seed = 5;
   o.spectral = spectral;
@@ -37,8 +45,8 @@ static int against_mitsuba(const char *name, int spp, int block, int spectral) {
   CHECK(ref.w == st.width && ref.h == st.height, "reference %dx%d, render %dx%d", ref.w, ref.h, st.width, st.height);
   cmp_result cr;
   compare_images(img, ref.rgb, ref.w, ref.h, block, &cr);
-  fprintf(stderr, "%s%s at %d spp (%.1f s): mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit %dx%d blocks %.2f%% at (%d,%d)\n", name,
-          spectral ? " (spectral)" : "", o.spp, st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2],
+  fprintf(stderr, "%s%s, %s%s at %d spp (%.1f s): mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit %dx%d blocks %.2f%% at (%d,%d)\n", name,
+          spectral ? " (spectral)" : "", integrator ? integrator : "path", depth, o.spp, st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2],
           cr.lit_blocks, block, block, 100 * cr.worst_block, cr.worst_bx, cr.worst_by);
   if (getenv("VALO_TEST_KEEP")) {
     char out[300];
@@ -50,7 +58,7 @@ static int against_mitsuba(const char *name, int spp, int block, int spectral) {
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   for (int c = 0; c < 3; c++) CHECK(cr.mean_err[c] < 0.01, "%s: channel %d mean differs by %.2f%%", name, c, 100 * cr.mean_err[c]);
-  CHECK(cr.lit_blocks >= 8, "%s: only %d lit blocks", name, cr.lit_blocks);
+  CHECK(cr.lit_blocks >= (st.width / block) * (st.height / block) / 2, "%s: only %d lit blocks", name, cr.lit_blocks);
   CHECK(cr.worst_block < 0.03, "%s: block (%d,%d) differs by %.2f%%", name, cr.worst_bx, cr.worst_by, 100 * cr.worst_block);
   return 0;
 }
@@ -68,6 +76,12 @@ static int textured_quad(void) { return against_mitsuba("textured-quad", 64, 16,
  * wavelength; from RGB data neither is the physical answer and they differ by 13-18 %
  * (a spectral comparison needs measured spectral eta, k in valo: not yet). */
 static int glass_rough_spectral(void) { return against_mitsuba("glass-rough", 1536, 16, 1); }
+/* distribution ray tracing (and path) truncated at two bounces against Mitsuba's path
+ * at the same depth: independent of valo's own path */
+static int distribution_depth2(void) {
+  int r = against("gold-rough", 256, 32, 0, "distribution", 2); /* light sampling alone: noisy highlights */
+  return r ? r : against("gold-rough", 256, 16, 0, "path", 2);
+}
 /* punctual lights in their units: a spot (W/sr, hard cone) and a sun (W/m^2) */
 static int spot_light(void) { return against_mitsuba("spot-light", 256, 16, 0); }
 static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
@@ -85,7 +99,7 @@ int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
                                     {"spot_light", spot_light}, {"sun_light", sun_light}, {"textured_quad", textured_quad},
-                                    {"glass_rough_spectral", glass_rough_spectral},
+                                    {"glass_rough_spectral", glass_rough_spectral}, {"distribution_depth2", distribution_depth2},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
