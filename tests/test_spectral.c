@@ -59,7 +59,7 @@ static int rgb_equals_spectral(void) {
   fprintf(stderr, "grey furnace: RGB (%.4f %.4f %.4f), spectral (%.4f %.4f %.4f)\n", a[0], a[1], a[2], b[0], b[1], b[2]);
   for (int c = 0; c < 3; c++) CHECK(fabs(a[c] - b[c]) < 0.005 * a[c], "channel %d: RGB %g vs spectral %g", c, a[c], b[c]);
   const char *cb = shared_file("scenes/cornell/CornellBox-Original.obj");
-  if (!cb) return 0;
+  if (!cb) return TEST_SKIP; /* the grey half passed; the Cornell half needs ../shared (CI fails) */
   char json[2048];
   snprintf(json, sizeof json,
            "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"fov\": 40},\n"
