@@ -128,7 +128,7 @@ static int veach_mis_tungsten(void) {
 
 /* Adaptive sampling against uniform at the same sample count, relMSE against the Cycles
  * references: no worse than uniform (+5 %) on CornellBox-Mirror (mirror caustics) and
- * CornellBox-Original (even noise). Measured 0.96x on both. The rule that gave 0.67x on
+ * CornellBox-Original (even noise). Measured 0.87x and 0.95x. The rule that gave 0.17x on
  * the Mirror box decided on each pixel's own samples and darkened rare bright paths
  * (test_analytic adaptive_unbiased shows the digest rule doing so); an unbiased rule gains
  * only where the noise is far from even. (Equal time is what docs/performance.md
