@@ -35,6 +35,12 @@ SCENES = {
     "copper-smooth": {"type": "conductor", **COPPER},
     "glass-rough": {"type": "dielectric", "ior": 1.5, "roughness": 0.3},
     "glass-smooth": {"type": "dielectric", "ior": 1.5},
+    # glTF metallic-roughness, fully metallic: valo's metal lobe is Schlick's Fresnel on the
+    # base colour with GGX, as Mitsuba's principled BSDF at metallic 1 (its other lobes off).
+    # Not the dielectric part: principled's specular layer (metallic 0, black base) comes
+    # out 25 % brighter on the sphere than glTF's Schlick F0 = 0.04 layer, and its diffuse
+    # is Disney's, not glTF's Lambert.
+    "pbr-metal": {"type": "pbr", "base_color": [0.95, 0.64, 0.54], "metallic": 1, "roughness": 0.4},
 }
 # Lit only by ../shared/scenes/envmaps/ENV_SOURCE at its full 1024 x 512 (not committed:
 # the test needs ../shared), turned ENV_ROTATION degrees: a diffuse and a rough gold sphere.
@@ -157,6 +163,9 @@ def mitsuba_bsdf(mat):
         if r > 0:
             return {"type": "roughconductor", "distribution": "ggx", "alpha": r * r, "sample_visible": True, **d}
         return {"type": "conductor", **d}
+    if mat["type"] == "pbr":
+        return {"type": "principled", "base_color": {"type": "rgb", "value": mat["base_color"]}, "metallic": mat["metallic"],
+                "roughness": mat["roughness"], "specular": 0.5, "spec_tint": 0.0, "sheen": 0.0, "clearcoat": 0.0}
     if mat["type"] == "diffuse":
         return {"type": "diffuse", "reflectance": {"type": "rgb", "value": [mat["reflectance"]] * 3}}
     if r > 0:
