@@ -243,7 +243,8 @@ static int fallback_warnings(void) {
   warnings_capture(0);
   scene_free(s);
   CHECK(st == VALO_OK, "%s", err.message);
-  CHECK(strstr(said, "missing-texture.png") && strstr(said, "ignored"), "no warning naming the unreadable texture: \"%s\"", said);
+  CHECK(strstr(said, "missing-texture.png") && strstr(said, "ignored") && strstr(said, "material 'lost'"),
+        "no warning naming the unreadable texture and the material asking for it: \"%s\"", said);
   CHECK(strstr(said, "nouv.obj") && strstr(said, "no texture coordinates") && strstr(said, "painted"), "no warning about maps without UVs: \"%s\"", said);
   /* a JSON sphere (no UVs) with a textured material */
   const char *sj = scratch_file("texsphere.json", "{ \"materials\": {\"painted\": {\"type\": \"diffuse\", \"reflectance\": \"paint.png\"}},\n"

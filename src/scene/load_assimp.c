@@ -474,7 +474,9 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
       material m = convert_material(ai->mMaterials[i], obj ? &oc : NULL);
+      snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
       convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, obj ? &oc : NULL);
+      s->tex_user[0] = 0;
       s->mats[c.mat_base + i] = m;
     }
     if (ai->mNumMaterials == 0) {

@@ -106,7 +106,10 @@ int scene_texture_file(scene *s, const char *path, int srgb) {
   if (i >= 0) return i;
   texture t;
   valo_error err;
-  if (texture_load_file(&t, path, srgb, &err)) { log_warning("%s (the map is ignored)", err.message); return -1; }
+  if (texture_load_file(&t, path, srgb, &err)) {
+    log_warning("%s%s%s (the map is ignored)", s->tex_user, s->tex_user[0] ? ": " : "", err.message);
+    return -1;
+  }
   return add_texture(s, &t, key);
 }
 
@@ -117,7 +120,10 @@ int scene_texture_memory(scene *s, const char *name, const unsigned char *data, 
   if (i >= 0) return i;
   texture t;
   valo_error err;
-  if (texture_load_memory(&t, data, len, name, srgb, &err)) { log_warning("%s (the map is ignored)", err.message); return -1; }
+  if (texture_load_memory(&t, data, len, name, srgb, &err)) {
+    log_warning("%s%s%s (the map is ignored)", s->tex_user, s->tex_user[0] ? ": " : "", err.message);
+    return -1;
+  }
   return add_texture(s, &t, key);
 }
 

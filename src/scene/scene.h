@@ -80,6 +80,8 @@ typedef struct scene {
   float *tan;              /* 4 per vertex (tangent xyz, bitangent sign), after commit when
                               a material has a normal map; else NULL */
   float *uv;               /* 2 per vertex */
+  char tex_user[1200];      /* while a loader reads a material's maps: "file: material 'x'",
+                              named in the warning when one cannot be read */
   float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and
                               the bitangent sign); w = 0 where it gave none */
   uint32_t nverts, cap_verts;
