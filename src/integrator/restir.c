@@ -301,40 +301,75 @@ static int reservoir_select(const pw_in *in, int n, int unbiased, sampler *rng, 
   return kept;
 }
 
-/* Merges DI reservoirs in[0..n) (in[0] this pixel's, in[i] from pixel gs[i]; M of in[1..]
- * capped by cap_M when > 0) into *out at pixel g. The target includes visibility: another
- * pixel's sample counts only if g sees it (one shadow ray), so every reservoir holds a
- * sample its own pixel sees (or W = 0) and shading needs no shadow ray. */
-static void di_merge(const render_ctx *c, int unbiased, const gpix *g, const di_res *const *in, const gpix *const *gs, int n, float cap_M,
-                     sampler *rng, thread_stats *ts, di_res *out) {
-  memset(out, 0, sizeof *out);
+/* What merging asks of a kind of reservoir: target(u, at, j), the target of input j's
+ * sample at pixel `at` in the measure common to all pixels; visible(u, at, j), whether
+ * `at` sees that sample (called right after target of the same pair); W(u, j), input j's
+ * contribution weight in that measure (0: none). */
+typedef struct merge_ops {
+  float (*target)(void *u, const gpix *at, int j);
+  int (*visible)(void *u, const gpix *at, int j, thread_stats *ts);
+  float (*W)(void *u, int j);
+} merge_ops;
+
+/* Merges inputs 0..n-1 (0 the pixel gs[0]'s own, j from pixel gs[j]; M[j] of j > 0
+ * capped by cap_M when > 0; `can`: input 0 holds a sample) through reservoir_select:
+ * returns the kept input (or -1), its W and the merged M. The targets include
+ * visibility: another pixel's sample counts only if gs[0] sees it (one shadow ray), so
+ * every reservoir holds a sample its own pixel sees (or W = 0) and shading needs no
+ * shadow ray; unbiased, also whether gs[j] sees input 0's (another). */
+static int merge(const merge_ops *ops, void *u, int unbiased, int can, const float *M, const gpix *const *gs, int n, float cap_M,
+                 sampler *rng, thread_stats *ts, float *M_out, float *W_out) {
   pw_in pw[72];
-  rgb contrib;
-  light_li li;
-  int can = in[0]->W > 0;
+  *M_out = 0;
   for (int i = 0; i < n; i++) {
-    const di_res *r = in[i];
     pw_in *p = &pw[i];
-    p->M = r->M;
+    p->M = M[i];
     if (i > 0 && cap_M > 0 && p->M > cap_M) p->M = cap_M;
-    out->M += p->M;
-    p->W = r->W;
+    *M_out += p->M;
     p->p_own = p->p_here = p->p_can = 0;
+    p->W = ops->W(u, i);
     if (i == 0) {
-      if (can) p->p_own = p->p_here = di_target_g(c, g, &r->y, &contrib, &li);
+      if (can) p->p_own = p->p_here = ops->target(u, gs[0], 0);
       continue;
     }
-    if (r->W > 0) {
-      p->p_here = di_target_g(c, g, &r->y, &contrib, &li);
-      if (p->p_here > 0 && !di_visible(c, g, &li, ts)) p->p_here = 0;
-      if (unbiased) p->p_own = di_target_g(c, gs[i], &r->y, &contrib, &li);
+    if (p->W > 0) {
+      p->p_here = ops->target(u, gs[0], i);
+      if (p->p_here > 0 && !ops->visible(u, gs[0], i, ts)) p->p_here = 0;
+      if (unbiased) p->p_own = ops->target(u, gs[i], i);
     }
     if (can && unbiased) {
-      p->p_can = di_target_g(c, gs[i], &in[0]->y, &contrib, &li);
-      if (p->p_can > 0 && !di_visible(c, gs[i], &li, ts)) p->p_can = 0;
+      p->p_can = ops->target(u, gs[i], 0);
+      if (p->p_can > 0 && !ops->visible(u, gs[i], 0, ts)) p->p_can = 0;
     }
   }
-  int kept = reservoir_select(pw, n, unbiased, rng, &out->W);
+  return reservoir_select(pw, n, unbiased, rng, W_out);
+}
+
+/* DI reservoirs: targets in the light's measure; visibility of the light point the last
+ * target found. */
+typedef struct di_merge_ctx { const render_ctx *c; const di_res *const *in; light_li li; } di_merge_ctx;
+static float di_merge_target(void *u, const gpix *at, int j) {
+  di_merge_ctx *m = u;
+  rgb contrib;
+  return di_target_g(m->c, at, &m->in[j]->y, &contrib, &m->li);
+}
+static int di_merge_visible(void *u, const gpix *at, int j, thread_stats *ts) {
+  (void)j;
+  di_merge_ctx *m = u;
+  return di_visible(m->c, at, &m->li, ts);
+}
+static float di_merge_W(void *u, int j) { return ((di_merge_ctx *)u)->in[j]->W; }
+
+/* Merges DI reservoirs in[0..n) (in[0] pixel g's, in[i] from pixel gs[i], gs[0] = g) into
+ * *out (merge says how). */
+static void di_merge(const render_ctx *c, int unbiased, const gpix *const *gs, const di_res *const *in, int n, float cap_M, sampler *rng,
+                     thread_stats *ts, di_res *out) {
+  static const merge_ops ops = {di_merge_target, di_merge_visible, di_merge_W};
+  di_merge_ctx m = {.c = c, .in = in};
+  float M[72];
+  for (int i = 0; i < n; i++) M[i] = in[i]->M;
+  memset(out, 0, sizeof *out);
+  int kept = merge(&ops, &m, unbiased, in[0]->W > 0, M, gs, n, cap_M, rng, ts, &out->M, &out->W);
   if (kept >= 0) out->y = in[kept]->y;
 }
 
@@ -447,46 +482,40 @@ static float gi_area(const gpix *g, const gi_res *r, int use_jacobian) {
   float f = fabsf(v3_dot(r->ns, d)) / (d2 * sqrtf(d2));
   return isfinite(f) ? f : 0;
 }
-/* Merges GI reservoirs as di_merge does, in the area measure at the sample points: a
- * target p^_omega times gi_area, a W divided by its owner's gi_area, so a reused W carries
- * the Jacobian of the shift (restir_gi_jacobian); g traces a visibility ray to each reused
- * sample point. */
-static void gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const gpix *g, const gi_res *const *in, const gpix *const *gs, int n,
-                     float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
-  memset(out, 0, sizeof *out);
-  pw_in pw[72];
+/* GI reservoirs: targets p^_omega times gi_area (the area measure at the sample points),
+ * W divided by its owner's gi_area, so a reused W carries the Jacobian of the shift
+ * (restir_gi_jacobian); visibility is a ray to the sample point. */
+typedef struct gi_merge_ctx { const render_ctx *c; const gi_res *const *in; const gpix *const *gs; int use_jacobian; } gi_merge_ctx;
+static float gi_merge_target(void *u, const gpix *at, int j) {
+  gi_merge_ctx *m = u;
   rgb contrib;
   vec3 wi;
-  int can = in[0]->W > 0;
-  for (int i = 0; i < n; i++) {
-    const gi_res *r = in[i];
-    pw_in *p = &pw[i];
-    p->M = r->M;
-    if (i > 0 && cap_M > 0 && p->M > cap_M) p->M = cap_M;
-    out->M += p->M;
-    p->p_own = p->p_here = p->p_can = p->W = 0;
-    float a_own = gi_area(gs[i], r, use_jacobian);
-    if (r->W > 0 && a_own > 0) p->W = r->W / a_own;
-    if (i == 0) {
-      if (can) p->p_own = p->p_here = gi_target(g, r, &contrib, &wi) * a_own;
-      continue;
-    }
-    if (p->W > 0) {
-      p->p_here = gi_target(g, r, &contrib, &wi) * gi_area(g, r, use_jacobian);
-      if (p->p_here > 0 && !gi_visible(c, g, r, ts)) p->p_here = 0;
-      if (unbiased) p->p_own = gi_target(gs[i], r, &contrib, &wi) * a_own;
-    }
-    if (can && unbiased) {
-      p->p_can = gi_target(gs[i], in[0], &contrib, &wi) * gi_area(gs[i], in[0], use_jacobian);
-      if (p->p_can > 0 && !gi_visible(c, gs[i], in[0], ts)) p->p_can = 0;
-    }
-  }
-  float W;
-  int kept = reservoir_select(pw, n, unbiased, rng, &W);
+  return gi_target(at, m->in[j], &contrib, &wi) * gi_area(at, m->in[j], m->use_jacobian);
+}
+static int gi_merge_visible(void *u, const gpix *at, int j, thread_stats *ts) {
+  gi_merge_ctx *m = u;
+  return gi_visible(m->c, at, m->in[j], ts);
+}
+static float gi_merge_W(void *u, int j) {
+  gi_merge_ctx *m = u;
+  float a_own = gi_area(m->gs[j], m->in[j], m->use_jacobian);
+  return m->in[j]->W > 0 && a_own > 0 ? m->in[j]->W / a_own : 0;
+}
+
+/* Merges GI reservoirs as di_merge does, in the area measure at the sample points; the
+ * result's W goes back to pixel gs[0]'s solid angle. */
+static void gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const gpix *const *gs, const gi_res *const *in, int n,
+                     float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
+  static const merge_ops ops = {gi_merge_target, gi_merge_visible, gi_merge_W};
+  gi_merge_ctx m = {c, in, gs, use_jacobian};
+  float M[72], W;
+  for (int i = 0; i < n; i++) M[i] = in[i]->M;
+  memset(out, 0, sizeof *out);
+  int kept = merge(&ops, &m, unbiased, in[0]->W > 0, M, gs, n, cap_M, rng, ts, &out->M, &W);
   if (kept < 0) return;
   const gi_res *r = in[kept];
   out->xs = r->xs; out->ns = r->ns; out->Lo = r->Lo;
-  out->W = W * gi_area(g, r, use_jacobian); /* from the area measure to this pixel's solid angle */
+  out->W = W * gi_area(gs[0], r, use_jacobian); /* from the area measure to this pixel's solid angle */
 }
 
 /* A reuse pass over the DI (gi = 0) or GI reservoirs: temporal (round < 0: each pixel
@@ -522,13 +551,13 @@ static void stage_reuse(void *user, int64_t row, int thread) {
       in[0] = &s->gr[j->src][pix];
       for (int i = 1; i < n; i++) in[i] = temporal ? &s->gr_prev[from[i]] : &s->gr[j->src][from[i]];
       if (n == 1) s->gr[j->dst][pix] = *in[0];
-      else gi_merge(j->c, cfg->unbiased, cfg->jacobian, g, in, gs, n, cap, &rng, &j->f->ts[thread], &s->gr[j->dst][pix]);
+      else gi_merge(j->c, cfg->unbiased, cfg->jacobian, gs, in, n, cap, &rng, &j->f->ts[thread], &s->gr[j->dst][pix]);
     } else {
       const di_res *in[65];
       in[0] = &s->di[j->src][pix];
       for (int i = 1; i < n; i++) in[i] = temporal ? &s->di_prev[from[i]] : &s->di[j->src][from[i]];
       if (n == 1) s->di[j->dst][pix] = *in[0];
-      else di_merge(j->c, cfg->unbiased, g, in, gs, n, cap, &rng, &j->f->ts[thread], &s->di[j->dst][pix]);
+      else di_merge(j->c, cfg->unbiased, gs, in, n, cap, &rng, &j->f->ts[thread], &s->di[j->dst][pix]);
     }
   }
 }
