@@ -91,7 +91,7 @@ int check_losses(const valo_render *r) {
   for (int k = 0; k < VALO_LOSS_COUNT; k++) {
     if (!st.lost[k]) continue;
     if (k == VALO_LOSS_SHADING_NORMAL) {
-      double f = st.bsdf_samples ? (double)st.lost[k] / (double)st.bsdf_samples : 1;
+      double f = st.surface_samples ? (double)st.lost[k] / (double)st.surface_samples : 1;
       if (f <= g_shading_bound) continue;
       fprintf(stderr, "render lost %.3g%% of its surface samples to shading normals (bound %.3g%%)\n", 100 * f, 100 * g_shading_bound);
     } else {

@@ -405,9 +405,9 @@ static int stress_no_nan(void) {
       valo_stats s;
       valo_render_stats(r, &s);
       fprintf(stderr, "%-12s%s: %llu surface samples, %.2f %% refused for shading normals, 0 NaN/inf/negative/BSDF\n", integ[k],
-              spectral ? " spectral" : "", (unsigned long long)s.bsdf_samples,
-              s.bsdf_samples ? 100.0 * (double)s.lost[VALO_LOSS_SHADING_NORMAL] / (double)s.bsdf_samples : 0.0);
-      CHECK(s.bsdf_samples > 0 || !strcmp(integ[k], "ao") || !strcmp(integ[k], "whitted"), "%s drew no surface samples", integ[k]);
+              spectral ? " spectral" : "", (unsigned long long)s.surface_samples,
+              s.surface_samples ? 100.0 * (double)s.lost[VALO_LOSS_SHADING_NORMAL] / (double)s.surface_samples : 0.0);
+      CHECK(s.surface_samples > 0 || !strcmp(integ[k], "ao") || !strcmp(integ[k], "whitted"), "%s drew no surface samples", integ[k]);
       valo_render_destroy(r);
       valo_scene_destroy(sc);
     }

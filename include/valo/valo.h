@@ -180,7 +180,7 @@ typedef struct valo_stats {
   int frames_done;        /* a sequence: frames finished (and given to the callback) */
   uint64_t samples;       /* camera samples taken over the whole film */
   uint64_t lost[VALO_LOSS_COUNT]; /* by cause (valo_loss), over every run of this render */
-  uint64_t bsdf_samples;  /* BSDF and light samples drawn at surfaces: the base of the
+  uint64_t surface_samples; /* BSDF and light samples drawn at surfaces: the base of the
                              SHADING_NORMAL and BSDF_NONFINITE fractions */
   int width, height;
   int threads;

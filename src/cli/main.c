@@ -493,8 +493,8 @@ static int cmd_render(int argc, char **argv) {
     for (int k = 0; k < VALO_LOSS_COUNT; k++) {
       if (!st.lost[k] || n >= sizeof lost) continue;
       n += (size_t)snprintf(lost + n, sizeof lost - n, "%s%llu %s", n ? ", " : "", (unsigned long long)st.lost[k], valo_loss_name(k));
-      if (k == VALO_LOSS_SHADING_NORMAL && n < sizeof lost && st.bsdf_samples)
-        n += (size_t)snprintf(lost + n, sizeof lost - n, " (%.3g%% of surface samples)", 100.0 * (double)st.lost[k] / (double)st.bsdf_samples);
+      if (k == VALO_LOSS_SHADING_NORMAL && n < sizeof lost && st.surface_samples)
+        n += (size_t)snprintf(lost + n, sizeof lost - n, " (%.3g%% of surface samples)", 100.0 * (double)st.lost[k] / (double)st.surface_samples);
     }
     fprintf(stderr,
             "valo: summary: %llu triangles; load %.2f s, build %.2f s, render %.2f s; %d spp; %.3g rays, %.2f Mrays/s; lost: %s\n",

@@ -48,8 +48,8 @@ struct valo_render {
   double *lum;            /* adaptive: per pixel sum of luminance and of its square */
   int spp_done;
   double build_seconds, render_seconds;
-  uint64_t rays, lost[VALO_LOSS_COUNT], surface_samples;
-  thread_stats prep; /* create's and prepare's rays and losses, added at run_finish */
+  thread_stats total;      /* rays, losses and surface samples of every run so far */
+  thread_stats prep;       /* create's and prepare's, added to total at run_finish */
   atomic_int cancel;
   camera cam_still;       /* the scene camera fitted to the film (frame 0 of an animation) */
   cam_view view, view_prev;/* this frame's pinhole basis and the previous frame's */
@@ -598,11 +598,9 @@ static valo_status run_finish(valo_render *r, thread_stats *ts, double t0, valo_
   memset(&r->prep, 0, sizeof r->prep);
   for (int t = 0; t < r->opt.threads; t++) thread_stats_add(&sum, &ts[t]);
   free(ts);
-  r->rays += sum.rays;
-  r->surface_samples += sum.surface_samples;
+  thread_stats_add(&r->total, &sum);
   const uint64_t *run = sum.lost;
   for (int k = 0; k < VALO_LOSS_COUNT; k++) {
-    r->lost[k] += run[k];
     if (run[k] && k <= VALO_LOSS_NEGATIVE)
       log_warning("%llu samples were %s and were dropped (their pixels are darker)", (unsigned long long)run[k], valo_loss_name(k));
     else if (run[k] && k == VALO_LOSS_BSDF_NONFINITE)
@@ -729,9 +727,9 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   o->triangles = r->s->ntris;
   o->build_seconds = r->build_seconds;
   o->render_seconds = r->render_seconds;
-  o->rays = r->rays;
-  memcpy(o->lost, r->lost, sizeof o->lost);
-  o->bsdf_samples = r->surface_samples;
+  o->rays = r->total.rays;
+  memcpy(o->lost, r->total.lost, sizeof o->lost);
+  o->surface_samples = r->total.surface_samples;
   o->spp_done = r->spp_done;
   o->frames_done = r->frames_done;
   size_t np = (size_t)r->opt.width * r->opt.height;
