@@ -462,13 +462,20 @@ static void render_tile(void *user, int64_t item, int thread) {
 #define ADAPT_EPS 0.01
 #define ADAPT_RADIUS 2 /* the neighbourhood whose variance sets a pixel's priority */
 
-static double pixel_priority(const valo_render *r, size_t i) {
+/* The "error" rule's v of pixel i: the relative variance of one sample of its luminance,
+ * var / (mean^2 + eps); 0 with fewer than two samples or no variance. */
+static double pixel_relvar(const valo_render *r, size_t i) {
   double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
   if (n < 2) return 0;
   double mean = s / n, var = (s2 - s * s / n) / (n - 1);
-  if (!(var > 0)) return 0;
-  if (r->opt.adaptive == VALO_ADAPTIVE_DIGEST) { if (!(s > 0)) return 0; double rel = (n * s2 / (s * s) - 1) / n; return rel > 0 ? rel : 0; }
-  return var / n / (mean * mean + ADAPT_EPS);
+  return var > 0 ? var / (mean * mean + ADAPT_EPS) : 0;
+}
+/* The "digest" rule's priority of pixel i, on its own samples: (N sum s^2 / (sum s)^2 - 1) / N. */
+static double pixel_digest(const valo_render *r, size_t i) {
+  double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
+  if (n < 2 || !(s > 0)) return 0;
+  double rel = (n * s2 / (s * s) - 1) / n;
+  return rel > 0 ? rel : 0;
 }
 
 typedef struct prio { double p; uint32_t i; } prio;
@@ -675,13 +682,13 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
      * adaptive_unbiased); the neighbours share the rare paths a caustic spreads. */
     int digest = r->opt.adaptive == VALO_ADAPTIVE_DIGEST;
     if (!digest)
-      for (size_t i = 0; i < np; i++) { double n = r->count[i]; raw[i] = pixel_priority(r, i) * n; }
+      for (size_t i = 0; i < np; i++) raw[i] = pixel_relvar(r, i);
     while (taken < total) {
       for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
           size_t i = (size_t)y * W + x;
           pr[i].i = (uint32_t)i;
-          if (digest) { double pd = pixel_priority(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
+          if (digest) { double pd = pixel_digest(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
           double acc = 0;
           int cnt = 0;
           for (int dy = -ADAPT_RADIUS; dy <= ADAPT_RADIUS; dy++)
