@@ -3,7 +3,7 @@
 # same meshes with Mitsuba 3 into <name>-mitsuba.exr beside them (optional tooling: the
 # files it makes are committed; valo builds, renders and tests without Python).
 #
-#   pip install mitsuba
+#   pip install mitsuba numpy
 #   DRJIT_LIBLLVM_PATH=~/.rustup/toolchains/stable-x86_64-unknown-linux-gnu/lib/libLLVM.so.22.1-rust-1.95.0-stable \
 #   python3 scripts/mitsuba-materials.py [--spp 16384] [--only gold-rough]
 #   ... --variant llvm_ad_spectral --only glass-rough   (writes NAME-mitsuba-spectral.exr)
@@ -17,7 +17,8 @@
 #  - GGX: valo's roughness r is Mitsuba's alpha = r^2, visible-normal sampling; Mitsuba's
 #    Smith G is separable, valo's height-correlated (a difference far below the test's
 #    tolerance at alpha 0.09);
-#  - conductors: the same RGB eta and k in both (not Mitsuba's spectral presets);
+#  - conductors: the same RGB eta and k in both (not Mitsuba's spectral presets); gold-spectral
+#    gives both the same eta, k per wavelength (GOLD_SPECTRUM), linear between points;
 #  - glass: interior ior 1.5, exterior 1.0;
 #  - environment: valo's map has its centre looking down -z and u growing towards +x;
 #    Mitsuba's envmap has u = 0 at -z, so its to_world is a turn of 180 + rotation degrees
@@ -30,8 +31,15 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "tests", "data", "materials")
 GOLD = {"eta": [0.143, 0.374, 1.442], "k": [3.983, 2.385, 1.603]}
 COPPER = {"eta": [0.200, 0.924, 1.102], "k": [3.912, 2.452, 2.142]}
+# A gold-like complex index per wavelength (rounded values in the shape of published gold
+# measurements; not a measured table): valo's JSON "spectrum", Mitsuba's irregular spectra.
+# For --spectral renders against Mitsuba's spectral variant (--variant llvm_ad_spectral).
+GOLD_NM = [360, 400, 450, 500, 550, 600, 650, 700, 750, 830]
+GOLD_SPECTRUM = {"wavelengths": GOLD_NM, "eta": [1.70, 1.66, 1.50, 0.97, 0.43, 0.25, 0.17, 0.16, 0.16, 0.19],
+                 "k": [1.90, 1.96, 1.88, 1.87, 2.45, 3.00, 3.55, 4.00, 4.45, 5.10]}
 SCENES = {
     "gold-rough": {"type": "conductor", **GOLD, "roughness": 0.3},
+    "gold-spectral": {"type": "conductor", "spectrum": GOLD_SPECTRUM, "roughness": 0.3},
     "copper-smooth": {"type": "conductor", **COPPER},
     "glass-rough": {"type": "dielectric", "ior": 1.5, "roughness": 0.3},
     "glass-smooth": {"type": "dielectric", "ior": 1.5},
@@ -159,7 +167,13 @@ def env_json(name, mats):
 def mitsuba_bsdf(mat):
     r = mat.get("roughness", 0)
     if mat["type"] == "conductor":
-        d = {"eta": {"type": "rgb", "value": mat["eta"]}, "k": {"type": "rgb", "value": mat["k"]}}
+        if "spectrum" in mat:
+            sp = mat["spectrum"]
+            def irregular(v):
+                return {"type": "irregular", "wavelengths": ", ".join(map(str, sp["wavelengths"])), "values": ", ".join(map(str, v))}
+            d = {"eta": irregular(sp["eta"]), "k": irregular(sp["k"])}
+        else:
+            d = {"eta": {"type": "rgb", "value": mat["eta"]}, "k": {"type": "rgb", "value": mat["k"]}}
         if r > 0:
             return {"type": "roughconductor", "distribution": "ggx", "alpha": r * r, "sample_visible": True, **d}
         return {"type": "conductor", **d}
@@ -220,14 +234,39 @@ def scene_dict(mi, name, mat, spp):
                       "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [LE, LE, LE]}}}}, WIDTH, HEIGHT
 
 
+def spectral_white(mi):
+    """Mitsuba's linear sRGB of the equal-energy spectrum of radiance 1: a constant
+    environment seen directly, 16 x 16 pixels at 4096 spp (wavelength noise < 0.05 %)."""
+    s = mi.load_dict({"type": "scene", "integrator": {"type": "path", "max_depth": 1},
+                      "sensor": sensor(mi, {"position": [0, 0, 0], "look_at": [0, 0, 1], "up": [0, 1, 0], "fov": 30}, 16, 16, 4096),
+                      "env": {"type": "constant", "radiance": {"type": "uniform", "value": 1.0}}})
+    import numpy as np
+    return np.array(mi.render(s, seed=1)).reshape(-1, 3).mean(axis=0)
+
+
 def render(mi, name, mat, spp, seed):
     scene, w, h = scene_dict(mi, name, mat, spp)
+    white = None
+    if "spectral" in mi.variant():
+        # valo's spectral white is the equal-energy spectrum, balanced per channel on the film
+        # (src/core/spectrum.h); Mitsuba's RGB white is D65. On grey scenes the two agree;
+        # on coloured ones (gold) they differ by up to 3 %. So here every emitter emits the
+        # equal-energy spectrum and the image is divided by its sRGB, as valo's film does.
+        white = spectral_white(mi)
+        for v in scene.values():
+            if isinstance(v, dict) and "emitter" in v:
+                rad = v["emitter"]["radiance"]["value"]
+                v["emitter"]["radiance"] = {"type": "uniform", "value": rad[0]}
     s = mi.load_dict(scene)
     img = None
     passes = max(1, spp // 4096)
     for k in range(passes):
         part = mi.render(s, seed=seed + k, spp=min(spp, 4096))
         img = part if img is None else img + part
+    if white is not None:
+        import numpy as np
+        print("spectral white (equal-energy spectrum in Mitsuba's sRGB): %.5f %.5f %.5f" % tuple(white), flush=True)
+        img = mi.TensorXf(np.array(img) / white)
     out = os.path.join(OUT, name + "-mitsuba" + ("-spectral" if "spectral" in mi.variant() else "") + SUFFIX + ".exr")
     mi.Bitmap(img / passes).write(out)
     print("wrote %s (%dx%d, %d spp, mitsuba %s)" % (out, w, h, passes * min(spp, 4096), mi.__version__), flush=True)

@@ -127,6 +127,32 @@ rgb spec_to_rgb(spec4 L, const wavelengths *w) {
   return o;
 }
 
+float tab_eval(const float *nm, const float *v, int n, float l) {
+  if (l <= nm[0]) return v[0];
+  if (l >= nm[n - 1]) return v[n - 1];
+  int lo = 0, hi = n - 1; /* nm[lo] < l < nm[hi] */
+  while (hi - lo > 1) {
+    int mid = (lo + hi) / 2;
+    if (nm[mid] <= l) lo = mid; else hi = mid;
+  }
+  float t = (l - nm[lo]) / (nm[hi] - nm[lo]);
+  return v[lo] + t * (v[hi] - v[lo]);
+}
+
+rgb tab_to_rgb(const float *nm, const float *v, int n) {
+  pthread_once(&g_once, spectrum_setup);
+  double X = 0, Y = 0, Z = 0;
+  for (float l = LAMBDA_MIN + 0.25f; l < LAMBDA_MAX; l += 0.5f) {
+    float x, y, z, f = tab_eval(nm, v, n, l);
+    cie_xyz(l, &x, &y, &z);
+    X += x * f; Y += y * f; Z += z * f;
+  }
+  float c[3];
+  for (int i = 0; i < 3; i++)
+    c[i] = (float)(g_white[i] * (XYZ_TO_SRGB[i][0] * X + XYZ_TO_SRGB[i][1] * Y + XYZ_TO_SRGB[i][2] * Z) * 0.5 / g_y_integral);
+  return c3(c[0], c[1], c[2]);
+}
+
 int dispersion_parse(const char *name, dispersion *d) {
   static const struct { const char *n; dispersion d; } t[] = {
       {"fused_silica", DISP_FUSED_SILICA}, {"sapphire", DISP_SAPPHIRE}, {"water", DISP_WATER}, {"cauchy_glass", DISP_CAUCHY_GLASS},

@@ -30,6 +30,13 @@ static inline spec4 spec_scale(spec4 a, float s) { for (int i = 0; i < N_LAMBDA;
 static inline float spec_max(spec4 a) { float m = a.v[0]; for (int i = 1; i < N_LAMBDA; i++) m = a.v[i] > m ? a.v[i] : m; return m; }
 static inline int spec_black(spec4 a) { for (int i = 0; i < N_LAMBDA; i++) if (a.v[i] != 0) return 0; return 1; }
 void cie_xyz(float lambda_nm, float *x, float *y, float *z);
+/* A quantity tabulated at n >= 1 increasing wavelengths nm[]: linear between points,
+ * constant beyond the ends. */
+float tab_eval(const float *nm, const float *v, int n, float lambda);
+/* Its linear sRGB as the film sees a spectrum (CIE 1931 over [380, 720] nm, white
+ * balanced so that a constant c reads (c, c, c)): how RGB mode takes a tabulated
+ * conductor index. */
+rgb tab_to_rgb(const float *nm, const float *v, int n);
 
 /* Dispersion (digest 000, thesis table 2.1): index of refraction at wavelength lambda. */
 typedef enum dispersion { DISP_NONE, DISP_FUSED_SILICA, DISP_SAPPHIRE, DISP_WATER, DISP_CAUCHY_GLASS, DISP_DENSE_FLINT } dispersion;

@@ -218,6 +218,7 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
   out->f_cos = c3_scale(f, fabsf(wi_l.z));
   out->Li = ls.L;
   out->scale = w / light_pdf;
+  out->wi = ls.wi;
   return 1;
 }
 

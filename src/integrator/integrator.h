@@ -170,7 +170,7 @@ rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const f
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
-typedef struct direct_sample { rgb f_cos, Li; float scale; } direct_sample;
+typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi; } direct_sample;
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out);
 /* The same estimate with weight 1 (light sampling alone): for integrators that never

@@ -5,18 +5,35 @@
  * product (BSDF x light, throughput x BSDF) is taken per wavelength. At a dispersive
  * dielectric the index comes from its Sellmeier/Cauchy preset at the hero wavelength and
  * the other wavelengths are dropped (the hero then counts 4 times), so each colour
- * refracts at its own angle. The result is converted through CIE XYZ to linear sRGB. */
+ * refracts at its own angle. A conductor given per wavelength (JSON "spectrum") has its
+ * BSDF evaluated with F = 1 and the Fresnel term of each wavelength's eta, k applied
+ * here. The result is converted through CIE XYZ to linear sRGB. */
 #include "integrator/integrator.h"
 #include "core/sampling.h"
 #include "core/spectrum.h"
+#include "material/fresnel.h"
+
+/* The Fresnel reflectance of a tabulated conductor at each wavelength, for the pair of
+ * directions (world space, both away from the surface): at the half vector, which is
+ * the microfacet normal of a rough conductor and the normal of a smooth one. */
+static spec4 nk_fresnel(const nk_curve *nk, vec3 wo, vec3 wi, const wavelengths *wl) {
+  vec3 h = v3_add(wo, wi);
+  float len = v3_len(h), c = len > 1e-7f ? fabsf(v3_dot(wo, h)) / len : 0;
+  spec4 F;
+  for (int i = 0; i < N_LAMBDA; i++)
+    F.v[i] = fresnel_conductor1(c, tab_eval(nk->nm, nk->eta, nk->n, wl->lambda[i]), tab_eval(nk->nm, nk->k, nk->n, wl->lambda[i]));
+  return F;
+}
 
 /* Next-event estimation with f and Li upsampled separately and multiplied per
  * wavelength (estimate_direct multiplies them per RGB channel). */
 static spec4 direct_spectral(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                             thread_stats *ts, const wavelengths *wl) {
+                             thread_stats *ts, const wavelengths *wl, const nk_curve *nk) {
   direct_sample d;
   if (!sample_direct(c, it, b, fr, wo, smp, ts, 1, &d)) return spec_const(0);
-  return spec_scale(spec_mul(spec_from_rgb(d.f_cos, wl), spec_from_rgb(d.Li, wl)), d.scale);
+  spec4 f = spec_from_rgb(d.f_cos, wl);
+  if (nk) f = spec_mul(f, nk_fresnel(nk, wo, d.wi, wl));
+  return spec_scale(spec_mul(f, spec_from_rgb(d.Li, wl)), d.scale);
 }
 
 static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
@@ -39,13 +56,16 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
       b.eta = dispersion_ior((dispersion)it.m->dispersion, wl.lambda[0]);
       wavelengths_terminate_secondary(&wl);
     }
+    const nk_curve *nk = it.m->nk ? &s->nk[it.m->nk - 1] : NULL;
+    if (nk) b.fresnel_white = 1;
     frame fr = shading_frame(&it, &b, wo);
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-    if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl)));
+    if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl, nk)));
     rgb weight;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
     if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
     beta = spec_mul(beta, spec_from_rgb(weight, &wl));
+    if (nk) beta = spec_mul(beta, nk_fresnel(nk, wo, r.d, &wl));
     if (spec_black(beta)) break;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
     float survive = path_roulette(&st, spec_max(beta), depth, smp);

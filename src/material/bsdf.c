@@ -129,6 +129,10 @@ static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   return pdf;
 }
 
+static rgb conductor_F(const bsdf *b, float cos_i) {
+  return b->fresnel_white ? c3(1, 1, 1) : fresnel_conductor(cos_i, b->cond_eta, b->cond_k);
+}
+
 static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
   vec3 r = v3(-wo.x, -wo.y, wo.z); /* mirror direction of wo about z */
   return v3_dot(r, wi);
@@ -150,7 +154,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float dg = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
-    rgb F = fresnel_conductor(fabsf(v3_dot(wo, wm)), b->cond_eta, b->cond_k);
+    rgb F = conductor_F(b, fabsf(v3_dot(wo, wm)));
     return c3_scale(F, dg);
   }
   }
@@ -216,7 +220,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   case BSDF_CONDUCTOR: {
     if (wo.z <= 0) return 0;
     s->wi = v3(-wo.x, -wo.y, wo.z);
-    s->weight = fresnel_conductor(wo.z, b->cond_eta, b->cond_k);
+    s->weight = conductor_F(b, wo.z);
     s->pdf = 0;
     s->delta = 1;
     return 1;

@@ -19,6 +19,7 @@ typedef struct bsdf {
   float exponent;
   float eta;          /* dielectric: interior index / exterior index */
   rgb cond_eta, cond_k;
+  int fresnel_white;  /* conductors: F = 1, the caller applies F per wavelength (--spectral) */
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types) */
   float metallic;     /* BSDF_PBR */

@@ -297,6 +297,54 @@ static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const c
   return get_rgb(c, o, key, where, out);
 }
 
+/* "spectrum": {"wavelengths": [nm...], "eta": [...], "k": [...]}, e.g. a table of
+ * measured optical constants: stored in the scene for --spectral; RGB mode takes their
+ * colourimetric projection (tab_to_rgb). */
+static valo_status parse_nk_spectrum(jctx *c, const cJSON *o, const char *where0, material *m) {
+  char where[300];
+  snprintf(where, sizeof where, "%s.spectrum", where0);
+  static const char *const keys[] = {"wavelengths", "eta", "k", NULL};
+  TRY(check_keys(c, o, where, keys));
+  nk_curve cv = {0};
+  float *dst[3] = {cv.nm, cv.eta, cv.k};
+  for (int a = 0; a < 3; a++) {
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(o, keys[a]);
+    char msg[200];
+    int n = cJSON_GetArraySize(arr);
+    if (!cJSON_IsArray(arr) || n < 2 || n > NK_MAX) {
+      snprintf(msg, sizeof msg, "\"%s\" must be an array of 2 to %d numbers", keys[a], NK_MAX);
+      return bad(c, where, msg);
+    }
+    if (a > 0 && n != cv.n) {
+      snprintf(msg, sizeof msg, "\"%s\" has %d values for %d wavelengths", keys[a], n, cv.n);
+      return bad(c, where, msg);
+    }
+    cv.n = n;
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+      double v = cJSON_IsNumber(e) ? e->valuedouble : NAN;
+      int ok = isfinite(v) && (a == 0 ? v >= 100 && v <= 20000 && (i == 0 || v > dst[0][i - 1]) : a == 1 ? v > 0 : v >= 0);
+      if (!ok) {
+        snprintf(msg, sizeof msg, "\"%s\"[%d] %s", keys[a], i,
+                 a == 0 ? "must be a wavelength in nm (100 to 20000), increasing" : a == 1 ? "must be a number > 0" : "must be a number >= 0");
+        return bad(c, where, msg);
+      }
+      dst[a][i] = (float)v;
+    }
+  }
+  nk_curve *q = realloc(c->s->nk, (c->s->nnk + 1) * sizeof *q);
+  if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->nk = q;
+  q[c->s->nnk++] = cv;
+  m->nk = (int)c->s->nnk;
+  m->eta = tab_to_rgb(cv.nm, cv.eta, cv.n);
+  m->k = tab_to_rgb(cv.nm, cv.k, cv.n);
+  /* An index is not a colour: a projection with a negative channel is clamped. */
+  m->eta = c3(fmaxf(m->eta.r, 1e-3f), fmaxf(m->eta.g, 1e-3f), fmaxf(m->eta.b, 1e-3f));
+  m->k = c3(fmaxf(m->k.r, 0), fmaxf(m->k.g, 0), fmaxf(m->k.b, 0));
+  return VALO_OK;
+}
+
 static valo_status parse_material(jctx *c, const cJSON *o, const char *name, material *m) {
   char where[256];
   snprintf(where, sizeof where, "materials.%s", name);
@@ -310,7 +358,7 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "pbr")) {
@@ -360,7 +408,11 @@ static valo_status parse_material(jctx *c, const cJSON *o, const char *name, mat
     m->type = MAT_CONDUCTOR;
     const char *preset = NULL;
     TRY(get_str(c, o, "preset", where, &preset));
-    if (preset) {
+    if (cJSON_GetObjectItemCaseSensitive(o, "spectrum")) {
+      if (preset || cJSON_GetObjectItemCaseSensitive(o, "eta") || cJSON_GetObjectItemCaseSensitive(o, "k"))
+        return bad(c, where, "give either \"spectrum\" or \"preset\" / \"eta\" and \"k\", not both");
+      TRY(parse_nk_spectrum(c, cJSON_GetObjectItemCaseSensitive(o, "spectrum"), where, m));
+    } else if (preset) {
       if (conductor_preset(preset, &m->eta, &m->k)) return bad(c, where, "unknown conductor preset (Au, Ag, Cu, Al)");
     } else {
       if (!cJSON_GetObjectItemCaseSensitive(o, "eta") || !cJSON_GetObjectItemCaseSensitive(o, "k"))

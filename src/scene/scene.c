@@ -19,7 +19,7 @@ scene *scene_new(const char *path) {
 void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
-  free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys);
+  free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
   if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
   free(s->tex);

@@ -40,8 +40,15 @@ typedef struct material {
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
+  int nk;            /* MAT_CONDUCTOR: 1 + index into scene.nk (eta and k per wavelength,
+                        which --spectral evaluates per wavelength), 0 = RGB eta, k only */
   char name[64];
 } material;
+
+/* A conductor's complex index tabulated against wavelength (JSON "spectrum"): linear
+ * between points, constant beyond the ends (core/spectrum.h tab_eval). */
+#define NK_MAX 256
+typedef struct nk_curve { int n; float nm[NK_MAX], eta[NK_MAX], k[NK_MAX]; } nk_curve;
 
 typedef enum light_type { LIGHT_AREA, LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL, LIGHT_ENV } light_type;
 typedef struct light {
@@ -93,6 +100,8 @@ typedef struct scene {
   uint32_t nmats, cap_mats;
   struct texture *tex;
   uint32_t ntex, cap_tex;
+  nk_curve *nk;            /* spectral conductor data (material.nk), nnk of them */
+  uint32_t nnk;
   light *lights;
   uint32_t nlights, cap_lights;
   int32_t *tri_light;      /* per triangle: its area light or -1 (after commit) */
