@@ -2,10 +2,14 @@
  * are documented to differ (docs/integrators.md):
  *  - whitted == path on a scene whose only light paths are point light -> one diffuse
  *    surface -> an ideal mirror -> camera;
+ *  - whitted in closed form: a point-lit diffuse floor seen in a vertical mirror, smooth
+ *    gold and smooth glass gives reflectance x rho/pi x I cos / d^2, with the Fresnel
+ *    terms computed here in complex arithmetic;
  *  - whitted is darker than path in a closed box (no interreflection);
  *  - distribution == path at the same fixed max_depth (both unbiased for the truncated
  *    transport), and darker than unlimited path. */
 #include "harness.h"
+#include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +55,55 @@ static int whitted_equals_path_mirror(void) {
   CHECK(w > 0.01, "the wall is not visible in the mirror (mean %g)", w);
   CHECK(fabs(w - p) < 0.01 * p, "whitted %g vs path %g", w, p);
   CHECK(fabs(d - p) < 0.01 * p, "distribution %g vs path %g", d, p);
+  return 0;
+}
+
+/* Fresnel reflectance of an interface to complex index n (from index 1), unpolarised. */
+static double fresnel_complex(double cos_i, double complex n) {
+  double complex sin2 = 1 - cos_i * cos_i, cos_t = csqrt(1 - sin2 / (n * n));
+  double complex rs = (cos_i - n * cos_t) / (cos_i + n * cos_t), rp = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+  return 0.5 * (cabs(rs) * cabs(rs) + cabs(rp) * cabs(rp));
+}
+
+static int whitted_closed_form(void) {
+  /* The camera at (2, 0, 3) looks at Q = (0, 0, 1) on a vertical reflector (the plane
+   * x = 0, facing +x) at 45 degrees; the reflected ray meets the floor (z = 0, x >= 0,
+   * diffuse 0.5) at P = (1, 0, 0), lit by a point light of intensity 10 at (2, 1, 2).
+   * What the reflector transmits leaves towards x < 0, where there is nothing. */
+  CHECK(scratch_file("wall.obj", "v 0 -5 0.01\nv 0 5 0.01\nv 0 5 5\nv 0 -5 5\nf 1 2 3 4\n") &&
+            scratch_file("floor.obj", "v 0 -50 0\nv 50 -50 0\nv 50 50 0\nv 0 50 0\nf 1 2 3 4\n"),
+        "write");
+  const double lp[3] = {2, 1, 2}, P[3] = {1, 0, 0}, intensity = 10, rho = 0.5;
+  double dl[3] = {lp[0] - P[0], lp[1] - P[1], lp[2] - P[2]}, d2 = dl[0] * dl[0] + dl[1] * dl[1] + dl[2] * dl[2];
+  double Lfloor = rho / M_PI * intensity * (dl[2] / sqrt(d2)) / d2, c45 = sqrt(0.5);
+  static const struct { const char *mat; double complex n[3]; double ks; } cases[] = {
+      {"{\"type\": \"mirror\", \"reflectance\": 0.9}", {0, 0, 0}, 0.9},
+      {"{\"type\": \"conductor\", \"eta\": [0.143, 0.374, 1.442], \"k\": [3.983, 2.385, 1.603]}",
+       {0.143 + 3.983 * _Complex_I, 0.374 + 2.385 * _Complex_I, 1.442 + 1.603 * _Complex_I}, 0},
+      {"{\"type\": \"dielectric\", \"ior\": 1.5}", {1.5, 1.5, 1.5}, 0},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [2,0,3], \"look_at\": [0,0,1], \"up\": [0,0,1], \"fov\": 0.05},\n"
+             "  \"film\": {\"width\": 1, \"height\": 1}, \"render\": {\"spp\": 4},\n"
+             "  \"materials\": {\"r\": %s, \"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+             "  \"shapes\": [{\"file\": \"wall.obj\", \"material\": \"r\"}, {\"file\": \"floor.obj\", \"material\": \"floor\"}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [2,1,2], \"intensity\": 10}] }\n",
+             cases[k].mat);
+    valo_options o;
+    valo_options_init(&o);
+    snprintf(o.integrator, sizeof o.integrator, "whitted");
+    int w, h;
+    float *px = render_json_text(json, &o, &w, &h);
+    CHECK(px, "render failed");
+    for (int c = 0; c < 3; c++) {
+      double R = cases[k].ks > 0 ? cases[k].ks : fresnel_complex(c45, cases[k].n[c]), want = R * Lfloor;
+      fprintf(stderr, "%s channel %d: %.6f, closed form %.6f (R = %.4f)\n", cases[k].mat, c, px[c], want, R);
+      CHECK(fabs(px[c] - want) < 1e-3 * want, "%s channel %d: %.6f, closed form %.6f", cases[k].mat, c, px[c], want);
+    }
+    free(px);
+  }
   return 0;
 }
 
@@ -129,7 +182,7 @@ static int default_scene_clean(void) {
 
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"whitted_equals_path_mirror", whitted_equals_path_mirror},
-                                    {"whitted_darker_in_box", whitted_darker_in_box},
+                                    {"whitted_darker_in_box", whitted_darker_in_box}, {"whitted_closed_form", whitted_closed_form},
                                     {"distribution_equals_path_at_depth", distribution_equals_path_at_depth},
                                     {"default_scene_clean", default_scene_clean},
                                     {NULL, NULL}};

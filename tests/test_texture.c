@@ -644,6 +644,130 @@ static int normal_map_shading(void) {
   return 0;
 }
 
+/* ---- BRDFs in closed form: the radiance of the point at the origin of a large z = 0
+ * quad, seen from direction v through a 1 x 1 film 0.05 degrees wide, lit by a
+ * directional light of irradiance 2 arriving from direction l (one scattering event:
+ * max_depth 1), is f(v, l) * 2 * cos(theta_l). f is written here from the documented
+ * definitions (docs/scene-format.md): the glTF metallic-roughness BRDF (glTF 2.0
+ * appendix B; valo's one documented departure, the diffuse base weighted by 1 - F(n.v))
+ * and the normalised Phong BRDF kd/pi + ks (n+2)/(2 pi) cos^n alpha, with its exponent
+ * from an MTL map_Ns. */
+static int plane_radiance(const char *shape, const double v[3], const double l[3], double out[3]) {
+  if (!scratch_file("bq.obj", "v -50 -50 0\nv 50 -50 0\nv 50 50 0\nv -50 50 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+                              "f 1/1/1 2/2/1 3/3/1 4/4/1\n") ||
+      !scratch_file("bqm.obj", "mtllib bq.mtl\nusemtl m\nv -50 -50 0\nv 50 -50 0\nv 50 50 0\nv -50 50 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+                               "f 1/1/1 2/2/1 3/3/1 4/4/1\n"))
+    return -1;
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [%.9f, %.9f, %.9f], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 0.05},\n"
+           "  \"film\": {\"width\": 1, \"height\": 1}, \"render\": {\"spp\": 16, \"max_depth\": 1},\n%s,\n"
+           "  \"lights\": [{\"type\": \"directional\", \"direction\": [%.9f, %.9f, %.9f], \"irradiance\": 2}] }\n",
+           3 * v[0], 3 * v[1], 3 * v[2], shape, -l[0], -l[1], -l[2]);
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  if (!px) return -1;
+  for (int c = 0; c < 3; c++) out[c] = px[c];
+  free(px);
+  return 0;
+}
+static void unit_dir(double theta_deg, double phi_deg, double d[3]) {
+  double t = theta_deg * M_PI / 180, p = phi_deg * M_PI / 180;
+  d[0] = sin(t) * cos(p); d[1] = sin(t) * sin(p); d[2] = cos(t);
+}
+static double smith_lambda(double a, double c) { return 0.5 * (-1 + sqrt(1 + a * a * (1 - c * c) / (c * c))); }
+static void pbr_brdf(const double base[3], double metal, double rough, const double v[3], const double l[3], double f[3]) {
+  double a = fmax(rough * rough, 1e-3), h[3] = {v[0] + l[0], v[1] + l[1], v[2] + l[2]};
+  double hl = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+  for (int i = 0; i < 3; i++) h[i] /= hl;
+  double vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2], nh2 = h[2] * h[2];
+  double D = a * a / (M_PI * pow(nh2 * (a * a - 1) + 1, 2)), G = 1 / (1 + smith_lambda(a, v[2]) + smith_lambda(a, l[2]));
+  double spec = D * G / (4 * v[2] * l[2]), s5 = pow(1 - vh, 5);
+  double Fvh = 0.04 + 0.96 * s5, Fnv = 0.04 + 0.96 * pow(1 - v[2], 5);
+  for (int c = 0; c < 3; c++)
+    f[c] = (1 - metal) * ((1 - Fnv) * base[c] / M_PI + Fvh * spec) + metal * (base[c] + (1 - base[c]) * s5) * spec;
+}
+static void phong_brdf(double kd, double ks, double n, const double v[3], const double l[3], double f[3]) {
+  double ca = -v[0] * l[0] - v[1] * l[1] + v[2] * l[2]; /* the mirror direction of v against l */
+  double lobe = ca > 0 ? (n + 2) / (2 * M_PI) * pow(ca, n) : 0;
+  for (int c = 0; c < 3; c++) f[c] = kd / M_PI + ks * lobe;
+}
+static int brdf_closed_form(void) {
+  /* viewer and light (theta, phi in degrees): head-on, the mirror direction at 40 and 75
+   * degrees, off the mirror direction, and out of the plane of incidence */
+  static const double geo[][4] = {{0, 0, 30, 0}, {40, 0, 40, 180}, {75, 0, 75, 180}, {60, 0, 30, 180}, {50, 0, 20, 90}, {30, 0, 35, 170}};
+  const int ngeo = sizeof geo / sizeof geo[0];
+  static const double pbr[][2] = {{0, 0.3}, {0, 0.7}, {0.5, 0.5}, {1, 0.4}, {0, 0.15}}; /* metallic, roughness */
+  const double base[3] = {0.8, 0.3, 0.2};
+  double worst = 0;
+  for (size_t k = 0; k < sizeof pbr / sizeof pbr[0]; k++)
+    for (int g = 0; g < ngeo; g++) {
+      double v[3], l[3], f[3], got[3];
+      unit_dir(geo[g][0], geo[g][1], v);
+      unit_dir(geo[g][2], geo[g][3], l);
+      char shape[600];
+      snprintf(shape, sizeof shape,
+               "  \"materials\": {\"m\": {\"type\": \"pbr\", \"base_color\": [0.8, 0.3, 0.2], \"metallic\": %g, \"roughness\": %g}},\n"
+               "  \"shapes\": [{\"file\": \"bq.obj\", \"material\": \"m\"}]", pbr[k][0], pbr[k][1]);
+      CHECK(plane_radiance(shape, v, l, got) == 0, "render failed");
+      pbr_brdf(base, pbr[k][0], pbr[k][1], v, l, f);
+      for (int c = 0; c < 3; c++) {
+        double want = f[c] * 2 * l[2], e = fabs(got[c] - want) / want;
+        worst = fmax(worst, e);
+        CHECK(e < 2e-3, "pbr metallic %g roughness %g, view %g, light (%g, %g), channel %d: %.6f, closed form %.6f", pbr[k][0], pbr[k][1], geo[g][0],
+              geo[g][2], geo[g][3], c, got[c], want);
+      }
+    }
+  /* the same BRDF read from a glTF file: metallic 0, roughness 1, an sRGB base-colour texture */
+  unsigned char rgb8[4 * 4 * 3];
+  for (int i = 0; i < 16; i++) { rgb8[3 * i] = 204; rgb8[3 * i + 1] = 153; rgb8[3 * i + 2] = 102; }
+  char texp[1200];
+  snprintf(texp, sizeof texp, "%s/quad-texture.png", scratch_dir());
+  CHECK(stbi_write_png(texp, 4, 4, 3, rgb8, 12) && write_gltf_quad("pbrq.gltf", NULL, 0, "", 0) == 0, "write");
+  double lin[3];
+  for (int c = 0; c < 3; c++) {
+    double x = rgb8[c] / 255.0;
+    lin[c] = x <= 0.04045 ? x / 12.92 : pow((x + 0.055) / 1.055, 2.4);
+  }
+  for (int g = 0; g < ngeo; g++) {
+    double v[3], l[3], f[3], got[3];
+    unit_dir(geo[g][0], geo[g][1], v);
+    unit_dir(geo[g][2], geo[g][3], l);
+    CHECK(plane_radiance("  \"shapes\": [{\"file\": \"pbrq.gltf\"}]", v, l, got) == 0, "render failed");
+    pbr_brdf(lin, 0, 1, v, l, f);
+    for (int c = 0; c < 3; c++) {
+      double want = f[c] * 2 * l[2], e = fabs(got[c] - want) / want;
+      worst = fmax(worst, e);
+      CHECK(e < 2e-3, "glTF, view %g, light (%g, %g), channel %d: %.6f, closed form %.6f", geo[g][0], geo[g][2], geo[g][3], c, got[c], want);
+    }
+  }
+  fprintf(stderr, "pbr: %d cases (JSON and glTF) within %.3f %% of the closed form\n", (int)(sizeof pbr / sizeof pbr[0] + 1) * ngeo, 100 * worst);
+  /* Phong: JSON exponent 50, and an MTL exponent 250 times a map of 0.2 */
+  unsigned char tex[4 * 4];
+  memset(tex, 51, sizeof tex);
+  char png[1200];
+  snprintf(png, sizeof png, "%s/ns.png", scratch_dir());
+  CHECK(stbi_write_png(png, 4, 4, 1, tex, 4), "png");
+  CHECK(scratch_file("bq.mtl", "newmtl m\nKd 0.3 0.3 0.3\nKs 0.5 0.5 0.5\nillum 2\nNs 250\nmap_Ns ns.png\n"), "write");
+  worst = 0;
+  for (int mtl = 0; mtl < 2; mtl++)
+    for (int g = 0; g < ngeo; g++) {
+      double v[3], l[3], f[3], got[3];
+      unit_dir(geo[g][0], geo[g][1], v);
+      unit_dir(geo[g][2], geo[g][3], l);
+      const char *shape = mtl ? "  \"shapes\": [{\"file\": \"bqm.obj\"}]"
+                              : "  \"materials\": {\"m\": {\"type\": \"phong\", \"diffuse\": 0.3, \"specular\": 0.5, \"exponent\": 50}},\n"
+                                "  \"shapes\": [{\"file\": \"bq.obj\", \"material\": \"m\"}]";
+      CHECK(plane_radiance(shape, v, l, got) == 0, "render failed");
+      phong_brdf(0.3, 0.5, mtl ? 250 * (51 / 255.0) : 50, v, l, f);
+      double want = f[0] * 2 * l[2], e = fabs(got[0] - want) / want;
+      worst = fmax(worst, e);
+      CHECK(e < 2e-3, "phong (%s), view %g, light (%g, %g): %.6f, closed form %.6f", mtl ? "MTL map_Ns" : "JSON", geo[g][0], geo[g][2], geo[g][3], got[0], want);
+    }
+  fprintf(stderr, "phong: %d cases within %.3f %% of the closed form\n", 2 * ngeo, 100 * worst);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
@@ -651,6 +775,6 @@ int main(int argc, char **argv) {
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
                                     {"alpha_cutoff", alpha_cutoff},
-                                    {"normal_map_shading", normal_map_shading}, {NULL, NULL}};
+                                    {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
