@@ -21,7 +21,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 46
+#define CHI2_TESTS 50
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -633,7 +633,7 @@ static int light_selection_facing(void) {
   valo_error err;
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   light_sampler ls;
-  CHECK(light_sampler_init(&ls, s) == 0, "init");
+  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID) == 0, "init");
   /* Lights: [0] point, [1] A, [2] B (area lights are added at commit). */
   int ia = -1, ib = -1;
   for (uint32_t i = 0; i < s->nlights; i++)
@@ -660,6 +660,94 @@ static int light_selection_facing(void) {
   double o2[2] = {obs[0], obs[ia]}, e2[2] = {ex[0], ex[ia]};
   int rc = chi2_check("light selection at a point (one light facing away)", o2, e2, 2);
   light_sampler_free(&ls);
+  scene_free(s);
+  return rc;
+}
+
+static float u01(uint64_t *st) {
+  uint64_t z = (*st += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return (float)((z ^ (z >> 31)) >> 40) * 0x1p-24f;
+}
+
+/* ---- the light grid (light.h): 300 one-sided emissive triangles of varied size, facing
+ * and power scattered through a 10 m box, a point light and a directional light. At
+ * points in the box: the pmfs sum to 1, every light keeps at least the power share's
+ * fraction LIGHT_GRID_POWER (so nothing that can reach the point is starved), the
+ * choice light_select reports is light_select_pmf's, frequencies match the pmfs
+ * (chi-square), and the nearest lamp is picked far more often than by power. */
+static int light_grid_selection(void) {
+  const int nt = 300;
+  scene *s = scene_new("grid");
+  CHECK(scene_reserve(s, 3 * nt, nt) == 0, "reserve");
+  uint64_t st = 12345;
+  for (int t = 0; t < nt; t++) {
+    vec3 c = v3(10 * u01(&st), 10 * u01(&st), 10 * u01(&st));
+    for (int k = 0; k < 3; k++)
+      s->pos[3 * t + k] = v3_add(c, v3(0.3f * (u01(&st) - 0.5f), 0.3f * (u01(&st) - 0.5f), 0.3f * (u01(&st) - 0.5f)));
+    for (int k = 0; k < 3; k++) s->idx[3 * t + k] = (uint32_t)(3 * t + k);
+    s->tri_mat[t] = (uint32_t)(t % 3);
+    s->tri_flags[t] = 0;
+  }
+  s->nverts = 3 * nt;
+  s->ntris = nt;
+  for (int k = 0; k < 3; k++) {
+    material m = material_default();
+    m.emission = c3(1.0f + 4 * k, 2, 1);
+    CHECK(scene_add_material(s, &m) == (uint32_t)k, "material");
+  }
+  light pt = {0};
+  pt.type = LIGHT_POINT; pt.p = v3(5, 5, 5); pt.L = c3(3, 3, 3);
+  CHECK(scene_add_light(s, &pt) == 0, "light");
+  light sun = {0};
+  sun.type = LIGHT_DIRECTIONAL; sun.dir = v3(0, -1, 0); sun.L = c3(0.5f, 0.5f, 0.5f);
+  CHECK(scene_add_light(s, &sun) == 0, "light");
+  valo_error err;
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  light_sampler ls, lp;
+  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID) == 0 && ls.grid_cdf, "grid not built");
+  CHECK(light_sampler_init(&lp, s, LIGHT_SELECT_POWER) == 0 && !lp.grid_cdf, "power selection built a grid");
+  uint32_t n = s->nlights;
+  double *obs = calloc(n, sizeof *obs), *ex = calloc(n, sizeof *ex);
+  int rc = 0;
+  for (int q = 0; q < 4 && !rc; q++) {
+    vec3 p = v3(10 * u01(&st), 10 * u01(&st), 10 * u01(&st));
+    double total = 0;
+    uint32_t nearest = 0;
+    float dmin = INFINITY;
+    for (uint32_t i = 0; i < n; i++) {
+      float pg = light_select_pmf(&ls, s, i, p), pp = light_select_pmf(&lp, s, i, p);
+      total += pg;
+      CHECK(pg >= LIGHT_GRID_POWER * pp * (1 - 1e-5f), "light %u: pmf %g below the power share's %g", i, pg, LIGHT_GRID_POWER * pp);
+      const light *l = &s->lights[i];
+      if (l->type == LIGHT_AREA) {
+        const uint32_t *ix = &s->idx[3 * l->tri];
+        vec3 cen = v3_scale(v3_add(v3_add(s->pos[ix[0]], s->pos[ix[1]]), s->pos[ix[2]]), 1.0f / 3);
+        float d = v3_len(v3_sub(cen, p));
+        if (d < dmin && v3_dot(scene_tri_ng(s, l->tri), v3_sub(p, cen)) > 0) { dmin = d; nearest = i; }
+      }
+    }
+    CHECK(fabs(total - 1) < 1e-4, "pmfs sum to %g", total);
+    double gain = light_select_pmf(&ls, s, nearest, p) / light_select_pmf(&lp, s, nearest, p);
+    CHECK(gain > 5, "the nearest lamp facing the point (%.2f m) is picked only %.2f times as often as by power", dmin, gain);
+    memset(obs, 0, n * sizeof *obs);
+    long ns = nsamples();
+    for (long k = 0; k < ns; k++) {
+      sampler sm = sampler_make(7, (uint64_t)k, (uint64_t)q);
+      float pmf;
+      uint32_t li = light_select(&ls, s, p, sampler_1d(&sm), &pmf);
+      CHECK(li < n, "no light picked");
+      CHECK(pmf == light_select_pmf(&ls, s, li, p), "light %u: select says %g, pmf %g", li, pmf, light_select_pmf(&ls, s, li, p));
+      obs[li]++;
+    }
+    for (uint32_t i = 0; i < n; i++) ex[i] = ns * light_select_pmf(&ls, s, i, p);
+    fprintf(stderr, "point %d: nearest lamp %.2f m, picked %.1fx as often as by power\n", q, dmin, gain);
+    rc = chi2_check("light grid selection", obs, ex, (int)n);
+  }
+  free(obs); free(ex);
+  light_sampler_free(&ls);
+  light_sampler_free(&lp);
   scene_free(s);
   return rc;
 }
@@ -736,7 +824,7 @@ int main(int argc, char **argv) {
                                     {"microfacet_furnace", microfacet_furnace}, {"ggx_albedo", ggx_albedo}, {"bsdf_reciprocity", bsdf_reciprocity},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness},
                                     {"sobol_sampler", sobol_sampler},
-                                    {"light_selection_facing", light_selection_facing},
+                                    {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -338,6 +338,10 @@ static int bad_options(void) {
   EXPECT_FAIL(2, "render", obj, "--focus", "0");
   SAID("--focus");
   EXPECT_FAIL(2, "dance");
+  EXPECT_FAIL(2, "render", obj, "--light-sampler", "tree", "--res", "4x4");
+  SAID("--light-sampler"); SAID("grid or power");
+  EXPECT_FAIL(2, "render", obj, "--sampler", "halton", "--res", "4x4");
+  SAID("sobol or independent");
   /* integrator parameters: unknown, out of range, malformed, for no integrator */
   EXPECT_FAIL(2, "render", obj, "--integrator", "photon", "--param", "globl=5", "--res", "4x4");
   SAID("unknown parameter \"globl\" for the photon integrator"); SAID("global");
@@ -359,6 +363,9 @@ static int bad_options(void) {
     snprintf(json, sizeof json, "{ \"render\": {\"integrator\": \"photon\", \"photon\": {\"globl\": 3}}, \"shapes\": [{\"file\": \"ok.obj\"}] }");
     EXPECT_FAIL(1, "render", write_file("params.json", json), "--res", "4x4");
     SAID("unknown parameter \"globl\" for the photon integrator");
+    snprintf(json, sizeof json, "{ \"render\": {\"light_sampler\": \"tree\"}, \"shapes\": [{\"file\": \"ok.obj\"}] }");
+    EXPECT_FAIL(1, "render", write_file("lights.json", json), "--res", "4x4");
+    SAID("render.light_sampler"); SAID("\"grid\" or \"power\"");
     snprintf(json, sizeof json, "{ \"render\": {\"photon\": 5}, \"shapes\": [{\"file\": \"ok.obj\"}] }");
     EXPECT_FAIL(1, "render", write_file("params2.json", json), "--res", "4x4");
     SAID("unknown key \"photon\"");

@@ -63,6 +63,10 @@ typedef struct valo_options {
   char accel[16];         /* "kdtree" (default) or "embree" */
   char sampler[16];       /* "sobol" (default: Owen-scrambled Sobol, padded per dimension)
                              or "independent" (a hash per sample and dimension) */
+  char light_sampler[16]; /* how next-event estimation picks a light in scenes with more
+                             than 64: "grid" (default: a distribution per cell of a grid
+                             over the scene, by power over distance squared) or "power"
+                             (by power alone) */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
                              valo_render_write can then write; with the VALO_AOVS_AO bit
                              also ambient occlusion and the bent normal (one more ray
@@ -187,6 +191,7 @@ typedef struct valo_stats {
   char integrator[32];
   char accel[16];
   char sampler[16];
+  char light_sampler[16];
 } valo_stats;
 VALO_API void valo_render_stats(const valo_render *r, valo_stats *out);
 

@@ -68,6 +68,8 @@ static void usage_render(FILE *f) {
           "                         --help-integrators lists them with defaults\n"
           "  --accel NAME           kdtree (default) or embree\n"
           "  --sampler NAME         sobol (default: Owen-scrambled Sobol) or independent\n"
+          "  --light-sampler NAME   grid (default: lights near the point first, in scenes\n"
+          "                         with more than 64 lights) or power\n"
           "  --max-depth N          maximum path length (default -1: unlimited, Russian roulette\n"
           "                         ends paths)\n"
           "  --env FILE             light by this environment map (.exr/.hdr/.pfm), replacing\n"
@@ -282,6 +284,10 @@ static int cmd_render(int argc, char **argv) {
       size_t used = strlen(opt.params);
       if (used + strlen(val) + 2 > sizeof opt.params) { fprintf(stderr, "valo: --param: too many parameters\n"); return EXIT_USAGE; }
       snprintf(opt.params + used, sizeof opt.params - used, "%s%s", used ? " " : "", val);
+    } else if (!strcmp(a, "--light-sampler")) {
+      NEED_VALUE();
+      if (strcmp(val, "grid") && strcmp(val, "power")) BAD_VALUE("grid or power");
+      snprintf(opt.light_sampler, sizeof opt.light_sampler, "%s", val);
     } else if (!strcmp(a, "--sampler")) {
       NEED_VALUE();
       if (strcmp(val, "sobol") && strcmp(val, "independent")) BAD_VALUE("sobol or independent");

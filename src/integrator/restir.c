@@ -30,7 +30,7 @@ enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIA
 #define DI_PARAMS_COMMON                                                                                                              \
   {"candidates", IPARAM_INT, 32, 1, 1024, "M: light samples per pixel per frame (RIS candidates)"},                                   \
   {"temporal", IPARAM_INT, -1, -1, 1, "1: reuse the previous frame's reservoir at the reprojected pixel; -1: in sequences only"},  \
-  {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},                    \
+  {"history", IPARAM_FLOAT, 2, 0, 1000, "the previous frame's M is capped at this many times the current one's (paper: 20)"},          \
   {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
   {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"}, \
   {"iterations", IPARAM_INT, 2, 0, 8, "n: rounds of spatial reuse"},                                                                   \

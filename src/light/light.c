@@ -5,6 +5,7 @@
 #include "light/envmap.h"
 #include "scene/texture.h"
 #include <stdlib.h>
+#include <string.h>
 
 rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v) {
   rgb L = light_area_emitted(l, ng, w);
@@ -26,8 +27,92 @@ float light_power(const scene *s, const light *l) {
   return 0;
 }
 
-int light_sampler_init(light_sampler *ls, const scene *s) {
-  ls->table.bins = NULL; ls->table.n = 0; ls->env_index = -1; ls->power = NULL; ls->n = 0; ls->local = 0;
+/* The light grid (light.h): per-light centre, radius and (one-sided area lights) plane,
+ * then each cell's running sums. */
+typedef struct grid_light { vec3 c; float r, w_far; vec3 n; float d; int local, one_sided; } grid_light;
+
+static int grid_build(light_sampler *ls, const scene *s) {
+  uint32_t n = ls->n;
+  uint64_t budget = LIGHT_GRID_CELLS;
+  if (budget * n > (64u << 20)) budget = (64u << 20) / n; /* at most 256 MB of sums */
+  if (budget < 8) return 0;
+  vec3 ext = v3_sub(s->bounds.hi, s->bounds.lo);
+  float emax = fmaxf(ext.x, fmaxf(ext.y, ext.z));
+  if (!(emax > 0) || !isfinite(emax)) return 0;
+  float e[3] = {fmaxf(ext.x, 1e-3f * emax), fmaxf(ext.y, 1e-3f * emax), fmaxf(ext.z, 1e-3f * emax)};
+  float h = cbrtf(e[0] * e[1] * e[2] / (float)budget);
+  uint64_t cells = 1;
+  for (int a = 0; a < 3; a++) {
+    int d = (int)ceilf(e[a] / h);
+    ls->gdim[a] = d < 1 ? 1 : d > 64 ? 64 : d;
+    cells *= (uint64_t)ls->gdim[a];
+  }
+  grid_light *gl = malloc(n * sizeof *gl);
+  float *cdf = malloc(cells * n * sizeof *cdf);
+  if (!gl || !cdf) { free(gl); free(cdf); return -1; }
+  float R2 = PI_F * s->radius * s->radius;
+  for (uint32_t i = 0; i < n; i++) {
+    const light *l = &s->lights[i];
+    grid_light *g = &gl[i];
+    memset(g, 0, sizeof *g);
+    float pw = ls->power[i];
+    switch (l->type) {
+    case LIGHT_AREA: {
+      const uint32_t *ix = &s->idx[3 * l->tri];
+      vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+      g->c = v3_scale(v3_add(v3_add(a, b), c), 1.0f / 3);
+      g->r = sqrtf(fmaxf(v3_len2(v3_sub(a, g->c)), fmaxf(v3_len2(v3_sub(b, g->c)), v3_len2(v3_sub(c, g->c)))));
+      g->w_far = pw / PI_F;
+      g->local = 1;
+      g->one_sided = !l->two_sided;
+      g->n = scene_tri_ng(s, l->tri);
+      g->d = -v3_dot(g->n, a);
+      break;
+    }
+    case LIGHT_POINT: case LIGHT_SPOT: g->c = l->p; g->w_far = pw / (4 * PI_F); g->local = 1; break;
+    case LIGHT_DIRECTIONAL: case LIGHT_ENV: g->w_far = pw / R2; break;
+    }
+  }
+  vec3 cell = v3(e[0] / ls->gdim[0], e[1] / ls->gdim[1], e[2] / ls->gdim[2]);
+  vec3 half = v3_scale(cell, 0.5f);
+  float rc = v3_len(half);
+  for (int z = 0; z < ls->gdim[2]; z++)
+    for (int y = 0; y < ls->gdim[1]; y++)
+      for (int x = 0; x < ls->gdim[0]; x++) {
+        size_t ci = ((size_t)z * ls->gdim[1] + y) * ls->gdim[0] + x;
+        float *row = cdf + ci * n;
+        vec3 cc = v3(s->bounds.lo.x + (x + 0.5f) * cell.x, s->bounds.lo.y + (y + 0.5f) * cell.y, s->bounds.lo.z + (z + 0.5f) * cell.z);
+        double total = 0;
+        for (uint32_t i = 0; i < n; i++) {
+          const grid_light *g = &gl[i];
+          float w = g->w_far;
+          if (g->local) {
+            /* one-sided and the whole cell behind (or level with) its plane: nothing */
+            if (g->one_sided &&
+                v3_dot(g->n, cc) + g->d + fabsf(g->n.x) * half.x + fabsf(g->n.y) * half.y + fabsf(g->n.z) * half.z <= 0)
+              w = 0;
+            else {
+              float rr = rc + g->r;
+              w /= fmaxf(v3_len2(v3_sub(g->c, cc)), rr * rr);
+            }
+          }
+          total += (w > 0 && isfinite(w)) ? w : 0;
+          row[i] = (float)total;
+        }
+        float inv = total > 0 ? (float)(1 / total) : 0;
+        for (uint32_t i = 0; i < n; i++) row[i] *= inv;
+        if (total > 0) row[n - 1] = 1;
+      }
+  free(gl);
+  ls->grid_cdf = cdf;
+  ls->glo = s->bounds.lo;
+  ls->ginv = v3(1 / cell.x, 1 / cell.y, 1 / cell.z);
+  return 0;
+}
+
+int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode) {
+  memset(ls, 0, sizeof *ls);
+  ls->env_index = -1;
   if (s->nlights == 0) return 0;
   float *w = malloc(s->nlights * sizeof *w);
   if (!w) return -1;
@@ -41,9 +126,16 @@ int light_sampler_init(light_sampler *ls, const scene *s) {
   ls->power = w;
   ls->n = s->nlights;
   ls->local = s->nlights <= LIGHT_LOCAL_MAX;
+  if (!ls->local && mode == LIGHT_SELECT_GRID && grid_build(ls, s)) return -1;
   return 0;
 }
-void light_sampler_free(light_sampler *ls) { alias_free(&ls->table); free(ls->power); ls->power = NULL; }
+void light_sampler_free(light_sampler *ls) {
+  alias_free(&ls->table);
+  free(ls->power);
+  free(ls->grid_cdf);
+  ls->power = NULL;
+  ls->grid_cdf = NULL;
+}
 
 /* Can light l send anything to p? Only one-sided area lights can be turned away. */
 static int light_faces(const scene *s, const light *l, vec3 p) {
@@ -60,8 +152,42 @@ static float facing_weights(const light_sampler *ls, const scene *s, vec3 p, flo
   return total;
 }
 
+/* The grid cell's running sums for point p (NULL when the cell has no light). */
+static const float *grid_row(const light_sampler *ls, vec3 p) {
+  vec3 q = v3_sub(p, ls->glo);
+  int c[3];
+  const float f[3] = {q.x * ls->ginv.x, q.y * ls->ginv.y, q.z * ls->ginv.z};
+  for (int a = 0; a < 3; a++) {
+    int i = isfinite(f[a]) ? (int)floorf(fminf(fmaxf(f[a], 0), 1e6f)) : 0;
+    c[a] = i >= ls->gdim[a] ? ls->gdim[a] - 1 : i;
+  }
+  const float *row = ls->grid_cdf + (((size_t)c[2] * ls->gdim[1] + c[1]) * ls->gdim[0] + c[0]) * ls->n;
+  return row[ls->n - 1] > 0 ? row : NULL;
+}
+static inline float grid_pmf(const float *row, uint32_t i) { return i ? row[i] - row[i - 1] : row[0]; }
+
 uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
+  if (ls->grid_cdf) {
+    const float *row = grid_row(ls, p);
+    if (!row) return alias_sample(&ls->table, u, pmf);
+    uint32_t i;
+    const float a = LIGHT_GRID_POWER;
+    if (u < a) {
+      float pp;
+      i = alias_sample(&ls->table, fminf(u / a, 0x1.fffffep-1f), &pp);
+    } else {
+      float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
+      uint32_t lo = 0, hi = ls->n - 1; /* the first i with row[i] > v */
+      while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (row[mid] > v) hi = mid; else lo = mid + 1;
+      }
+      i = lo;
+    }
+    *pmf = a * alias_pmf(&ls->table, i) + (1 - a) * grid_pmf(row, i);
+    return i;
+  }
   if (!ls->local) return alias_sample(&ls->table, u, pmf);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   if (!(total > 0)) return UINT32_MAX;
@@ -79,6 +205,11 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
 
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
   if (ls->table.n == 0) return 0;
+  if (ls->grid_cdf) {
+    const float *row = grid_row(ls, p);
+    if (!row) return alias_pmf(&ls->table, li);
+    return LIGHT_GRID_POWER * alias_pmf(&ls->table, li) + (1 - LIGHT_GRID_POWER) * grid_pmf(row, li);
+  }
   if (!ls->local) return alias_pmf(&ls->table, li);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   return total > 0 ? w[li] / total : 0;

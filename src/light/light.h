@@ -9,16 +9,33 @@
 #include "scene/scene.h"
 #include "core/alias.h"
 
-/* Light selection for next-event estimation. By power (alias table), except that in
- * scenes with at most LIGHT_LOCAL_MAX lights the choice is made per shading point: one-
- * sided area lights the point is behind (or level with) get weight 0, the rest keep
- * their power, so no sample is spent on a light that cannot reach the point. Above
- * that count the O(n) pass per sample costs more than it saves (a light tree would be
- * the way; not built). light_select and light_select_pmf make the same choice. */
+/* Light selection for next-event estimation (and restir's candidates). By power (alias
+ * table), except:
+ *  - in scenes with at most LIGHT_LOCAL_MAX lights the choice is made per shading point:
+ *    one-sided area lights the point is behind (or level with) get weight 0, the rest
+ *    keep their power, so no sample is spent on a light that cannot reach the point;
+ *  - above that count, with the light grid (LIGHT_SELECT_GRID, the default): the scene's
+ *    bounds are cut into up to LIGHT_GRID_CELLS cells, and each cell holds a distribution
+ *    over the lights with weight power / (pi max(d^2, r^2)) (d from the cell's centre to
+ *    the light's, r the two radii: a bound on the irradiance the light can bring to the
+ *    cell), 0 for one-sided lights the whole cell is behind; directional lights and the
+ *    environment weigh power / (pi R^2) (R the scene's radius). A point picks from its
+ *    cell's distribution with probability 1 - LIGHT_GRID_POWER, else by power, and the
+ *    pmf is that mixture, so every light that can reach the point keeps a positive
+ *    probability (unbiased whatever the bound misjudges).
+ * light_select and light_select_pmf make the same choice. */
 #define LIGHT_LOCAL_MAX 64
-typedef struct light_sampler { alias_table table; int env_index; float *power; uint32_t n; int local; } light_sampler;
+#define LIGHT_GRID_CELLS 4096
+#define LIGHT_GRID_POWER 0.2f
+typedef enum light_select_mode { LIGHT_SELECT_GRID, LIGHT_SELECT_POWER } light_select_mode;
+typedef struct light_sampler {
+  alias_table table; int env_index; float *power; uint32_t n; int local;
+  float *grid_cdf;      /* per cell, n running sums normalised to 1 (cells with nothing: all 0) */
+  int gdim[3];
+  vec3 glo, ginv;       /* grid origin and cells per unit length */
+} light_sampler;
 
-int light_sampler_init(light_sampler *ls, const scene *s);
+int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode);
 void light_sampler_free(light_sampler *ls);
 /* Picks a light for shading point p with u in [0,1); returns its index and *pmf, or
  * UINT32_MAX when no light can reach p. */

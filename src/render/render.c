@@ -185,6 +185,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
     }
     if (o->accel[0]) memcpy(dst->accel, o->accel, sizeof dst->accel);
     if (o->sampler[0]) memcpy(dst->sampler, o->sampler, sizeof dst->sampler);
+    if (o->light_sampler[0]) memcpy(dst->light_sampler, o->light_sampler, sizeof dst->light_sampler);
     if (o->aovs != VALO_UNSET) dst->aovs = o->aovs;
     if (o->adaptive != VALO_UNSET) dst->adaptive = o->adaptive;
     if (o->noise_threshold != VALO_UNSET) dst->noise_threshold = o->noise_threshold;
@@ -207,6 +208,7 @@ static void merge_options(valo_options *dst, const valo_options *file, const val
   if (!dst->integrator[0]) snprintf(dst->integrator, sizeof dst->integrator, "path");
   if (!dst->accel[0]) snprintf(dst->accel, sizeof dst->accel, "kdtree");
   if (!dst->sampler[0]) snprintf(dst->sampler, sizeof dst->sampler, "sobol");
+  if (!dst->light_sampler[0]) snprintf(dst->light_sampler, sizeof dst->light_sampler, "grid");
 }
 
 /* The pinhole basis of frame f of a sequence (the scene's camera animation, if any), or
@@ -247,6 +249,8 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   if (o.max_depth < -1) return err_set(err, VALO_ERR_INVALID, "max_depth must be -1 (unlimited) or >= 0");
   if (strcmp(o.sampler, "sobol") && strcmp(o.sampler, "independent"))
     return err_set(err, VALO_ERR_INVALID, "unknown sampler \"%s\" (sobol or independent)", o.sampler);
+  if (strcmp(o.light_sampler, "grid") && strcmp(o.light_sampler, "power"))
+    return err_set(err, VALO_ERR_INVALID, "unknown light sampler \"%s\" (grid or power)", o.light_sampler);
   const integrator_ops *integ = integrator_find(o.integrator);
   if (!integ) {
     char list[256] = "";
@@ -301,7 +305,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &r->alpha_filter : NULL, &r->acc, err);
   if (st) { free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r->frame_rgb); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
-  if (light_sampler_init(&r->ctx.ls, s)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  if (light_sampler_init(&r->ctx.ls, s, strcmp(r->opt.light_sampler, "power") ? LIGHT_SELECT_GRID : LIGHT_SELECT_POWER)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   r->ctx.s = s;
   r->ctx.acc = r->acc;
   r->ctx.max_depth = o.max_depth;
@@ -747,6 +751,7 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   snprintf(o->integrator, sizeof o->integrator, "%s", r->opt.integrator);
   snprintf(o->accel, sizeof o->accel, "%s", r->opt.accel);
   snprintf(o->sampler, sizeof o->sampler, "%s", r->opt.sampler);
+  snprintf(o->light_sampler, sizeof o->light_sampler, "%s", r->opt.light_sampler);
 }
 
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) {

@@ -224,13 +224,13 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
       if (n < 0 || (size_t)n >= sizeof op->params - used) return bad(c, w, "too many parameters");
     }
   }
-  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", NULL};
+  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", "light_sampler", NULL};
   for (const cJSON *it = o->child; it; it = it->next) {
     int ok = cJSON_IsObject(it);
     for (const char *const *a = keys; *a && !ok; a++) ok = !strcmp(it->string, *a);
     if (!ok) {
       char msg[400];
-      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed: integrator spp seed max_depth accel time sampler, or an "
+      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed: integrator spp seed max_depth accel time sampler light_sampler, or an "
                                 "integrator's name with an object of its parameters)", it->string);
       return bad(c, "render", msg);
     }
@@ -245,6 +245,10 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
   TRY(get_str(c, o, "sampler", "render", &s));
   if (s && strcmp(s, "sobol") && strcmp(s, "independent")) return bad(c, "render.sampler", "must be \"sobol\" or \"independent\"");
   if (s) snprintf(op->sampler, sizeof op->sampler, "%s", s);
+  s = NULL;
+  TRY(get_str(c, o, "light_sampler", "render", &s));
+  if (s && strcmp(s, "grid") && strcmp(s, "power")) return bad(c, "render.light_sampler", "must be \"grid\" or \"power\"");
+  if (s) snprintf(op->light_sampler, sizeof op->light_sampler, "%s", s);
   TRY(get_int(c, o, "spp", "render", 1, 1048576, &op->spp));
   double seed = -1;
   TRY(get_num(c, o, "seed", "render", 0, 9007199254740992.0, &seed));
