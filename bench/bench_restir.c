@@ -1,8 +1,10 @@
 /* bench_restir.c — restir-di and restir-gi against the baselines of the ReSTIR papers, at
  * equal time, on the many-light scenes (docs/performance.md):
- *  - direct light: restir-di against path limited to direct light (--max-depth 1: power-
- *    proportional light selection, one NEE sample, MIS with BSDF sampling);
- *  - global illumination: restir-gi against path.
+ *  - direct light: restir-di against path limited to direct light (--max-depth 1: one NEE
+ *    sample, MIS with BSDF sampling), with power-proportional light selection (the
+ *    papers' baseline, which the issue's bar names) and with valo's default light grid;
+ *  - global illumination: restir-gi against path (both with the light grid).
+ * restir draws its candidates from the default light grid as well.
  * For each: per-frame relMSE at 1 sample per pixel per frame (the baseline given as many
  * samples per pixel as fit in restir's frame time, at least 1), the relMSE of the image
  * accumulated over an equal total time, and temporal stability on a static camera (mean
@@ -38,6 +40,7 @@ typedef struct job {
   float *px;            /* final film */
   float *seq[64];       /* a sequence's frames */
   int nseq;
+  const char *lights;   /* light sampler ("power"), NULL: the default */
 } job;
 
 static valo_status grab(void *user, const valo_render *r, int f, valo_error *err) {
@@ -64,6 +67,7 @@ static int run(job *j) {
   if (j->max_depth >= 0) o.max_depth = j->max_depth;
   if (j->budget > 0) o.time_budget = j->budget;
   if (j->frames > 0) o.frames = j->frames;
+  if (j->lights) snprintf(o.light_sampler, sizeof o.light_sampler, "%s", j->lights);
   valo_render *r;
   double t0 = bench_now();
   if (valo_render_create(sc, &o, &r, &err)) { fprintf(stderr, "%s\n", err.message); return -1; }
@@ -140,7 +144,7 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
   char stat[1024];
   if (static_copy(sd->file, stat, sizeof stat)) { fprintf(stderr, "cannot copy %s\n", sd->file); return 1; }
   /* lamp mask: emission seen directly */
-  job em = {stat, "path", NULL, sd->w, sd->h, 1024, 0, 0, 0, 1, 0, NULL, {NULL}, 0}; /* every pixel a lamp touches */
+  job em = {stat, "path", NULL, sd->w, sd->h, 1024, 0, 0, 0, 1, 0, NULL, {NULL}, 0, NULL}; /* every pixel a lamp touches */
   if (run(&em)) return 1;
   g_ok = malloc((size_t)n);
   for (int y = 0; y < sd->h; y++)
@@ -167,43 +171,56 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
     printf("\n%s, %s against path%s (%dx%d, 2 threads)\n", sd->name, integ, gi ? "" : " --max-depth 1", sd->w, sd->h);
     /* time per frame (still, static camera) and per baseline sample */
     int nf = quick ? 4 : 16;
-    job rt = {stat, integ, NULL, sd->w, sd->h, nf, 0, -1, 0, 3, 0, NULL, {NULL}, 0};
-    job pt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0};
-    if (run(&rt) || run(&pt)) return 1;
-    double t_frame = rt.secs / nf, t_spp = pt.secs / nf;
-    int base_spp = (int)lround(t_frame / t_spp);
+    job rt = {stat, integ, NULL, sd->w, sd->h, nf, 0, -1, 0, 3, 0, NULL, {NULL}, 0, NULL};
+    job pt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, "power"};
+    job gt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, NULL};
+    if (run(&rt) || run(&pt) || run(&gt)) return 1;
+    double t_frame = rt.secs / nf, t_spp = pt.secs / nf, t_gspp = gt.secs / nf;
+    int base_spp = (int)lround(t_frame / t_spp), gbase_spp = (int)lround(t_frame / t_gspp);
     if (base_spp < 1) base_spp = 1;
-    job_free(&rt); job_free(&pt);
+    if (gbase_spp < 1) gbase_spp = 1;
+    job_free(&rt); job_free(&pt); job_free(&gt);
     /* per frame: a static-camera sequence; the last frame (history built) */
     int seqn = quick ? 8 : 24;
-    job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0};
-    job rs0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0};
-    job ris = {stat, integ, "temporal=0 iterations=0", sd->w, sd->h, 1, 1, -1, 0, 7, 0, NULL, {NULL}, 0};
-    job ps = {stat, "path", NULL, sd->w, sd->h, base_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0};
-    if (run(&rs) || run(&rs0) || run(&ris) || run(&ps)) return 1;
-    double e_rs = 0, e_rs0 = 0, e_ps = 0;
+    job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+    job rs0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+    job ris = {stat, integ, "temporal=0 iterations=0", sd->w, sd->h, 1, 1, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+    job rsp = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, "power"};
+    job ps = {stat, "path", NULL, sd->w, sd->h, base_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, "power"};
+    job gs = {stat, "path", NULL, sd->w, sd->h, gbase_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, NULL};
+    if (run(&rs) || run(&rs0) || run(&ris) || run(&rsp) || run(&ps) || run(&gs)) return 1;
+    double e_rs = 0, e_rs0 = 0, e_rsp = 0, e_ps = 0, e_gs = 0;
     int last = 4 < rs.nseq ? 4 : rs.nseq;
     for (int k = rs.nseq - last; k < rs.nseq; k++) {
       e_rs += bench_relmse(rs.seq[k], ref.rgb, n, g_ok) / last;
       e_rs0 += bench_relmse(rs0.seq[k], ref.rgb, n, g_ok) / last;
+      e_rsp += bench_relmse(rsp.seq[k], ref.rgb, n, g_ok) / last;
       e_ps += bench_relmse(ps.seq[k], ref.rgb, n, g_ok) / last;
+      e_gs += bench_relmse(gs.seq[k], ref.rgb, n, g_ok) / last;
     }
     double e_ris = bench_relmse(ris.seq[0], ref.rgb, n, g_ok);
-    printf("  time per frame: %s %.3f s; path %.3f s per spp -> baseline %d spp per frame\n", integ, t_frame, t_spp, base_spp);
-    printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g; path %d spp %.4g\n",
-           last, seqn, integ, e_rs, e_rs0, e_ris, base_spp, e_ps);
-    printf("  per-frame ratio path / %s: %.2f (spatial only: %.2f)\n", integ, e_ps / e_rs, e_ps / e_rs0);
-    printf("  temporal stability (mean relative frame-to-frame change): %s %.4f, without temporal %.4f, path %.4f\n", integ, flicker(&rs, n),
-           flicker(&rs0, n), flicker(&ps, n));
-    job_free(&rs); job_free(&rs0); job_free(&ris); job_free(&ps);
+    printf("  time per frame: %s %.3f s; path %.3f s per spp with power selection, %.3f s with the light grid -> baselines %d and %d spp per frame\n",
+           integ, t_frame, t_spp, t_gspp, base_spp, gbase_spp);
+    printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g, candidates by power %.4g;"
+           " path (power) %d spp %.4g; path (grid) %d spp %.4g\n",
+           last, seqn, integ, e_rs, e_rs0, e_ris, e_rsp, base_spp, e_ps, gbase_spp, e_gs);
+    printf("  per-frame ratio path (power) / %s: %.2f (spatial only: %.2f); path (grid) / %s: %.2f\n", integ, e_ps / e_rs, e_ps / e_rs0, integ,
+           e_gs / e_rs);
+    printf("  temporal stability (mean relative frame-to-frame change): %s %.4f, without temporal %.4f, path (power) %.4f, path (grid) %.4f\n", integ,
+           flicker(&rs, n), flicker(&rs0, n), flicker(&ps, n), flicker(&gs, n));
+    job_free(&rs); job_free(&rs0); job_free(&ris); job_free(&rsp); job_free(&ps); job_free(&gs);
     /* accumulated at equal time: a still (frames averaged) against path with the same budget */
     double T = seconds > 0 ? seconds : (quick ? 2.0 : 10.0);
-    job ra = {stat, integ, NULL, sd->w, sd->h, 1048576, 0, -1, T, 11, 0, NULL, {NULL}, 0};
-    job pa = {stat, "path", NULL, sd->w, sd->h, 1048576, 0, depth, T, 11, 0, NULL, {NULL}, 0};
-    if (run(&ra) || run(&pa)) return 1;
-    double ea = bench_relmse(ra.px, ref.rgb, n, g_ok), epa = bench_relmse(pa.px, ref.rgb, n, g_ok);
-    printf("  accumulated over %.0f s: %s relMSE %.4g (mean ratio %.4f), path %.4g (mean ratio %.4f); ratio path / %s %.2f\n", T, integ, ea,
-           mean_ratio(ra.px, ref.rgb, n), epa, mean_ratio(pa.px, ref.rgb, n), integ, epa / ea);
+    job ra = {stat, integ, NULL, sd->w, sd->h, 1048576, 0, -1, T, 11, 0, NULL, {NULL}, 0, NULL};
+    job pa = {stat, "path", NULL, sd->w, sd->h, 1048576, 0, depth, T, 11, 0, NULL, {NULL}, 0, "power"};
+    job ga = {stat, "path", NULL, sd->w, sd->h, 1048576, 0, depth, T, 11, 0, NULL, {NULL}, 0, NULL};
+    if (run(&ra) || run(&pa) || run(&ga)) return 1;
+    double ea = bench_relmse(ra.px, ref.rgb, n, g_ok), epa = bench_relmse(pa.px, ref.rgb, n, g_ok), ega = bench_relmse(ga.px, ref.rgb, n, g_ok);
+    printf("  accumulated over %.0f s: %s relMSE %.4g (mean ratio %.4f), path (power) %.4g (mean ratio %.4f), path (grid) %.4g (mean ratio %.4f);"
+           " ratios path / %s: %.2f (power), %.2f (grid)\n",
+           T, integ, ea, mean_ratio(ra.px, ref.rgb, n), epa, mean_ratio(pa.px, ref.rgb, n), ega, mean_ratio(ga.px, ref.rgb, n), integ, epa / ea,
+           ega / ea);
+    job_free(&ga);
     job_free(&ra); job_free(&pa);
     image_free(&ref);
   }
