@@ -17,6 +17,10 @@
 #          for meshes without an MTL, such as Keenan Crane's Spot)
 #          --valo-args "..." (extra valo flags)  --label NAME  --seed N (default 12345: not
 #          the shared references' seed 7, whose samples a Cycles render would share)
+#          --adaptive THRESHOLD: also each renderer's adaptive sampling at every sample
+#          count (Cycles: its noise threshold THRESHOLD, at most spp samples; valo:
+#          --adaptive, spp on average) and its gain at equal time over its own uniform
+#          sampling, (uniform relMSE x time) / (adaptive relMSE x time)
 #
 # Conventions matched (documented in docs/performance.md):
 #  - OBJ axes: valo's (x, y, z) is Blender's (x, -z, y) (the importer's -Z forward, Y up);
@@ -39,7 +43,7 @@ from mathutils import Vector
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 opt = {"spp": "64,256,1024", "res": "256", "threads": "2", "cam": "0,1,3.4,0,1,0", "fov": "40", "env": "",
        "env-rotation": "0", "make-ref": "", "ref-spp": "4096", "valo": "build/valo", "valo-args": "", "label": "", "ref": "",
-       "obj": "", "seed": "12345", "texture": "", "bounces": "128"}
+       "obj": "", "seed": "12345", "texture": "", "bounces": "128", "adaptive": ""}
 i = 0
 while i < len(argv):
     k = argv[i].lstrip("-")
@@ -271,15 +275,18 @@ def relmse(img, ref):
     return float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
 
 
-def cycles_render(sc, spp, out):
+def cycles_render(sc, spp, out, adaptive=""):
     sc.cycles.samples = spp
+    sc.cycles.use_adaptive_sampling = bool(adaptive)
+    if adaptive:
+        sc.cycles.adaptive_threshold = float(adaptive)
     sc.render.filepath = out
     t0 = time.time()
     bpy.ops.render.render(write_still=True)
     return time.time() - t0
 
 
-def valo_render(spp, out):
+def valo_render(spp, out, extra=()):
     scene_json = os.path.join(tempfile.gettempdir(), "valo-side-by-side.json")
     with open(scene_json, "w") as f:
         env = ', "environment": {"type": "map", "file": "%s", "rotation": %s}' % (os.path.abspath(opt["env"]), opt["env-rotation"]) if opt["env"] else ""
@@ -289,7 +296,7 @@ def valo_render(spp, out):
                 '  "film": {"width": %d, "height": %d}, "render": {"seed": %s},\n'
                 '  "shapes": [{"file": "%s"%s}]%s }\n' % (*cam, fov, res, res, opt["seed"], os.path.abspath(opt["obj"]),
                                                      ', "material": "tex"' if opt["texture"] else "", env))
-    cmd = [opt["valo"], "render", scene_json, "--spp", str(spp), "--threads", str(threads), "-o", out] + opt["valo-args"].split()
+    cmd = [opt["valo"], "render", scene_json, "--spp", str(spp), "--threads", str(threads), "-o", out] + opt["valo-args"].split() + list(extra)
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode:
         sys.exit("valo failed: " + p.stderr)
@@ -330,6 +337,7 @@ if opt["make-ref"]:
 ref = read_exr(os.path.abspath(opt["ref"]))
 spps = [int(v) for v in opt["spp"].split(",")]
 rows = []
+adaptive_rows = []
 for spp in spps:
     tc = cycles_render(sc, spp, os.path.join(tmp, "cycles.exr"))
     ec = relmse(read_exr(os.path.join(tmp, "cycles.exr")), ref)
@@ -337,6 +345,14 @@ for spp in spps:
     ev = relmse(read_pfm(os.path.join(tmp, "valo.pfm")), ref)
     rows.append((spp, tc, ec, tv, ev))
     print("spp %d: Cycles %.2f s relMSE %.6f | valo %.2f s relMSE %.6f" % (spp, tc, ec, tv, ev), flush=True)
+    if opt["adaptive"]:
+        tca = cycles_render(sc, spp, os.path.join(tmp, "cycles-a.exr"), opt["adaptive"])
+        eca = relmse(read_exr(os.path.join(tmp, "cycles-a.exr")), ref)
+        tva = valo_render(spp, os.path.join(tmp, "valo-a.pfm"), ["--adaptive"])
+        eva = relmse(read_pfm(os.path.join(tmp, "valo-a.pfm")), ref)
+        adaptive_rows.append((spp, tca, eca, ec * tc / (eca * tca), tva, eva, ev * tv / (eva * tva)))
+        print("spp %d adaptive: Cycles (threshold %s) %.2f s relMSE %.6f, gain %.2f | valo %.2f s relMSE %.6f, gain %.2f"
+              % (spp, opt["adaptive"], tca, eca, adaptive_rows[-1][3], tva, eva, adaptive_rows[-1][6]), flush=True)
 
 
 def time_to(errs, times, target):
@@ -359,3 +375,8 @@ print("\nCycles' %d-spp relMSE %.6f: Cycles %.1f s; valo reaches it in %.1f s (l
 for spp, tc, ec, tv, ev in rows:
     t, _ = time_to([r[4] for r in rows], [r[3] for r in rows], ec)
     print("At %d spp: valo reaches Cycles' relMSE %.6f in %.2fx Cycles' time" % (spp, ec, t / tc))
+if adaptive_rows:
+    print("\nAdaptive sampling, gain at equal time over the same renderer's uniform sampling, (relMSE x s) uniform / adaptive:\n")
+    print("| max/avg spp | Cycles adaptive s | relMSE | **gain** | valo --adaptive s | relMSE | **gain** |\n|---|---|---|---|---|---|---|")
+    for spp, tca, eca, gc, tva, eva, gv in adaptive_rows:
+        print("| %d | %.2f | %.6f | **%.2f** | %.2f | %.6f | **%.2f** |" % (spp, tca, eca, gc, tva, eva, gv))
