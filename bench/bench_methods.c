@@ -264,11 +264,13 @@ static int bench_manylight(int quick) {
   const char *refs[3] = {refp, VALO_SOURCE_DIR "/tests/data/cornell-glossy-path.exr", VALO_SOURCE_DIR "/bench/references/sponza-sun-path.exr"};
   const char *names[3] = {"CornellBox-Original 256x256", "cornell-glossy.json 64x64", "Sponza under a sun (bench/sponza-sun.json) 128x72"};
   const int ws[3] = {256, 64, 128}, hs[3] = {256, 64, 72};
-  const struct { const char *integ, *params, *label; } m[5] = {
+  const struct { const char *integ, *params, *label; } m[7] = {
       {"path", "", "path"},
       {"vpl", "count=64 direct=8", "vpl (clamp 0.1)"},
       {"vpl", "count=64 direct=8 clamp=0.3", "vpl (clamp 0.3)"},
       {"vpl", "count=64 direct=8 clamp=0.3 compensate=1", "vpl (clamp 0.3, compensated)"},
+      {"vpl", "count=256 direct=8 clamp=0.2", "vpl (clamp 0.2, 256 lights)"},
+      {"vpl", "count=512 direct=8 clamp=0.2 shadow_rays=32", "vpl (clamp 0.2, 512 lights, 32 sampled shadow rays)"},
       {"vsl", "count=64 direct=8", "vsl"}};
   const double budgets[3] = {2.5, 10, 40};
   int nb = quick ? 2 : 3;
@@ -286,7 +288,7 @@ static int bench_manylight(int quick) {
     printf("\n|---|");
     for (int b = 0; b < nb; b++) printf("---|");
     printf("\n");
-    for (int i = 0; i < 5; i++) {
+    for (int i = 0; i < 7; i++) {
       printf("| %s |", m[i].label);
       for (int b = 0; b < nb; b++) {
         double t;

@@ -153,6 +153,33 @@ static int vpl_clamping_and_compensation(void) {
   return 0;
 }
 
+/* shadow_rays = S: S lights drawn per camera sample in proportion to their unshadowed
+ * contribution, weighted 1 / (S p), stand for all of them: the same expectation. The
+ * furnace (every light visible) gives the analytic 2, and unclamped vpl on
+ * CornellBox-Original meets the reference as vpl with a ray to every light does. */
+static int vpl_sampled_shadow_rays(void) {
+  const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
+                     "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
+                     "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": 3,\n"
+                     "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }";
+  float *px = render_res(scratch_file("furnace.json", json), "vpl", "clamp=0 count=1024 shadow_rays=16", 32, 0, 16);
+  CHECK(px, "render");
+  double m = 0;
+  for (int k = 0; k < 16 * 16 * 3; k++) m += px[k] / (16 * 16 * 3);
+  free(px);
+  fprintf(stderr, "vpl shadow_rays=16, furnace (rho 0.5, Le 1): mean %.4f, analytic 2\n", m);
+  CHECK(fabs(m - 2) < 0.01, "furnace: %g", m);
+  const char *scene = cornell_json(), *refp = shared_file("references/cornell-original.exr");
+  if (!scene || !refp) return TEST_SKIP;
+  image ref;
+  valo_error err;
+  CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
+  int rc = meets_reference(scene, "clamp=0 count=256 shadow_rays=32", 128, &ref, "vpl, no clamping, 128 passes of 256 lights, 32 shadow rays");
+  image_free(&ref);
+  CHECK(rc == 0, "vpl with sampled shadow rays does not meet the reference");
+  return 0;
+}
+
 static int vpl_furnace(void) {
   const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
                      "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
@@ -223,7 +250,7 @@ static int vpl_threads(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"vpl_unclamped_converges", vpl_unclamped_converges},
                                     {"vpl_clamping_and_compensation", vpl_clamping_and_compensation},
-                                    {"vpl_furnace", vpl_furnace},
+                                    {"vpl_furnace", vpl_furnace}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
                                     {"vsl_glossy", vsl_glossy},
                                     {"vpl_threads", vpl_threads},
                                     {NULL, NULL}};

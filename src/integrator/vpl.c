@@ -43,13 +43,15 @@ typedef struct vpl {
 
 typedef struct vpl_state { vpl *v; uint32_t n; int spherical; float c; uint64_t paths; } vpl_state;
 
-enum { P_COUNT, P_DIRECT, P_CLAMP, P_COMPENSATE };
+enum { P_COUNT, P_DIRECT, P_CLAMP, P_COMPENSATE, P_SHADOW };
 static const integrator_param vpl_params[] = {
     {"count", IPARAM_INT, 1024, 1, 1e6, "virtual point lights per pass (each costs one shadow ray per camera sample)"},
     {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample (cheap beside the lights' shadow rays)"},
     {"clamp", IPARAM_FLOAT, 0.1, 0, 10,
      "clamping distance as a fraction of the scene's bounding-sphere radius R: G f_r is limited to 1 / (clamp R)^2; 0 = no clamping"},
     {"compensate", IPARAM_INT, 0, 0, 1, "1: add back what clamping removed by path tracing (Kollig & Keller 2004): unbiased"},
+    {"shadow_rays", IPARAM_INT, 0, 0, 1e6,
+     "0: one shadow ray to every light; S > 0: S shadow rays to lights drawn in proportion to their unshadowed contribution"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 enum { S_COUNT, S_DIRECT, S_RADIUS, S_K, S_CONE };
 static const integrator_param vsl_params[] = {
@@ -154,57 +156,92 @@ static rgb vpl_reflect(const vpl *l, vec3 w) {
   return bsdf_eval(&l->b, frame_to_local(&l->fr, w), frame_to_local(&l->fr, l->wi));
 }
 
-/* Indirect light at x from the pass's lights. */
+/* Unshadowed contribution of light l at x (0 when it cannot reach x). */
+static rgb vpl_contrib(const render_ctx *c, const vpl_state *vs, const vpl *l, uint32_t i, const isect *it, const bsdf *b, const frame *fr,
+                       vec3 wo_l, sampler *smp) {
+  vec3 d = v3_sub(l->p, it->p);
+  float d2 = v3_len2(d);
+  if (!(d2 > 0)) return c3(0, 0, 0);
+  float dist = sqrtf(d2);
+  vec3 w = v3_scale(d, 1 / dist); /* x -> light */
+  if (!vs->spherical) {
+    float cos_x = fabsf(v3_dot(w, fr->n));
+    rgb fx = bsdf_eval(b, wo_l, frame_to_local(fr, w));
+    if (c3_black(fx)) return c3(0, 0, 0);
+    if (!bsdf_transmits(b) && v3_dot(w, it->ng) <= 0) return c3(0, 0, 0);
+    rgb fv = vpl_reflect(l, v3_neg(w));
+    if (c3_black(fv)) return c3(0, 0, 0);
+    float G = cos_x * fabsf(v3_dot(w, l->n)) / d2;
+    float scale = G;
+    if (vs->c > 0) {
+      float K = G * c3_max(fx);
+      if (K > vs->c) scale *= vs->c / K; /* min(c, G f_r) */
+    }
+    return c3_scale(c3_mul(c3_mul(fx, fv), l->power), scale);
+  }
+  /* the cone the sphere subtends at x (every direction from inside it) */
+  int cone = (int)c->param[S_CONE];
+  float r = l->radius, cos_max = dist > r ? sqrtf(fmaxf(0.0f, 1 - r * r / d2)) : -1;
+  float omega = 2 * PI_F * (1 - cos_max);
+  frame cf = frame_from_n(w);
+  rgb acc = c3(0, 0, 0);
+  sampler ls = sampler_child(smp, i, vs->n);
+  sampler_set_dim(&ls, SDIM_EXTRA);
+  for (int m = 0; m < cone; m++) {
+    float u1, u2;
+    sampler_2d(&ls, &u1, &u2);
+    vec3 dir = frame_to_world(&cf, sample_uniform_cone(u1, u2, cos_max));
+    if (!bsdf_transmits(b) && v3_dot(dir, it->ng) <= 0) continue;
+    rgb fx = bsdf_eval(b, wo_l, frame_to_local(fr, dir));
+    if (c3_black(fx)) continue;
+    rgb fv = vpl_reflect(l, v3_neg(dir));
+    if (c3_black(fv)) continue;
+    float cc = fabsf(v3_dot(dir, fr->n)) * fabsf(v3_dot(dir, l->n));
+    acc = c3_add(acc, c3_scale(c3_mul(fx, fv), cc));
+  }
+  if (c3_black(acc)) return c3(0, 0, 0);
+  return c3_scale(c3_mul(acc, l->power), omega / ((float)cone * PI_F * r * r));
+}
+
+/* Indirect light at x from the pass's lights: every light with a shadow ray each, or
+ * (vpl, shadow_rays = S > 0) S lights drawn by systematic sampling of the distribution
+ * proportional to their unshadowed contributions' channel sum, each weighted 1 / (S p):
+ * unbiased for the same sum, and where nearly every light is visible nearly as good as
+ * all of them for S shadow rays. */
+#define VPL_SAMPLED_MAX 4096
 static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts) {
   rgb sum = c3(0, 0, 0);
   vec3 wo_l = frame_to_local(fr, wo);
-  int cone = vs->spherical ? (int)c->param[S_CONE] : 0;
+  int S = vs->spherical ? 0 : (int)c->param[P_SHADOW];
+  if (S > 0 && vs->n > (uint32_t)S && vs->n <= VPL_SAMPLED_MAX) {
+    rgb con[VPL_SAMPLED_MAX];
+    float cdf[VPL_SAMPLED_MAX];
+    double total = 0;
+    for (uint32_t i = 0; i < vs->n; i++) {
+      con[i] = vpl_contrib(c, vs, &vs->v[i], i, it, b, fr, wo_l, smp);
+      float w = c3_finite(con[i]) ? con[i].r + con[i].g + con[i].b : 0;
+      total += w > 0 ? w : 0;
+      cdf[i] = (float)total;
+    }
+    if (!(total > 0)) return sum;
+    sampler us = sampler_child(smp, 0, 1);
+    sampler_set_dim(&us, SDIM_EXTRA + 16); /* apart from compensate's SDIM_EXTRA stream */
+    float u0 = sampler_1d(&us);
+    uint32_t i = 0;
+    for (int m = 0; m < S; m++) {
+      float target = (float)(((float)m + u0) / (float)S * total);
+      while (i + 1 < vs->n && cdf[i] <= target) i++;
+      float w = con[i].r + con[i].g + con[i].b, p = (float)(w / total);
+      if (!(p > 0)) continue;
+      if (ctx_segment_blocked(c, it, vs->v[i].p, vs->v[i].ng, ts)) continue;
+      sum = c3_add(sum, c3_scale(con[i], 1 / ((float)S * p)));
+    }
+    return sum;
+  }
   for (uint32_t i = 0; i < vs->n; i++) {
     const vpl *l = &vs->v[i];
-    vec3 d = v3_sub(l->p, it->p);
-    float d2 = v3_len2(d);
-    if (!(d2 > 0)) continue;
-    float dist = sqrtf(d2);
-    vec3 w = v3_scale(d, 1 / dist); /* x -> light */
-    rgb contrib;
-    if (!vs->spherical) {
-      float cos_x = fabsf(v3_dot(w, fr->n));
-      rgb fx = bsdf_eval(b, wo_l, frame_to_local(fr, w));
-      if (c3_black(fx)) continue;
-      if (!bsdf_transmits(b) && v3_dot(w, it->ng) <= 0) continue;
-      rgb fv = vpl_reflect(l, v3_neg(w));
-      if (c3_black(fv)) continue;
-      float G = cos_x * fabsf(v3_dot(w, l->n)) / d2;
-      float scale = G;
-      if (vs->c > 0) {
-        float K = G * c3_max(fx);
-        if (K > vs->c) scale *= vs->c / K; /* min(c, G f_r) */
-      }
-      contrib = c3_scale(c3_mul(c3_mul(fx, fv), l->power), scale);
-    } else {
-      /* the cone the sphere subtends at x (every direction from inside it) */
-      float r = l->radius, cos_max = dist > r ? sqrtf(fmaxf(0.0f, 1 - r * r / d2)) : -1;
-      float omega = 2 * PI_F * (1 - cos_max);
-      frame cf = frame_from_n(w);
-      rgb acc = c3(0, 0, 0);
-      sampler ls = sampler_child(smp, i, vs->n);
-      sampler_set_dim(&ls, SDIM_EXTRA);
-      for (int m = 0; m < cone; m++) {
-        float u1, u2;
-        sampler_2d(&ls, &u1, &u2);
-        vec3 dir = frame_to_world(&cf, sample_uniform_cone(u1, u2, cos_max));
-        if (!bsdf_transmits(b) && v3_dot(dir, it->ng) <= 0) continue;
-        rgb fx = bsdf_eval(b, wo_l, frame_to_local(fr, dir));
-        if (c3_black(fx)) continue;
-        rgb fv = vpl_reflect(l, v3_neg(dir));
-        if (c3_black(fv)) continue;
-        float cc = fabsf(v3_dot(dir, fr->n)) * fabsf(v3_dot(dir, l->n));
-        acc = c3_add(acc, c3_scale(c3_mul(fx, fv), cc));
-      }
-      if (c3_black(acc)) continue;
-      contrib = c3_scale(c3_mul(acc, l->power), omega / ((float)cone * PI_F * r * r));
-    }
+    rgb contrib = vpl_contrib(c, vs, l, i, it, b, fr, wo_l, smp);
     if (c3_black(contrib) || !c3_finite(contrib)) continue;
     if (ctx_segment_blocked(c, it, l->p, l->ng, ts)) continue;
     sum = c3_add(sum, contrib);
