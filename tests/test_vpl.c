@@ -232,16 +232,16 @@ static int vsl_glossy(void) {
 
 static int vpl_threads(void) {
   const char *scene = VALO_SOURCE_DIR "/scenes/cornell-glossy.json";
-  const char *integ[2] = {"vpl", "vsl"};
-  for (int k = 0; k < 2; k++) {
+  const char *integ[3] = {"vpl", "vpl", "vsl"}, *params[3] = {"count=64 compensate=1", "count=64 shadow_rays=8", "count=64"};
+  for (int k = 0; k < 3; k++) {
     float *img[3];
     const int th[3] = {1, 2, 7};
     for (int i = 0; i < 3; i++) {
-      img[i] = render_with(scene, integ[k], k == 0 ? "count=64 compensate=1" : "count=64", 2, th[i]);
+      img[i] = render_with(scene, integ[k], params[k], 2, th[i]);
       CHECK(img[i], "render");
     }
     CHECK(!memcmp(img[0], img[1], RES * RES * 3 * sizeof(float)) && !memcmp(img[0], img[2], RES * RES * 3 * sizeof(float)),
-          "%s: threads change the image", integ[k]);
+          "%s %s: threads change the image", integ[k], params[k]);
     for (int i = 0; i < 3; i++) free(img[i]);
   }
   return 0;
