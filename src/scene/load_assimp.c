@@ -258,6 +258,11 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   mat34 nm = m34_normal_matrix(xf);
   int flip = m34_det(xf) < 0;
   uint32_t base = s->nverts;
+  /* glTF TANGENT (xyz, w): Assimp gives the tangent and the bitangent w (n x t); the
+   * scene's tangent array is made when the first file gives one */
+  int has_tan = c->gltf && mesh->mTangents && mesh->mBitangents && mesh->mNormals;
+  if (has_tan && !s->tan_file && !(s->tan_file = calloc((size_t)s->cap_verts * 4, sizeof(float))))
+    return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
   for (unsigned v = 0; v < mesh->mNumVertices; v++) {
     const struct aiVector3D *p = &mesh->mVertices[v];
     vec3 pv = v3(p->x, p->y, p->z);
@@ -274,10 +279,9 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
       if (!v3_finite(n)) n = v3(0, 0, 0);
     }
     s->nrm[base + v] = n;
-    float *tf = &s->tan_file[4 * (size_t)(base + v)];
-    tf[0] = tf[1] = tf[2] = tf[3] = 0;
-    if (c->gltf && mesh->mTangents && mesh->mBitangents && mesh->mNormals && v3_len2(n) > 0) {
-      /* glTF TANGENT (xyz, w): Assimp gives the tangent and the bitangent w (n x t) */
+    float *tf = s->tan_file ? &s->tan_file[4 * (size_t)(base + v)] : NULL;
+    if (tf) tf[0] = tf[1] = tf[2] = tf[3] = 0;
+    if (tf && has_tan && v3_len2(n) > 0) {
       vec3 t = m34_vector(xf, v3(mesh->mTangents[v].x, mesh->mTangents[v].y, mesh->mTangents[v].z));
       vec3 bt = m34_vector(xf, v3(mesh->mBitangents[v].x, mesh->mBitangents[v].y, mesh->mBitangents[v].z));
       if (v3_finite(t) && v3_finite(bt) && v3_len2(t) > 0) {

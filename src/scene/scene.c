@@ -45,9 +45,9 @@ int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris) {
   if (nv > s->cap_verts) {
     uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts, c4 = s->cap_verts;
     if (grow((void **)&s->pos, &c, nv, sizeof(vec3)) || grow((void **)&s->nrm, &c2, nv, sizeof(vec3)) ||
-        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)) || grow((void **)&s->tan_file, &c4, nv, 4 * sizeof(float)))
+        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)) || (s->tan_file && grow((void **)&s->tan_file, &c4, nv, 4 * sizeof(float))))
       return -1;
-    memset(s->tan_file + 4 * (size_t)s->cap_verts, 0, (size_t)(c4 - s->cap_verts) * 4 * sizeof(float)); /* none given */
+    if (s->tan_file) memset(s->tan_file + 4 * (size_t)s->cap_verts, 0, (size_t)(c4 - s->cap_verts) * 4 * sizeof(float)); /* none given */
     s->cap_verts = c;
   }
   if (nt > s->cap_tris) {
@@ -177,10 +177,10 @@ static int compute_tangents(scene *s) {
     }
   }
   for (uint32_t v = 0; v < s->nverts; v++) {
-    const float *a = &acc[7 * v], *given = &s->tan_file[4 * v];
+    const float *a = &acc[7 * v], *given = s->tan_file ? &s->tan_file[4 * v] : NULL;
     vec3 n = s->nrm[v], t = v3(a[0], a[1], a[2]), b = v3(a[3], a[4], a[5]);
     float *o = &s->tan[4 * v];
-    if (given[3] != 0 && v3_len2(n) > 0) {
+    if (given && given[3] != 0 && v3_len2(n) > 0) {
       vec3 g = v3(given[0], given[1], given[2]);
       g = v3_sub(g, v3_scale(n, v3_dot(n, g)));
       if (v3_len2(g) > 1e-12f) {

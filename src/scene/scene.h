@@ -90,7 +90,8 @@ typedef struct scene {
   char tex_user[1200];      /* while a loader reads a material's maps: "file: material 'x'",
                               named in the warning when one cannot be read */
   float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and
-                              the bitangent sign); w = 0 where it gave none */
+                              the bitangent sign); w = 0 where it gave none; NULL until a
+                              file gives one (then grown with the other vertex arrays) */
   uint32_t nverts, cap_verts;
   uint32_t *idx;           /* 3 per triangle */
   uint32_t *tri_mat;
