@@ -685,28 +685,35 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
      * bright path is not left with too few samples to find it: test_analytic
      * adaptive_unbiased); the neighbours share the rare paths a caustic spreads. */
     int digest = r->opt.adaptive == VALO_ADAPTIVE_DIGEST;
-    if (!digest)
-      for (size_t i = 0; i < np; i++) raw[i] = pixel_relvar(r, i);
-    while (taken < total) {
+    if (!digest) {
+      /* raw[i]: the mean of the neighbours' relative variances, frozen for every round */
+      double *rv = malloc(np * sizeof *rv);
+      if (!rv) { free(raw); free(pr); free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+      for (size_t i = 0; i < np; i++) rv[i] = pixel_relvar(r, i);
       for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
-          size_t i = (size_t)y * W + x;
-          pr[i].i = (uint32_t)i;
-          if (digest) { double pd = pixel_digest(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
           double acc = 0;
           int cnt = 0;
           for (int dy = -ADAPT_RADIUS; dy <= ADAPT_RADIUS; dy++)
             for (int dx = -ADAPT_RADIUS; dx <= ADAPT_RADIUS; dx++) {
               int xx = x + dx, yy = y + dy;
               if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-              acc += raw[(size_t)yy * W + xx];
+              acc += rv[(size_t)yy * W + xx];
               cnt++;
             }
-          /* N grows as the neighbours' relative standard deviation (the allocation that
-           * minimises the summed relMSE), until var/N is below the noise threshold */
-          double v = cnt ? acc / cnt : 0, n = (double)r->count[i];
-          pr[i].p = v / n > thr2 ? sqrt(v) / n : 0;
+          raw[(size_t)y * W + x] = cnt ? acc / cnt : 0;
         }
+      free(rv);
+    }
+    while (taken < total) {
+      for (size_t i = 0; i < np; i++) {
+        pr[i].i = (uint32_t)i;
+        if (digest) { double pd = pixel_digest(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
+        /* N grows as the neighbours' relative standard deviation (the allocation that
+         * minimises the summed relMSE), until var/N is below the noise threshold */
+        double v = raw[i], n = (double)r->count[i];
+        pr[i].p = v / n > thr2 ? sqrt(v) / n : 0;
+      }
       size_t sel = k;
       if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
       if (sel == 0) break;
