@@ -164,7 +164,11 @@ static const float *grid_row(const light_sampler *ls, vec3 p) {
   const float *row = ls->grid_cdf + (((size_t)c[2] * ls->gdim[1] + c[1]) * ls->gdim[0] + c[0]) * ls->n;
   return row[ls->n - 1] > 0 ? row : NULL;
 }
-static inline float grid_pmf(const float *row, uint32_t i) { return i ? row[i] - row[i - 1] : row[0]; }
+/* The mixture's probability of light i at a point whose cell has running sums row: one
+ * expression for light_select and light_select_pmf, so they agree to the bit. */
+static inline float grid_mix_pmf(const light_sampler *ls, const float *row, uint32_t i) {
+  return LIGHT_GRID_POWER * alias_pmf(&ls->table, i) + (1 - LIGHT_GRID_POWER) * (i ? row[i] - row[i - 1] : row[0]);
+}
 
 uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
@@ -174,8 +178,8 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
     uint32_t i;
     const float a = LIGHT_GRID_POWER;
     if (u < a) {
-      float pp;
-      i = alias_sample(&ls->table, fminf(u / a, 0x1.fffffep-1f), &pp);
+      float power_pmf; /* not the answer: the mixture's pmf is */
+      i = alias_sample(&ls->table, fminf(u / a, 0x1.fffffep-1f), &power_pmf);
     } else {
       float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
       uint32_t lo = 0, hi = ls->n - 1; /* the first i with row[i] > v */
@@ -185,7 +189,7 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
       }
       i = lo;
     }
-    *pmf = a * alias_pmf(&ls->table, i) + (1 - a) * grid_pmf(row, i);
+    *pmf = grid_mix_pmf(ls, row, i);
     return i;
   }
   if (!ls->local) return alias_sample(&ls->table, u, pmf);
@@ -208,7 +212,7 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
   if (ls->grid_cdf) {
     const float *row = grid_row(ls, p);
     if (!row) return alias_pmf(&ls->table, li);
-    return LIGHT_GRID_POWER * alias_pmf(&ls->table, li) + (1 - LIGHT_GRID_POWER) * grid_pmf(row, li);
+    return grid_mix_pmf(ls, row, li);
   }
   if (!ls->local) return alias_pmf(&ls->table, li);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
