@@ -97,6 +97,17 @@ static int report(const char *what, const cmp *c) {
   return 0;
 }
 
+/* The CornellBox-Original scene file and its Cycles reference: 0, TEST_SKIP without
+ * ../shared, or 1 when the reference cannot be read. */
+static int cornell_reference(const char **scene, image *ref) {
+  const char *refp = shared_file("references/cornell-original.exr");
+  *scene = cornell_json();
+  if (!*scene || !refp) return TEST_SKIP;
+  valo_error err;
+  CHECK(image_read(refp, ref, &err) == VALO_OK, "%s", err.message);
+  return 0;
+}
+
 /* Renders vpl with params over `passes` passes and checks it against ref: means per
  * channel within 1 %, lit 16x16 blocks within 3 %. */
 static int meets_reference(const char *scene, const char *params, int passes, const image *ref, const char *what) {
@@ -112,11 +123,10 @@ static int meets_reference(const char *scene, const char *params, int passes, co
 }
 
 static int vpl_unclamped_converges(void) {
-  const char *scene = cornell_json(), *refp = shared_file("references/cornell-original.exr");
-  if (!scene || !refp) return TEST_SKIP;
+  const char *scene;
   image ref;
-  valo_error err;
-  CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
+  int got = cornell_reference(&scene, &ref);
+  if (got) return got;
   int rc = meets_reference(scene, "clamp=0 count=256", 128, &ref, "vpl, no clamping, 128 passes of 256 lights");
   image_free(&ref);
   CHECK(rc == 0, "vpl without clamping does not meet the reference");
@@ -124,11 +134,10 @@ static int vpl_unclamped_converges(void) {
 }
 
 static int vpl_clamping_and_compensation(void) {
-  const char *scene = cornell_json(), *refp = shared_file("references/cornell-original.exr");
-  if (!scene || !refp) return TEST_SKIP;
+  const char *scene;
   image ref;
-  valo_error err;
-  CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
+  int got = cornell_reference(&scene, &ref);
+  if (got) return got;
   /* the same seed gives the same lights: clamping can only lower each contribution, so
    * its darkening is measured against the unclamped render of the same lights */
   const char *clamps[4] = {"clamp=0", "clamp=0.1", "clamp=0.3", "clamp=0.6"};
@@ -169,11 +178,10 @@ static int vpl_sampled_shadow_rays(void) {
   free(px);
   fprintf(stderr, "vpl shadow_rays=16, furnace (rho 0.5, Le 1): mean %.4f, analytic 2\n", m);
   CHECK(fabs(m - 2) < 0.01, "furnace: %g", m);
-  const char *scene = cornell_json(), *refp = shared_file("references/cornell-original.exr");
-  if (!scene || !refp) return TEST_SKIP;
+  const char *scene;
   image ref;
-  valo_error err;
-  CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
+  int got = cornell_reference(&scene, &ref);
+  if (got) return got;
   int rc = meets_reference(scene, "clamp=0 count=256 shadow_rays=32", 128, &ref, "vpl, no clamping, 128 passes of 256 lights, 32 shadow rays");
   image_free(&ref);
   CHECK(rc == 0, "vpl with sampled shadow rays does not meet the reference");
