@@ -207,11 +207,9 @@ static int bench_ao(int quick) {
  * folder; remove it after) and the path of that reference. */
 static int write_cornell(char *path, size_t pn, char *refp, size_t rn) {
   snprintf(path, pn, "bench-cornell-%ld.json", (long)getpid());
-  FILE *f = fopen(path, "w");
-  if (!f) return 1;
-  fprintf(f, "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
-             "  \"shapes\": [ {\"file\": \"%s/scenes/cornell/CornellBox-Original.obj\"} ] }", shared());
-  fclose(f);
+  char obj[2048];
+  snprintf(obj, sizeof obj, "%s/scenes/cornell/CornellBox-Original.obj", shared());
+  if (bench_cornell_scene(path, obj, 256, 256)) return 1;
   snprintf(refp, rn, "%s/references/cornell-original.exr", shared());
   return 0;
 }

@@ -3,11 +3,10 @@
  * and 1024 spp, beside Cycles' own times on a 2-core machine (references/README.md), and
  * the time valo needs to reach the relMSE of Cycles' 1024-spp render (0.00014, reached by
  * Cycles in 106 s). relMSE = mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01).
- * Then adaptive sampling against uniform sampling at equal time on CornellBox-Original,
- * CornellBox-Mirror and scenes/caustic.json (a glass sphere's caustic on a floor, with
- * `path`, against tests/data/caustic-path.exr, 32 768 spp). Usage: bench_render [--quick] */
+ * Adaptive sampling is bench_adaptive's. Usage: bench_render [--quick] [--sampler S] */
 #include "valo/valo.h"
 #include "image/image_io.h"
+#include "bench_util.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,17 +25,12 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--sampler") && i + 1 < argc) sampler_name = argv[++i];
   }
   const char *root = getenv("VALO_SHARED");
-  char obj[2048], refp[2048], json[4096];
+  char obj[2048], refp[2048];
   snprintf(obj, sizeof obj, "%s/scenes/cornell/CornellBox-Original.obj", root && *root ? root : VALO_SHARED_DIR);
   snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", root && *root ? root : VALO_SHARED_DIR);
   char scene_path[64];
   snprintf(scene_path, sizeof scene_path, "bench-render-%ld.json", (long)getpid());
-  FILE *f = fopen(scene_path, "w");
-  if (!f) return 1;
-  fprintf(f, "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
-             "  \"film\": {\"width\": 256, \"height\": 256}, \"shapes\": [ {\"file\": \"%s\"} ] }\n", obj);
-  fclose(f);
-  (void)json;
+  if (bench_cornell_scene(scene_path, obj, 256, 256)) return 1;
   valo_error err;
   image ref;
   if (image_read(refp, &ref, &err)) { fprintf(stderr, "%s\n", err.message); remove(scene_path); return 1; }
@@ -76,58 +70,5 @@ int main(int argc, char **argv) {
   printf("\nTime for valo to reach relMSE %.5f (Cycles 1024 spp, 106 s): about %.1f s, %.2fx Cycles' time.\n", target, t_needed, t_needed / 106);
   valo_scene_destroy(sc);
   image_free(&ref);
-  /* Adaptive against uniform sampling at equal time, on both scenes with a reference. */
-  printf("\n## Adaptive sampling: equal-time relMSE against uniform sampling (2 threads)\n\n");
-  printf("| scene | uniform spp | seconds | uniform relMSE | adaptive relMSE (same time) | adaptive/uniform |\n|---|---|---|---|---|---|\n");
-  const char *names[3] = {"CornellBox-Original", "CornellBox-Mirror", "scenes/caustic.json (path)"},
-             *refs[2] = {"cornell-original.exr", "cornell-mirror.exr"};
-  for (int k = 0; k < 3; k++) {
-    int caustic = k == 2;
-    const char *load_path = caustic ? VALO_SOURCE_DIR "/scenes/caustic.json" : scene_path;
-    if (caustic) {
-      snprintf(refp, sizeof refp, "%s", VALO_SOURCE_DIR "/tests/data/caustic-path.exr");
-    } else {
-      snprintf(obj, sizeof obj, "%s/scenes/cornell/%s.obj", root && *root ? root : VALO_SHARED_DIR, names[k]);
-      snprintf(refp, sizeof refp, "%s/references/%s", root && *root ? root : VALO_SHARED_DIR, refs[k]);
-      f = fopen(scene_path, "w");
-      if (!f) return 1;
-      fprintf(f, "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
-                 "  \"film\": {\"width\": 256, \"height\": 256}, \"shapes\": [ {\"file\": \"%s\"} ] }\n", obj);
-      fclose(f);
-    }
-    int loaded = !image_read(refp, &ref, &err) && !valo_scene_load(load_path, &sc, &err);
-    if (!caustic) remove(scene_path);
-    if (!loaded) { fprintf(stderr, "%s\n", err.message); return 1; }
-    int np = ref.w * ref.h, spp = caustic ? (quick ? 256 : 1024) : (quick ? 64 : 256);
-    double secs = 0, e[2];
-    for (int mode = 0; mode < 2; mode++) {
-      valo_options o;
-      valo_options_init(&o);
-      o.threads = 2;
-      o.seed = 5;
-      snprintf(o.sampler, sizeof o.sampler, "%s", sampler_name);
-      o.spp = spp;
-      o.width = ref.w;
-      o.height = ref.h;
-      if (caustic) snprintf(o.integrator, sizeof o.integrator, "path");
-      if (mode == 1) { o.adaptive = 1; o.spp = 1 << 20; o.time_budget = secs; }
-      valo_render *r;
-      if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
-      float *px = malloc((size_t)np * 3 * sizeof(float));
-      valo_render_pixels(r, px);
-      double acc = 0;
-      for (int i = 0; i < np * 3; i++) acc += (px[i] - ref.rgb[i]) * (px[i] - ref.rgb[i]) / (ref.rgb[i] * ref.rgb[i] + 0.01);
-      e[mode] = acc / (np * 3);
-      valo_stats st;
-      valo_render_stats(r, &st);
-      if (mode == 0) secs = st.render_seconds;
-      free(px);
-      valo_render_destroy(r);
-    }
-    printf("| %s | %d | %.1f | %.6f | %.6f | %.2f |\n", names[k], spp, secs, e[0], e[1], e[1] / e[0]);
-    fflush(stdout);
-    valo_scene_destroy(sc);
-    image_free(&ref);
-  }
   return 0;
 }

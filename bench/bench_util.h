@@ -1,8 +1,20 @@
-/* bench_util.h — owns what the benchmark programs share: a monotonic clock and the
- * relMSE they report (docs/performance.md). */
+/* bench_util.h — owns what the benchmark programs share: a monotonic clock, the relMSE
+ * they report (docs/performance.md) and the Cornell scene file with the references'
+ * camera. */
 #ifndef VALO_BENCH_UTIL_H
 #define VALO_BENCH_UTIL_H
+#include <stdio.h>
 #include <time.h>
+
+/* Writes a scene file at path holding the mesh file obj seen by the shared references'
+ * Cornell-box camera, on a w x h film; the caller removes it. 0 on success. */
+static inline int bench_cornell_scene(const char *path, const char *obj, int w, int h) {
+  FILE *f = fopen(path, "w");
+  if (!f) return 1;
+  fprintf(f, "{ \"camera\": {\"position\": [0,1,3.4], \"look_at\": [0,1,0], \"up\": [0,1,0], \"fov\": 40},\n"
+             "  \"film\": {\"width\": %d, \"height\": %d}, \"shapes\": [ {\"file\": \"%s\"} ] }\n", w, h, obj);
+  return fclose(f) != 0;
+}
 
 /* Seconds on a monotonic clock. */
 static inline double bench_now(void) {
