@@ -229,6 +229,47 @@ static int adaptive_unbiased(void) {
   return 0;
 }
 
+/* Adaptive sampling pays where noise is uneven (issue 9): on the glass sphere's caustic
+ * (scenes/caustic.json, path, 128x128, 256 spp) the default rule's relMSE against
+ * tests/data/caustic-path.exr (32 768 spp), summed over two seeds, is at least 1.35x below
+ * uniform sampling's at the same samples (measured 1.6x; bench_adaptive: 1.70x at 1024 spp,
+ * the bound 1.87x). The rule spending its samples as uniform sampling would fails it. */
+static int adaptive_pays_caustic(void) {
+  allow_shading_loss(0.02);
+  image ref;
+  valo_error err;
+  CHECK(image_read(VALO_SOURCE_DIR "/tests/data/caustic-path.exr", &ref, &err) == VALO_OK, "%s", err.message);
+  double e[2] = {0, 0};
+  size_t np = (size_t)ref.w * ref.h;
+  float *px = malloc(np * 3 * sizeof *px);
+  for (int mode = 0; mode < 2; mode++)
+    for (int k = 0; k < 2; k++) {
+      valo_options o;
+      valo_options_init(&o);
+      snprintf(o.integrator, sizeof o.integrator, "path");
+      o.width = ref.w;
+      o.height = ref.h;
+      o.spp = 256;
+      o.seed = 40 + k;
+      o.adaptive = mode ? VALO_ADAPTIVE_ERROR : 0;
+      valo_scene *sc;
+      valo_render *r = render_file(VALO_SOURCE_DIR "/scenes/caustic.json", &o, &sc);
+      CHECK(r, "render failed");
+      valo_render_pixels(r, px);
+      valo_render_destroy(r);
+      valo_scene_destroy(sc);
+      for (size_t i = 0; i < np * 3; i++) {
+        double d = px[i] - ref.rgb[i];
+        e[mode] += d * d / (ref.rgb[i] * ref.rgb[i] + 0.01);
+      }
+    }
+  free(px);
+  image_free(&ref);
+  fprintf(stderr, "caustic relMSE at 256 spp: uniform %.5f, adaptive %.5f (%.2fx)\n", e[0] / (6.0 * np), e[1] / (6.0 * np), e[0] / e[1]);
+  CHECK(e[0] > 1.35 * e[1], "adaptive sampling gains only %.2fx over uniform on the caustic", e[0] / e[1]);
+  return 0;
+}
+
 /* Orientation: a map red for u < 0.5, green for u >= 0.5; looking down -z (the map's
  * centre) shows red on the left, green on the right; turned 180 degrees, the reverse. */
 static int envmap_orientation(void) {
@@ -526,9 +567,9 @@ static int thin_lens_gltf_camera(void) {
   return 0;
 }
 
-/* Adaptive sampling on the albedo-0.5 furnace: the budget is used exactly (to within a
- * round), background pixels (zero variance, away from the sphere: the rule looks at 3x3
- * neighbourhoods) get no more than the first pass (three quarters of the budget), sphere
+/* Adaptive sampling on the albedo-0.5 furnace: the budget is used exactly, background
+ * pixels (zero variance, away from the sphere: the rule looks at 9x9 neighbourhoods) get
+ * no more than the first pass (half the budget), sphere
  * pixels get more, the image still shows 0.5 and 1, and a loose noise threshold stops
  * after the first pass. */
 static int adaptive_sampling(void) {
@@ -567,9 +608,9 @@ static int adaptive_sampling(void) {
         n[k]++;
         nsum[k] += c;
         sum[k] += (px[3 * (y * 32 + x)] + px[3 * (y * 32 + x) + 1] + px[3 * (y * 32 + x) + 2]) / 3;
-        int interior = 1; /* background with only background around (the rule looks at 5x5) */
-        for (int dy = -2; dy <= 2; dy++)
-          for (int dx = -2; dx <= 2; dx++) {
+        int interior = 1; /* background with only background around (the rule looks at 9x9) */
+        for (int dy = -4; dy <= 4; dy++)
+          for (int dx = -4; dx <= 4; dx++) {
             int xx = x + dx, yy = y + dy;
             if (xx >= 0 && yy >= 0 && xx < 32 && yy < 32 && classify(xx, yy) != 0) interior = 0;
           }
@@ -581,12 +622,12 @@ static int adaptive_sampling(void) {
     fprintf(stderr, "%s: %.0f samples (budget %d), background max %.0f per pixel, sphere mean %.1f; sphere %.4f, background %.4f\n",
             pass ? "threshold 10" : "budget", total, 64 * 32 * 32, bg_max, nsum[1] / n[1], sum[1] / n[1], sum[0] / n[0]);
     if (pass == 0) {
-      CHECK(fabs(total - 64 * 32 * 32) < 8, "used %.0f samples of a budget of %d", total, 64 * 32 * 32);
-      CHECK(bg_max == 48, "zero-variance background pixels got %.0f samples, expected only the first pass's 48", bg_max);
+      CHECK(total == 64 * 32 * 32, "used %.0f samples of a budget of %d", total, 64 * 32 * 32);
+      CHECK(bg_max == 32, "zero-variance background pixels got %.0f samples, expected only the first pass's 32", bg_max);
       CHECK(nsum[1] / n[1] > 64, "sphere pixels average %.1f samples, expected more than the mean 64", nsum[1] / n[1]);
       CHECK(fabs(sum[1] / n[1] - 0.5) < 0.01, "sphere mean %g", sum[1] / n[1]);
     } else {
-      CHECK(total == 48 * 32 * 32, "a threshold every pixel meets should stop after the first pass (%.0f samples)", total);
+      CHECK(total == 32 * 32 * 32, "a threshold every pixel meets should stop after the first pass (%.0f samples)", total);
     }
     CHECK(fabs(sum[0] / n[0] - 1) < 1e-5, "background %g", sum[0] / n[0]);
   }
@@ -654,7 +695,8 @@ int main(int argc, char **argv) {
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {"thin_lens_gltf_camera", thin_lens_gltf_camera},
-                                    {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased}, {"auto_framing", auto_framing},
+                                    {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased},
+                                    {"adaptive_pays_caustic", adaptive_pays_caustic}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -45,7 +45,7 @@ struct valo_render {
   void *istate;           /* the integrator's create() result */
   float ao_dist;          /* ray length of the ao AOV */
   uint32_t *count;        /* samples per pixel */
-  double *lum;            /* adaptive: per pixel sum of luminance and of its square */
+  double *sq;             /* adaptive: per pixel sums of squares: r, g, b and luminance */
   int spp_done;
   double build_seconds, render_seconds;
   thread_stats total;      /* rays, losses and surface samples of every run so far */
@@ -290,9 +290,9 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
     return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
   }
   r->count = calloc((size_t)o.width * o.height, sizeof(uint32_t));
-  if (o.adaptive) r->lum = calloc((size_t)o.width * o.height * 2, sizeof(double));
-  if (!r->sum || (o.aovs && !r->aov) || !r->count || (o.adaptive && !r->lum)) {
-    free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r->frame_rgb); free(r);
+  if (o.adaptive) r->sq = calloc((size_t)o.width * o.height * 4, sizeof(double));
+  if (!r->sum || (o.aovs && !r->aov) || !r->count || (o.adaptive && !r->sq)) {
+    free(r->sum); free(r->aov); free(r->count); free(r->sq); free(r->frame_rgb); free(r);
     return err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
   }
   double t0 = now_seconds();
@@ -303,7 +303,7 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   r->alpha_filter.tri_flags = s->tri_flags;
   r->alpha_filter.flag_bit = TRI_ALPHA;
   valo_status st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &r->alpha_filter : NULL, &r->acc, err);
-  if (st) { free(r->sum); free(r->aov); free(r->count); free(r->lum); free(r->frame_rgb); free(r); return st; }
+  if (st) { free(r->sum); free(r->aov); free(r->count); free(r->sq); free(r->frame_rgb); free(r); return st; }
   r->build_seconds = now_seconds() - t0;
   if (light_sampler_init(&r->ctx.ls, s, strcmp(r->opt.light_sampler, "power") ? LIGHT_SELECT_GRID : LIGHT_SELECT_POWER)) { valo_render_destroy(r); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   r->ctx.s = s;
@@ -413,10 +413,9 @@ static void film_add(valo_render *r, size_t pix, rgb L, thread_stats *ts) {
   if (!sample_usable(ts, L)) return;
   double *acc = &r->sum[3 * pix];
   acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
-  if (r->lum) {
-    double l = c3_lum(L);
-    r->lum[2 * pix] += l;
-    r->lum[2 * pix + 1] += l * l;
+  if (r->sq) {
+    double *q = &r->sq[4 * pix], l = c3_lum(L);
+    q[0] += (double)L.r * L.r; q[1] += (double)L.g * L.g; q[2] += (double)L.b * L.b; q[3] += l * l;
   }
 }
 
@@ -445,38 +444,39 @@ static void render_tile(void *user, int64_t item, int thread) {
     for (int x = x0; x < x1; x++) sample_pixel(r, x, y, j->s0, j->s1, ts);
 }
 
-/* ---- adaptive sampling (docs/integrators.md). A uniform first pass takes three quarters
- * of the budget (of the samples, or of the time with --time); then rounds give ADAPT_BATCH
- * more samples to the 1/ADAPT_FRACTION of pixels with the highest priority. The
- * priority ("error", the default) is the pixel mean's estimated squared error relative
- * to its brightness, v/N with v = var(L) / (mean^2 + 0.01) in luminance (the relMSE that
- * time-to-error is measured in); v is measured in the uniform pass on the pixel's 5x5
- * neighbourhood without the pixel itself (so its mean stays unbiased), N is its own
- * count, and pixels are ranked by sqrt(v)/N, so N grows as sqrt(v) (the allocation that
- * minimises the summed relMSE). "digest" is the digest's priority N sum s^2/(sum s)^2, minus 1
- * and over N so that it falls as a pixel gets samples, on the pixel alone (biased: a
- * pixel that missed a rare bright path stops early).
- * Measured (docs/performance.md): the old rule gave 5 % at equal time because with
- * --time the uniform pass took the whole budget; a first pass of an eighth of the budget
- * starved quiet pixels on CornellBox-Original. Selection happens between rounds from
- * deterministic sums (quickselect, ties by index): identical for any thread count. */
+/* ---- adaptive sampling (docs/integrators.md). A uniform first pass takes half of the
+ * budget (of the samples, or of the time with --time). "error" (the default, unbiased)
+ * then fixes each pixel's count from its neighbours' relative variance (adapt_error:
+ * water-filling, in a few stages over tiles); "digest" gives rounds of ADAPT_BATCH more
+ * samples to the 1/ADAPT_FRACTION of pixels with the highest priority on their own
+ * samples (adapt_digest). The first pass's share and the 9x9 neighbourhood are the best
+ * of those bench_adaptive measures against the bound of any allocation
+ * (docs/performance.md); counts are fixed from deterministic sums between stages, so the
+ * image is identical for any thread count. */
 #define ADAPT_BATCH 8
 #define ADAPT_FRACTION 8
-#define ADAPT_UNIFORM 0.75 /* the first pass's share: its variances must be good (0.5: 0.96x, 0.75: 0.87x uniform's relMSE on CornellBox-Mirror) */
+#define ADAPT_UNIFORM 0.5 /* the first pass's share (docs/performance.md, "Ninth session": the bound) */
 #define ADAPT_EPS 0.01
-#define ADAPT_RADIUS 2 /* the neighbourhood whose variance sets a pixel's priority */
+#define ADAPT_RADIUS 4 /* the 9x9 neighbourhood whose variance sets a pixel's priority */
 
-/* The "error" rule's v of pixel i: the relative variance of one sample of its luminance,
- * var / (mean^2 + eps); 0 with fewer than two samples or no variance. */
+/* The "error" rule's v of pixel i: the relative variance of one sample, var / (mean^2 +
+ * eps) per channel (as relMSE weighs them), averaged over r, g, b; 0 with fewer than two
+ * samples. (Per channel, not on luminance: the bound bench_adaptive measures is 1.12x
+ * against 1.08x on CornellBox-Original, whose walls are red and green.) */
 static double pixel_relvar(const valo_render *r, size_t i) {
-  double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
+  double n = r->count[i], acc = 0;
   if (n < 2) return 0;
-  double mean = s / n, var = (s2 - s * s / n) / (n - 1);
-  return var > 0 ? var / (mean * mean + ADAPT_EPS) : 0;
+  for (int c = 0; c < 3; c++) {
+    double s = r->sum[3 * i + c], mean = s / n, var = (r->sq[4 * i + c] - s * mean) / (n - 1);
+    if (var > 0) acc += var / (mean * mean + ADAPT_EPS);
+  }
+  return acc / 3;
 }
-/* The "digest" rule's priority of pixel i, on its own samples: (N sum s^2 / (sum s)^2 - 1) / N. */
+/* The "digest" rule's priority of pixel i, on its own samples' luminance:
+ * (N sum s^2 / (sum s)^2 - 1) / N. */
 static double pixel_digest(const valo_render *r, size_t i) {
-  double n = r->count[i], s = r->lum[2 * i], s2 = r->lum[2 * i + 1];
+  const double *m = &r->sum[3 * i];
+  double n = r->count[i], s = 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2], s2 = r->sq[4 * i + 3];
   if (n < 2 || !(s > 0)) return 0;
   double rel = (n * s2 / (s * s) - 1) / n;
   return rel > 0 ? rel : 0;
@@ -521,6 +521,192 @@ static void adapt_chunk(void *user, int64_t item, int thread) {
     int c = (int)j->r->count[pix];
     sample_pixel(j->r, x, y, c, c + ADAPT_BATCH, &j->ts[thread]);
   }
+}
+
+/* The "digest" rule after the first pass: rounds that give ADAPT_BATCH more samples to
+ * the 1/ADAPT_FRACTION of pixels with the highest priority (N sum s^2 / (sum s)^2 - 1) / N,
+ * on each pixel's own samples so far (biased: docs/integrators.md), until the budget or
+ * every pixel is below the noise threshold. */
+static valo_status adapt_digest(valo_render *r, int uniform_spp, double total, double budget, double t0, valo_progress_fn progress, void *user,
+                                thread_stats *ts, valo_error *err) {
+  size_t np = (size_t)r->opt.width * r->opt.height;
+  double taken = (double)uniform_spp * (double)np;
+  prio *pr = malloc(np * sizeof *pr);
+  if (!pr) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
+  double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
+  valo_status st = VALO_OK;
+  while (taken < total) {
+    for (size_t i = 0; i < np; i++) {
+      double pd = pixel_digest(r, i);
+      pr[i].i = (uint32_t)i;
+      pr[i].p = pd > thr2 ? pd : 0;
+    }
+    size_t sel = k;
+    if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
+    if (sel == 0) break;
+    prio_select(pr, np, sel);
+    qsort(pr, sel, sizeof *pr, prio_cmp);
+    if (!(pr[0].p > 0)) break; /* every pixel below the noise threshold */
+    while (sel > 0 && !(pr[sel - 1].p > 0)) sel--;
+    adapt_job aj = {r, pr, (int64_t)sel, ts};
+    parallel_for(r->opt.threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
+    if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
+    taken += (double)sel * ADAPT_BATCH;
+    double el = now_seconds() - t0;
+    double frac = taken / total;
+    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+    if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
+    if (budget > 0 && el >= budget) break;
+  }
+  r->spp_done = (int)(taken / (double)np);
+  free(pr);
+  return st;
+}
+
+/* The "error" rule's samples: every pixel of a tile takes samples up to target[pix], in
+ * order (tiles keep rays coherent; the targets were fixed before the pass). */
+typedef struct fill_job { valo_render *r; const uint32_t *target; int tiles_x; thread_stats *ts; } fill_job;
+static void fill_tile(void *user, int64_t item, int thread) {
+  fill_job *j = user;
+  valo_render *r = j->r;
+  if (atomic_load_explicit(&r->cancel, memory_order_relaxed)) return;
+  int tx = (int)(item % j->tiles_x), ty = (int)(item / j->tiles_x);
+  int x0 = tx * TILE, y0 = ty * TILE;
+  int x1 = x0 + TILE < r->opt.width ? x0 + TILE : r->opt.width;
+  int y1 = y0 + TILE < r->opt.height ? y0 + TILE : r->opt.height;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      size_t pix = (size_t)y * (size_t)r->opt.width + (size_t)x;
+      int c = (int)r->count[pix], t = (int)j->target[pix];
+      if (t > c) sample_pixel(r, x, y, c, t, &j->ts[thread]);
+    }
+}
+
+/* Sample counts for `total` samples over the image (water-filling): target_i =
+ * min(cap_i, max(count_i, floor(lam a_i))), lam the largest whose targets sum to at most
+ * total; the samples left over go one each to the pixels next in line, by index. So
+ * counts grow as a_i = sqrt(v_i) where the budget reaches, and never fall below what a
+ * pixel has. Deterministic (no thread or timing enters). Returns the targets' sum. */
+static double waterfill_at(const valo_render *r, const double *a, const uint32_t *cap, size_t np, double lam, uint32_t *target) {
+  double sum = 0;
+  for (size_t i = 0; i < np; i++) {
+    double want = floor(lam * a[i]);
+    uint32_t t = r->count[i];
+    if (want > (double)t) t = want >= (double)cap[i] ? cap[i] : (uint32_t)want;
+    target[i] = t;
+    sum += t;
+  }
+  return sum;
+}
+static double waterfill(const valo_render *r, const double *a, const uint32_t *cap, size_t np, double total, uint32_t *target, uint32_t *hi_t) {
+  double all = waterfill_at(r, a, cap, np, 1e300, target);
+  if (all <= total) return all; /* every pixel that can grow is at its cap */
+  double lo = 0, hi = 1;
+  while (waterfill_at(r, a, cap, np, hi, hi_t) <= total) {
+    lo = hi;
+    hi *= 2;
+  }
+  for (int it = 0; it < 80; it++) {
+    double mid = 0.5 * (lo + hi);
+    if (waterfill_at(r, a, cap, np, mid, hi_t) <= total) lo = mid;
+    else hi = mid;
+  }
+  double sum = waterfill_at(r, a, cap, np, lo, target);
+  waterfill_at(r, a, cap, np, hi, hi_t);
+  for (size_t i = 0; i < np && sum < total; i++)
+    if (hi_t[i] > target[i]) { target[i]++; sum++; }
+  return sum;
+}
+
+/* The "error" rule after the first pass (docs/integrators.md): each pixel's relative
+ * variance per sample, var(L) / (mean^2 + eps), from the first pass and then frozen; a
+ * pixel's share comes from its neighbours' (9x9 without itself). A pixel's own samples
+ * never decide how many samples it gets, so its mean stays unbiased (a pixel that
+ * happened to miss a rare bright path is not left with too few samples to find it:
+ * test_analytic adaptive_unbiased); the neighbours share the rare paths a caustic
+ * spreads. Counts grow as the square root of that variance (the allocation that
+ * minimises the summed relMSE), up to v / X^2 with a noise threshold X. The samples go
+ * out in stages over tiles: eight equal ones for a sample budget (the same image for
+ * any thread count), and with a time budget stages of 60 % of the samples the remaining
+ * time holds at the last stage's rate. */
+static valo_status adapt_error(valo_render *r, double total, double budget, double t0, valo_progress_fn progress, void *user, thread_stats *ts,
+                               valo_error *err) {
+  size_t np = (size_t)r->opt.width * r->opt.height;
+  int W = r->opt.width, H = r->opt.height;
+  double *rv = malloc(np * sizeof *rv), *a = malloc(np * sizeof *a), *box = malloc(np * sizeof *box);
+  uint32_t *cap = malloc(np * sizeof *cap), *target = malloc(np * sizeof *target), *tmp = malloc(np * sizeof *tmp);
+  valo_status st = VALO_OK;
+  if (!rv || !a || !box || !cap || !target || !tmp) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+  double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
+  double taken = 0;
+  for (size_t i = 0; i < np; i++) { rv[i] = pixel_relvar(r, i); taken += r->count[i]; }
+  /* box sums over the neighbourhood, separably: rows into a, then columns */
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      double acc = 0;
+      for (int xx = x - ADAPT_RADIUS; xx <= x + ADAPT_RADIUS; xx++)
+        if (xx >= 0 && xx < W) acc += rv[(size_t)y * W + xx];
+      a[(size_t)y * W + x] = acc;
+    }
+  for (int y = 0; y < H; y++) {
+    double *row = &box[(size_t)y * W];
+    memset(row, 0, (size_t)W * sizeof *row);
+    for (int yy = y - ADAPT_RADIUS; yy <= y + ADAPT_RADIUS; yy++)
+      if (yy >= 0 && yy < H)
+        for (int x = 0; x < W; x++) row[x] += a[(size_t)yy * W + x];
+  }
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      size_t i = (size_t)y * W + x;
+      int wx = (x + ADAPT_RADIUS < W ? x + ADAPT_RADIUS : W - 1) - (x - ADAPT_RADIUS > 0 ? x - ADAPT_RADIUS : 0) + 1;
+      int wy = (y + ADAPT_RADIUS < H ? y + ADAPT_RADIUS : H - 1) - (y - ADAPT_RADIUS > 0 ? y - ADAPT_RADIUS : 0) + 1;
+      int cnt = wx * wy - 1; /* without the pixel itself */
+      double v = cnt > 0 ? (box[i] - rv[i]) / cnt : 0;
+      if (!(v > 0)) v = 0;
+      a[i] = sqrt(v);
+      double c = thr2 > 0 ? ceil(v / thr2) : 2e9; /* sample indices are int */
+      cap[i] = c < (double)r->count[i] ? r->count[i] : c > 2e9 ? 2000000000u : (uint32_t)c;
+    }
+  int tiles_x = (W + TILE - 1) / TILE, tiles_y = (H + TILE - 1) / TILE;
+  double start = taken, rate = 0, t_prev = now_seconds();
+  if (budget > 0) rate = taken / (t_prev - t0 > 1e-6 ? t_prev - t0 : 1e-6);
+  for (int stage = 1;; stage++) {
+    double goal;
+    if (budget > 0) {
+      double rem = budget - (now_seconds() - t0);
+      if (rem <= 0.02 * budget) break;
+      goal = taken + (rem > 0.1 * budget ? 0.6 : 0.95) * rate * rem;
+      if (goal > total) goal = total;
+    } else {
+      if (stage > 8) break;
+      goal = start + (total - start) * stage / 8;
+    }
+    if (goal < taken + 1) break;
+    double sum = waterfill(r, a, cap, np, goal, target, tmp);
+    if (sum <= taken) break; /* nothing left to take: every pixel at its noise threshold */
+    fill_job fj = {r, target, tiles_x, ts};
+    double s0 = now_seconds();
+    parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, fill_tile, &fj);
+    if (atomic_load(&r->cancel)) {
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
+      break;
+    }
+    double el = now_seconds() - t0, dt = now_seconds() - s0;
+    if (dt > 1e-6) rate = (sum - taken) / dt;
+    taken = sum;
+    double frac = taken / total;
+    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+    if (progress && progress(user, frac, (int)(taken / (double)np), el)) {
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
+      break;
+    }
+    if (taken >= total || (budget > 0 && el >= budget)) break;
+  }
+  r->spp_done = (int)(taken / (double)np);
+done:
+  free(rv); free(a); free(box); free(cap); free(target); free(tmp);
+  return st;
 }
 
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
@@ -670,70 +856,9 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
   if (r->opt.adaptive) uniform_spp = r->spp_done;
   if (r->opt.adaptive && st == VALO_OK && !(budget > 0 && now_seconds() - t0 >= budget)) {
     size_t np = (size_t)r->opt.width * r->opt.height;
-    double total = (double)r->opt.spp * (double)np, taken = (double)uniform_spp * (double)np;
-    prio *pr = malloc(np * sizeof *pr);
-    if (!pr) { free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-    size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
-    double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
-    double *raw = malloc(np * sizeof *raw);
-    if (!raw) { free(pr); free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-    int W = r->opt.width, H = r->opt.height;
-    /* "error": each pixel's relative variance per sample, var(L) / (mean^2 + eps), from
-     * the uniform pass alone and then frozen; a pixel's priority comes from its
-     * neighbours' (5x5 without itself) and its own sample count. A pixel's own samples never decide how many
-     * samples it gets, so its mean stays unbiased (a pixel that happened to miss a rare
-     * bright path is not left with too few samples to find it: test_analytic
-     * adaptive_unbiased); the neighbours share the rare paths a caustic spreads. */
-    int digest = r->opt.adaptive == VALO_ADAPTIVE_DIGEST;
-    if (!digest) {
-      /* raw[i]: the mean of the neighbours' relative variances, frozen for every round */
-      double *rv = malloc(np * sizeof *rv);
-      if (!rv) { free(raw); free(pr); free(ts); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-      for (size_t i = 0; i < np; i++) rv[i] = pixel_relvar(r, i);
-      for (int y = 0; y < H; y++)
-        for (int x = 0; x < W; x++) {
-          double acc = 0;
-          int cnt = 0;
-          for (int dy = -ADAPT_RADIUS; dy <= ADAPT_RADIUS; dy++)
-            for (int dx = -ADAPT_RADIUS; dx <= ADAPT_RADIUS; dx++) {
-              int xx = x + dx, yy = y + dy;
-              if ((!dx && !dy) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-              acc += rv[(size_t)yy * W + xx];
-              cnt++;
-            }
-          raw[(size_t)y * W + x] = cnt ? acc / cnt : 0;
-        }
-      free(rv);
-    }
-    while (taken < total) {
-      for (size_t i = 0; i < np; i++) {
-        pr[i].i = (uint32_t)i;
-        if (digest) { double pd = pixel_digest(r, i); pr[i].p = pd > thr2 ? pd : 0; continue; }
-        /* N grows as the neighbours' relative standard deviation (the allocation that
-         * minimises the summed relMSE), until var/N is below the noise threshold */
-        double v = raw[i], n = (double)r->count[i];
-        pr[i].p = v / n > thr2 ? sqrt(v) / n : 0;
-      }
-      size_t sel = k;
-      if (taken + (double)sel * ADAPT_BATCH > total) sel = (size_t)((total - taken) / ADAPT_BATCH);
-      if (sel == 0) break;
-      prio_select(pr, np, sel);
-      qsort(pr, sel, sizeof *pr, prio_cmp);
-      if (!(pr[0].p > 0)) break; /* every pixel below the noise threshold */
-      while (sel > 0 && !(pr[sel - 1].p > 0)) sel--;
-      adapt_job aj = {r, pr, (int64_t)sel, ts};
-      parallel_for(threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
-      if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
-      taken += (double)sel * ADAPT_BATCH;
-      double el = now_seconds() - t0;
-      double frac = taken / total;
-      if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-      if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
-      if (budget > 0 && el >= budget) break;
-    }
-    r->spp_done = (int)(taken / (double)np);
-    free(pr);
-    free(raw);
+    double total = (double)r->opt.spp * (double)np;
+    if (r->opt.adaptive == VALO_ADAPTIVE_DIGEST) st = adapt_digest(r, uniform_spp, total, budget, t0, progress, user, ts, err);
+    else st = adapt_error(r, total, budget, t0, progress, user, ts, err);
   }
   return run_finish(r, ts, t0, st);
 }
@@ -850,7 +975,7 @@ VALO_API void valo_render_destroy(valo_render *r) {
   free(r->sum);
   free(r->aov);
   free(r->count);
-  free(r->lum);
+  free(r->sq);
   free(r->frame_rgb);
   free(r);
 }
