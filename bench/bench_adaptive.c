@@ -221,7 +221,7 @@ int main(int argc, char **argv) {
     image_free(&ref);
   }
   if (!bound) return 0;
-  printf("\n# The bound: equal-sample gain of the best allocation from a first pass (valo: share 0.5, 9x9)\n\n"
+  printf("\n# The bound: equal-sample gain of the best allocation from a first pass (valo: share 0.5, 17x17)\n\n"
          "First pass share F; the pilot's samples per pixel; allocation n ~ sqrt(v) from the pixel's own first-pass\n"
          "variance (biased if used, here only a bound) or its neighbours' (5x5, 9x9, 17x17 without itself).\n\n"
          "| scene | F | pilot | own pixel | 5x5 | 9x9 | 17x17 |\n|---|---|---|---|---|---|---|\n");

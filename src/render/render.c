@@ -449,7 +449,7 @@ static void render_tile(void *user, int64_t item, int thread) {
  * then fixes each pixel's count from its neighbours' relative variance (adapt_error:
  * water-filling, in a few stages over tiles); "digest" gives rounds of ADAPT_BATCH more
  * samples to the 1/ADAPT_FRACTION of pixels with the highest priority on their own
- * samples (adapt_digest). The first pass's share and the 9x9 neighbourhood are the best
+ * samples (adapt_digest). The first pass's share and the 17x17 neighbourhood are the best
  * of those bench_adaptive measures against the bound of any allocation
  * (docs/performance.md); counts are fixed from deterministic sums between stages, so the
  * image is identical for any thread count. */
@@ -457,7 +457,7 @@ static void render_tile(void *user, int64_t item, int thread) {
 #define ADAPT_FRACTION 8
 #define ADAPT_UNIFORM 0.5 /* the first pass's share (docs/performance.md, "Ninth session": the bound) */
 #define ADAPT_EPS 0.01
-#define ADAPT_RADIUS 4 /* the 9x9 neighbourhood whose variance sets a pixel's priority */
+#define ADAPT_RADIUS 8 /* the 17x17 neighbourhood whose variance sets a pixel's priority */
 
 /* The "error" rule's v of pixel i: the relative variance of one sample, var / (mean^2 +
  * eps) per channel (as relMSE weighs them), averaged over r, g, b; 0 with fewer than two
@@ -621,7 +621,7 @@ static double waterfill(const valo_render *r, const double *a, const uint32_t *c
 
 /* The "error" rule after the first pass (docs/integrators.md): each pixel's relative
  * variance per sample, var(L) / (mean^2 + eps), from the first pass and then frozen; a
- * pixel's share comes from its neighbours' (9x9 without itself). A pixel's own samples
+ * pixel's share comes from its neighbours' (17x17 without itself). A pixel's own samples
  * never decide how many samples it gets, so its mean stays unbiased (a pixel that
  * happened to miss a rare bright path is not left with too few samples to find it:
  * test_analytic adaptive_unbiased); the neighbours share the rare paths a caustic
