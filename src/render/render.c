@@ -583,6 +583,25 @@ static void fill_tile(void *user, int64_t item, int thread) {
     }
 }
 
+/* out = sums of in over the (2 ADAPT_RADIUS + 1)^2 window around each pixel (clipped to
+ * the image), separably: rows into tmp, then columns. */
+static void box_sums(const double *in, double *tmp, double *out, int W, int H) {
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      double acc = 0;
+      for (int xx = x - ADAPT_RADIUS; xx <= x + ADAPT_RADIUS; xx++)
+        if (xx >= 0 && xx < W) acc += in[(size_t)y * W + xx];
+      tmp[(size_t)y * W + x] = acc;
+    }
+  for (int y = 0; y < H; y++) {
+    double *row = &out[(size_t)y * W];
+    memset(row, 0, (size_t)W * sizeof *row);
+    for (int yy = y - ADAPT_RADIUS; yy <= y + ADAPT_RADIUS; yy++)
+      if (yy >= 0 && yy < H)
+        for (int x = 0; x < W; x++) row[x] += tmp[(size_t)yy * W + x];
+  }
+}
+
 /* Sample counts for `total` samples over the image (water-filling): target_i =
  * min(cap_i, max(count_i, floor(lam a_i))), lam the largest whose targets sum to at most
  * total; the samples left over go one each to the pixels next in line, by index. So
@@ -607,7 +626,7 @@ static double waterfill(const valo_render *r, const double *a, const uint32_t *c
     lo = hi;
     hi *= 2;
   }
-  for (int it = 0; it < 80; it++) {
+  for (int it = 0; it < 52; it++) { /* a double's precision; the remainder goes out below */
     double mid = 0.5 * (lo + hi);
     if (waterfill_at(r, a, cap, np, mid, hi_t) <= total) lo = mid;
     else hi = mid;
@@ -627,35 +646,22 @@ static double waterfill(const valo_render *r, const double *a, const uint32_t *c
  * test_analytic adaptive_unbiased); the neighbours share the rare paths a caustic
  * spreads. Counts grow as the square root of that variance (the allocation that
  * minimises the summed relMSE), up to v / X^2 with a noise threshold X. The samples go
- * out in stages over tiles: eight equal ones for a sample budget (the same image for
- * any thread count), and with a time budget stages of 60 % of the samples the remaining
- * time holds at the last stage's rate. */
+ * out in stages over tiles: equal steps towards the final counts for a sample budget
+ * (the same image for any thread count), and with a time budget stages of 60 % of the
+ * samples the remaining time holds at the last stage's rate. */
 static valo_status adapt_error(valo_render *r, double total, double budget, double t0, valo_progress_fn progress, void *user, thread_stats *ts,
                                valo_error *err) {
   size_t np = (size_t)r->opt.width * r->opt.height;
   int W = r->opt.width, H = r->opt.height;
-  double *rv = malloc(np * sizeof *rv), *a = malloc(np * sizeof *a), *box = malloc(np * sizeof *box);
+  double *rv = calloc(np, sizeof *rv), *a = malloc(np * sizeof *a), *box = malloc(np * sizeof *box);
   uint32_t *cap = malloc(np * sizeof *cap), *target = malloc(np * sizeof *target), *tmp = malloc(np * sizeof *tmp);
+  uint32_t *fin = malloc(np * sizeof *fin), *first = malloc(np * sizeof *first);
   valo_status st = VALO_OK;
-  if (!rv || !a || !box || !cap || !target || !tmp) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+  if (!rv || !a || !box || !cap || !target || !tmp || !fin || !first) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
   double thr2 = r->opt.noise_threshold > 0 ? r->opt.noise_threshold * r->opt.noise_threshold : 0;
   double taken = 0;
   for (size_t i = 0; i < np; i++) { rv[i] = pixel_relvar(r, i); taken += r->count[i]; }
-  /* box sums over the neighbourhood, separably: rows into a, then columns */
-  for (int y = 0; y < H; y++)
-    for (int x = 0; x < W; x++) {
-      double acc = 0;
-      for (int xx = x - ADAPT_RADIUS; xx <= x + ADAPT_RADIUS; xx++)
-        if (xx >= 0 && xx < W) acc += rv[(size_t)y * W + xx];
-      a[(size_t)y * W + x] = acc;
-    }
-  for (int y = 0; y < H; y++) {
-    double *row = &box[(size_t)y * W];
-    memset(row, 0, (size_t)W * sizeof *row);
-    for (int yy = y - ADAPT_RADIUS; yy <= y + ADAPT_RADIUS; yy++)
-      if (yy >= 0 && yy < H)
-        for (int x = 0; x < W; x++) row[x] += a[(size_t)yy * W + x];
-  }
+  box_sums(rv, a, box, W, H);
   for (int y = 0; y < H; y++)
     for (int x = 0; x < W; x++) {
       size_t i = (size_t)y * W + x;
@@ -669,22 +675,35 @@ static valo_status adapt_error(valo_render *r, double total, double budget, doub
       cap[i] = c < (double)r->count[i] ? r->count[i] : c > 2e9 ? 2000000000u : (uint32_t)c;
     }
   int tiles_x = (W + TILE - 1) / TILE, tiles_y = (H + TILE - 1) / TILE;
-  double start = taken, rate = 0, t_prev = now_seconds();
+  double rate = 0, t_prev = now_seconds();
   if (budget > 0) rate = taken / (t_prev - t0 > 1e-6 ? t_prev - t0 : 1e-6);
+  /* A sample budget: the final counts at once, taken in equal stages of about 2 samples
+   * per pixel (8 to 64 of them) so that progress moves; they depend on the budget alone,
+   * so the image does not depend on timing. */
+  int stages = 0;
+  if (!(budget > 0)) {
+    if (waterfill(r, a, cap, np, total, fin, tmp) <= taken) goto finish; /* all at their noise threshold */
+    for (size_t i = 0; i < np; i++) first[i] = r->count[i];
+    double per_pixel = (total - taken) / (double)np;
+    stages = per_pixel / 2 < 8 ? 8 : per_pixel / 2 > 64 ? 64 : (int)(per_pixel / 2);
+  }
   for (int stage = 1;; stage++) {
-    double goal;
+    double sum = 0;
     if (budget > 0) {
       double rem = budget - (now_seconds() - t0);
       if (rem <= 0.02 * budget) break;
-      goal = taken + (rem > 0.1 * budget ? 0.6 : 0.95) * rate * rem;
+      double goal = taken + (rem > 0.1 * budget ? 0.6 : 0.95) * rate * rem;
       if (goal > total) goal = total;
+      if (goal < taken + 1) break;
+      sum = waterfill(r, a, cap, np, goal, target, tmp);
+      if (sum <= taken) break; /* nothing left to take: every pixel at its noise threshold */
     } else {
-      if (stage > 8) break;
-      goal = start + (total - start) * stage / 8;
+      if (stage > stages) break;
+      for (size_t i = 0; i < np; i++) {
+        target[i] = first[i] + (uint32_t)((uint64_t)(fin[i] - first[i]) * (uint64_t)stage / (uint64_t)stages);
+        sum += target[i];
+      }
     }
-    if (goal < taken + 1) break;
-    double sum = waterfill(r, a, cap, np, goal, target, tmp);
-    if (sum <= taken) break; /* nothing left to take: every pixel at its noise threshold */
     fill_job fj = {r, target, tiles_x, ts};
     double s0 = now_seconds();
     parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, fill_tile, &fj);
@@ -703,9 +722,10 @@ static valo_status adapt_error(valo_render *r, double total, double budget, doub
     }
     if (taken >= total || (budget > 0 && el >= budget)) break;
   }
+finish:
   r->spp_done = (int)(taken / (double)np);
 done:
-  free(rv); free(a); free(box); free(cap); free(target); free(tmp);
+  free(rv); free(a); free(box); free(cap); free(target); free(tmp); free(fin); free(first);
   return st;
 }
 
