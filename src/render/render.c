@@ -402,6 +402,7 @@ static void record_aovs(const valo_render *r, ray ry, float *acc, sampler *smp, 
 typedef struct pass_job {
   valo_render *r;
   int s0, s1;          /* sample indices [s0, s1) */
+  const uint32_t *target; /* or, when not NULL: each pixel from its count up to target[pix] */
   int tiles_x;
   thread_stats *ts;    /* one per thread */
 } pass_job;
@@ -441,7 +442,12 @@ static void render_tile(void *user, int64_t item, int thread) {
   int x1 = x0 + TILE < r->opt.width ? x0 + TILE : r->opt.width;
   int y1 = y0 + TILE < r->opt.height ? y0 + TILE : r->opt.height;
   for (int y = y0; y < y1; y++)
-    for (int x = x0; x < x1; x++) sample_pixel(r, x, y, j->s0, j->s1, ts);
+    for (int x = x0; x < x1; x++) {
+      if (!j->target) { sample_pixel(r, x, y, j->s0, j->s1, ts); continue; }
+      size_t pix = (size_t)y * (size_t)r->opt.width + (size_t)x;
+      int c = (int)r->count[pix], t = (int)j->target[pix];
+      if (t > c) sample_pixel(r, x, y, c, t, ts);
+    }
 }
 
 /* ---- adaptive sampling (docs/integrators.md). A uniform first pass takes half of the
@@ -523,6 +529,13 @@ static void adapt_chunk(void *user, int64_t item, int thread) {
   }
 }
 
+/* Calls the progress callback (if any) with the larger of frac and the share of the time
+ * budget spent; non-zero when it asks to cancel. */
+static int report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget) {
+  if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+  return progress && progress(user, frac, spp, el);
+}
+
 /* The "digest" rule after the first pass: rounds that give ADAPT_BATCH more samples to
  * the 1/ADAPT_FRACTION of pixels with the highest priority (N sum s^2 / (sum s)^2 - 1) / N,
  * on each pixel's own samples so far (biased: docs/integrators.md), until the budget or
@@ -554,33 +567,15 @@ static valo_status adapt_digest(valo_render *r, int uniform_spp, double total, d
     if (atomic_load(&r->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
     taken += (double)sel * ADAPT_BATCH;
     double el = now_seconds() - t0;
-    double frac = taken / total;
-    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-    if (progress && progress(user, frac, (int)(taken / (double)np), el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
+    if (report_progress(progress, user, taken / total, (int)(taken / (double)np), el, budget)) {
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
+      break;
+    }
     if (budget > 0 && el >= budget) break;
   }
   r->spp_done = (int)(taken / (double)np);
   free(pr);
   return st;
-}
-
-/* The "error" rule's samples: every pixel of a tile takes samples up to target[pix], in
- * order (tiles keep rays coherent; the targets were fixed before the pass). */
-typedef struct fill_job { valo_render *r; const uint32_t *target; int tiles_x; thread_stats *ts; } fill_job;
-static void fill_tile(void *user, int64_t item, int thread) {
-  fill_job *j = user;
-  valo_render *r = j->r;
-  if (atomic_load_explicit(&r->cancel, memory_order_relaxed)) return;
-  int tx = (int)(item % j->tiles_x), ty = (int)(item / j->tiles_x);
-  int x0 = tx * TILE, y0 = ty * TILE;
-  int x1 = x0 + TILE < r->opt.width ? x0 + TILE : r->opt.width;
-  int y1 = y0 + TILE < r->opt.height ? y0 + TILE : r->opt.height;
-  for (int y = y0; y < y1; y++)
-    for (int x = x0; x < x1; x++) {
-      size_t pix = (size_t)y * (size_t)r->opt.width + (size_t)x;
-      int c = (int)r->count[pix], t = (int)j->target[pix];
-      if (t > c) sample_pixel(r, x, y, c, t, &j->ts[thread]);
-    }
 }
 
 /* out = sums of in over the (2 ADAPT_RADIUS + 1)^2 window around each pixel (clipped to
@@ -704,9 +699,9 @@ static valo_status adapt_error(valo_render *r, double total, double budget, doub
         sum += target[i];
       }
     }
-    fill_job fj = {r, target, tiles_x, ts};
+    pass_job job = {r, 0, 0, target, tiles_x, ts}; /* tiles keep rays coherent */
     double s0 = now_seconds();
-    parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, fill_tile, &fj);
+    parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
     if (atomic_load(&r->cancel)) {
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
       break;
@@ -714,9 +709,7 @@ static valo_status adapt_error(valo_render *r, double total, double budget, doub
     double el = now_seconds() - t0, dt = now_seconds() - s0;
     if (dt > 1e-6) rate = (sum - taken) / dt;
     taken = sum;
-    double frac = taken / total;
-    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-    if (progress && progress(user, frac, (int)(taken / (double)np), el)) {
+    if (report_progress(progress, user, taken / total, (int)(taken / (double)np), el, budget)) {
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
       break;
     }
@@ -753,7 +746,7 @@ static valo_status tile_samples(valo_render *r, int s0, int s1, thread_stats *ts
       valo_status pst = r->integ->prepare(r->istate, &r->ctx, a, err);
       if (pst) return pst;
     }
-    pass_job job = {r, a, b, tiles_x, ts};
+    pass_job job = {r, a, b, NULL, tiles_x, ts};
     parallel_for(r->opt.threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
     if (atomic_load(&r->cancel)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled");
     a = b;
@@ -863,8 +856,10 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     double el = now_seconds() - t0;
     double frac = (double)r->spp_done / r->opt.spp;
     if (r->opt.adaptive) frac *= (double)uniform_spp / r->opt.spp;
-    if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-    if (progress && progress(user, frac, r->spp_done, el)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done); break; }
+    if (report_progress(progress, user, frac, r->spp_done, el, budget)) {
+      st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done);
+      break;
+    }
     if (budget > 0 && el >= budget) break;
     /* Adaptive with a time budget: the uniform first pass gets ADAPT_UNIFORM of the time
      * (at least 4 spp), as it gets that share of a sample budget; before, with --time it
