@@ -855,7 +855,6 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
     r->spp_done += n;
     double el = now_seconds() - t0;
     double frac = (double)r->spp_done / r->opt.spp;
-    if (r->opt.adaptive) frac *= (double)uniform_spp / r->opt.spp;
     if (report_progress(progress, user, frac, r->spp_done, el, budget)) {
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", r->spp_done);
       break;
