@@ -3,8 +3,16 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
+
+#ifndef VALO_EXE
+#define VALO_EXE "valo"
+#endif
 
 #ifndef VALO_SHARED_DIR
 #define VALO_SHARED_DIR "../shared"
@@ -193,4 +201,57 @@ void compare_images(const float *img, const float *ref, int w, int h, int block,
       double e = fabs(a - b) / b;
       if (e > r->worst_block) { r->worst_block = e; r->worst_bx = bx; r->worst_by = by; }
     }
+}
+
+double run_cli_seconds;
+static double wall_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap) {
+  char log[1200];
+  snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
+  double t0 = wall_now();
+  pid_t pid = fork();
+  if (pid == 0) {
+    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(fd, 1); dup2(fd, 2);
+    close(fd);
+    const char *argv[32];
+    int n = 0;
+    argv[n++] = VALO_EXE;
+    for (int i = 0; args[i] && n < 31; i++) argv[n++] = args[i];
+    argv[n] = NULL;
+    execv(VALO_EXE, (char *const *)argv);
+    _exit(127);
+  }
+  int status = 0;
+  if (sigint_ms > 0) {
+    struct timespec d = {sigint_ms / 1000, (long)(sigint_ms % 1000) * 1000000L};
+    nanosleep(&d, NULL);
+    kill(pid, SIGINT);
+  }
+  for (;;) {
+    pid_t r = waitpid(pid, &status, WNOHANG);
+    if (r == pid) break;
+    if (wall_now() - t0 > timeout_s) {
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      fprintf(stderr, "valo hung: killed after %d s\n", timeout_s);
+      run_cli_seconds = wall_now() - t0;
+      return 999;
+    }
+    struct timespec ts = {0, 5000000};
+    nanosleep(&ts, NULL);
+  }
+  run_cli_seconds = wall_now() - t0;
+  FILE *f = fopen(log, "rb");
+  size_t len = f ? fread(out, 1, cap - 1, f) : 0;
+  if (f) fclose(f);
+  out[len] = 0;
+  fprintf(stderr, "valo said (%.2f s): %s", run_cli_seconds, out);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return WEXITSTATUS(status);
 }

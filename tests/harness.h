@@ -56,4 +56,10 @@ int read_aov(const valo_render *r, const char *name, image *out);
  * mean). */
 typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, lit_blocks; } cmp_result;
 void compare_images(const float *img, const float *ref, int w, int h, int block, cmp_result *r);
+/* Runs the valo binary with args (NULL-terminated): sends SIGINT (as Ctrl-C does) after
+ * sigint_ms milliseconds when > 0, kills it after timeout_s seconds (a hang: returns 999).
+ * Returns the exit code (128+signal if killed); the combined stdout+stderr go to out
+ * (and to stderr); run_cli_seconds gets the wall time. */
+int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap);
+extern double run_cli_seconds;
 #endif

@@ -13,55 +13,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#ifndef VALO_EXE
-#define VALO_EXE "valo"
-#endif
-
 static char g_out[65536];
-
-/* Runs valo with args (NULL-terminated); returns the exit code (128+sig if killed), and
- * the combined stdout+stderr in g_out. */
-static int run_valo_int(const char *const *args, int sigint_ms);
+static int run_valo_int(const char *const *args, int sigint_ms) { return run_cli(args, sigint_ms, 60, g_out, sizeof g_out); }
 static int run_valo(const char *const *args) { return run_valo_int(args, 0); }
-/* The same, sending SIGINT (as Ctrl-C does) after sigint_ms milliseconds when > 0. */
-static int run_valo_int(const char *const *args, int sigint_ms) {
-  char log[1200];
-  snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
-  pid_t pid = fork();
-  if (pid == 0) {
-    int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1); dup2(fd, 2);
-    close(fd);
-    const char *argv[32];
-    int n = 0;
-    argv[n++] = VALO_EXE;
-    for (int i = 0; args[i] && n < 31; i++) argv[n++] = args[i];
-    argv[n] = NULL;
-    execv(VALO_EXE, (char *const *)argv);
-    _exit(127);
-  }
-  int status = 0;
-  time_t t0 = time(NULL);
-  if (sigint_ms > 0) {
-    struct timespec d = {sigint_ms / 1000, (long)(sigint_ms % 1000) * 1000000L};
-    nanosleep(&d, NULL);
-    kill(pid, SIGINT);
-  }
-  for (;;) {
-    pid_t r = waitpid(pid, &status, WNOHANG);
-    if (r == pid) break;
-    if (time(NULL) - t0 > 60) { kill(pid, SIGKILL); waitpid(pid, &status, 0); fprintf(stderr, "valo hung: killed\n"); return 999; }
-    struct timespec ts = {0, 20000000};
-    nanosleep(&ts, NULL);
-  }
-  FILE *f = fopen(log, "rb");
-  size_t len = f ? fread(g_out, 1, sizeof g_out - 1, f) : 0;
-  if (f) fclose(f);
-  g_out[len] = 0;
-  fprintf(stderr, "valo said: %s", g_out);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return WEXITSTATUS(status);
-}
 
 #define EXPECT_FAIL(code, ...)                                                                          \
   do {                                                                                                  \

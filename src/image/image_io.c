@@ -1,11 +1,11 @@
 /* image_io.c — see image_io.h. */
 #include "image/image_io.h"
+#include "image/hdr.h"
 #include "core/error.h"
 #include "image/tonemap.h"
 #include <OpenEXR/openexr.h>
 #include <OpenEXR/ImfCRgbaFile.h>
 #include <stb_image_write.h>
-#include <stb_image.h>
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -338,16 +338,6 @@ valo_status image_read(const char *path, image *out, valo_error *err) {
   const char *ext = ext_of(path);
   if (!strcasecmp(ext, "exr")) return read_exr(path, out, err);
   if (!strcasecmp(ext, "pfm")) return read_pfm(path, out, err);
-  if (!strcasecmp(ext, "hdr")) {
-    int w, h, n;
-    float *px = stbi_loadf(path, &w, &h, &n, 3);
-    if (!px) return err_set(err, VALO_ERR_PARSE, "%s: cannot read Radiance HDR: %s", path, stbi_failure_reason());
-    out->w = w; out->h = h;
-    out->rgb = malloc((size_t)w * h * 3 * sizeof(float));
-    if (!out->rgb) { stbi_image_free(px); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-    memcpy(out->rgb, px, (size_t)w * h * 3 * sizeof(float));
-    stbi_image_free(px);
-    return VALO_OK;
-  }
+  if (!strcasecmp(ext, "hdr")) return hdr_read(path, out, err);
   return err_set(err, VALO_ERR_UNSUPPORTED, "%s: cannot read \".%s\" images (exr, hdr, pfm)", path, ext);
 }

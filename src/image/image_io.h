@@ -1,5 +1,5 @@
 /* image_io.h — owns image files: linear float EXR through OpenEXRCore (read and write),
- * PFM (read and write), 8-bit sRGB PNG through stb_image_write. Every write goes to a
+ * PFM (read and write), 8-bit sRGB PNG through stb_image_write; Radiance HDR through hdr.c. Every write goes to a
  * temporary file in the destination folder and is renamed over the target, so readers
  * never see a partial image. Pixels are RGB float, row-major, top row first. */
 #ifndef VALO_IMAGE_IO_H
@@ -9,7 +9,8 @@
 typedef struct image { int w, h; float *rgb; } image;
 
 valo_status image_write(const char *path, int w, int h, const float *px, const valo_output_options *o, valo_error *err);
-/* Reads an EXR (any compression OpenEXR supports; half/float/uint; R,G,B or Y) or PFM. */
+/* Reads an EXR (any compression OpenEXR supports; half/float/uint; R,G,B or Y), PFM or
+ * Radiance HDR. */
 valo_status image_read(const char *path, image *out, valo_error *err);
 void image_free(image *im);
 /* Display transform used for PNG: exposure, tone map, sRGB encode, 8-bit. */

@@ -13,6 +13,7 @@
 #include <assimp/ObjMaterial.h>
 #include "scene/texture.h"
 #include "scene/obj_check.h"
+#include "scene/ply_check.h"
 #include <assimp/cfileio.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/texture.h>
@@ -94,7 +95,7 @@ static int texture_in(scene *s, const char *dir, const char *p, int srgb) {
   if (p[0] == '/') snprintf(full, sizeof full, "%s", p);
   else snprintf(full, sizeof full, "%s%s", dir, p);
   for (char *q = full; *q; q++) if (*q == '\\') *q = '/';
-  return scene_texture_file(s, full, srgb);
+  return scene_texture_file(s, full, srgb, NULL);
 }
 
 /* Loads texture slot `type` of am into the scene: a file beside the mesh, or an image
@@ -428,26 +429,12 @@ static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
   return VALO_OK;
 }
 
-/* Assimp reads a PLY made of triangle strips (as some Stanford scans are stored) as one
- * bogus polygon without an error: look at the header ourselves. */
-static int ply_has_tristrips(FILE *f) {
-  char line[512];
-  int n = 0;
-  if (!fgets(line, sizeof line, f) || strncmp(line, "ply", 3)) return 0;
-  while (n++ < 200 && fgets(line, sizeof line, f)) {
-    if (!strncmp(line, "end_header", 10)) break;
-    if (!strncmp(line, "element tristrips", 17)) return 1;
-  }
-  return 0;
-}
-
 valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_error *err) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-  int strips = ply_has_tristrips(f);
-  fclose(f);
-  if (strips)
-    return err_set(err, VALO_ERR_UNSUPPORTED, "%s: PLY triangle strips (element tristrips) are not supported; convert the mesh to faces", path);
+  /* A PLY (by its magic, whatever its name) is checked by valo first: Assimp aborts the
+   * process on faces that disagree with the header (ply_check.h), and reads a PLY of
+   * triangle strips as one bogus polygon without an error. */
+  valo_status pst = ply_check_file(path, err);
+  if (pst) return pst;
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
   const char *ext = strrchr(path, '.');
   /* OBJ files are read by valo first (obj_check.c): checks with line numbers, repairs,

@@ -267,11 +267,12 @@ static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const 
   if (st || !file) return st;
   char full[2048];
   resolve_path(c, file, full, sizeof full);
-  *tex = scene_texture_file(c->s, full, 0);
+  valo_error terr;
+  *tex = scene_texture_file(c->s, full, 0, &terr);
   if (*tex >= 0) return VALO_OK;
-  char w[300], msg[200];
+  char w[300], msg[sizeof terr.message + 200];
   snprintf(w, sizeof w, "%s.%s", where, key);
-  snprintf(msg, sizeof msg, "cannot read the %s", what);
+  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
   return bad(c, w, msg);
 }
 
@@ -289,11 +290,13 @@ static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const c
       return bad(c, w, msg);
     }
     fclose(f);
-    *tex = scene_texture_file(c->s, full, 1);
+    valo_error terr;
+    *tex = scene_texture_file(c->s, full, 1, &terr);
     if (*tex < 0) {
-      char w[300];
+      char w[300], msg[sizeof terr.message + 40];
       snprintf(w, sizeof w, "%s.%s", where, key);
-      return bad(c, w, "texture could not be decoded");
+      snprintf(msg, sizeof msg, "texture could not be decoded: %s", terr.message);
+      return bad(c, w, msg);
     }
     *out = c3(1, 1, 1);
     return VALO_OK;

@@ -99,14 +99,15 @@ static int find_texture(const scene *s, const char *key) {
   return -1;
 }
 
-int scene_texture_file(scene *s, const char *path, int srgb) {
+int scene_texture_file(scene *s, const char *path, int srgb, valo_error *to) {
   char key[600];
   snprintf(key, sizeof key, "%s|%d", path, srgb);
   int i = find_texture(s, key);
   if (i >= 0) return i;
   texture t;
   valo_error err;
-  if (texture_load_file(&t, path, srgb, &err)) {
+  if (texture_load_file(&t, path, srgb, to ? to : &err)) {
+    if (to) return -1;
     log_warning("%s%s%s (the map is ignored)", s->tex_user, s->tex_user[0] ? ": " : "", err.message);
     return -1;
   }

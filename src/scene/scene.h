@@ -130,9 +130,10 @@ int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris);
 uint32_t scene_add_material(scene *s, const material *m); /* UINT32_MAX on OOM */
 int scene_add_light(scene *s, const light *l);
 material material_default(void);
-/* Adds (or finds, by key) a texture from a file; returns its index, or -1 after a
- * warning naming the file when it cannot be read (the map is then ignored). */
-int scene_texture_file(scene *s, const char *path, int srgb);
+/* Adds (or finds, by key) a texture from a file; returns its index, or -1 when it cannot
+ * be read: with err, err says why (the caller refuses the scene); without, a warning
+ * names the file and the map is ignored. */
+int scene_texture_file(scene *s, const char *path, int srgb, valo_error *err);
 int scene_texture_memory(scene *s, const char *key, const unsigned char *data, size_t len, int srgb);
 /* Surface UV of triangle t at barycentrics (b1, b2). */
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);

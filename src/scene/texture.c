@@ -7,6 +7,20 @@
 #include <string.h>
 #include <strings.h>
 
+/* Texels are 16 bytes: a header that claims more than this many (4 GiB of texels) is
+ * refused from stb's header read, before anything is decoded or allocated. */
+#define TEXTURE_MAX_PIXELS (1ull << 28)
+
+/* ok: stb read the header (when it did not, decoding fails below with stb's reason). */
+static valo_status check_size(int ok, int w, int h, const char *name, valo_error *err) {
+  if (ok && (w < 1 || h < 1))
+    return err_set(err, VALO_ERR_PARSE, "%s: the image header gives a size of %d x %d pixels", name, w, h);
+  if (ok && (unsigned long long)w * (unsigned long long)h > TEXTURE_MAX_PIXELS)
+    return err_set(err, VALO_ERR_INVALID, "%s: image of %d x %d pixels is larger than valo's texture limit (%llu pixels, %llu MiB as float RGBA)",
+                   name, w, h, TEXTURE_MAX_PIXELS, TEXTURE_MAX_PIXELS * 16 >> 20);
+  return VALO_OK;
+}
+
 static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
 
 static valo_status from_8bit(texture *t, unsigned char *data, int w, int h, int n, int srgb, const char *name, valo_error *err) {
@@ -30,7 +44,10 @@ static valo_status from_8bit(texture *t, unsigned char *data, int w, int h, int 
 valo_status texture_load_memory(texture *t, const unsigned char *data, size_t len, const char *name, int srgb, valo_error *err) {
   memset(t, 0, sizeof *t);
   if (len > (size_t)INT32_MAX) return err_set(err, VALO_ERR_INVALID, "%s: embedded image too large", name);
-  int w, h, n;
+  int w = 0, h = 0, n = 0;
+  int ok = stbi_info_from_memory(data, (int)len, &w, &h, &n);
+  valo_status st = check_size(ok, w, h, name, err);
+  if (st) return st;
   unsigned char *img = stbi_load_from_memory(data, (int)len, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_PARSE, "%s: cannot decode image: %s", name, stbi_failure_reason());
   return from_8bit(t, img, w, h, n, srgb, name, err);
@@ -53,7 +70,10 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
     image_free(&im);
     return VALO_OK;
   }
-  int w, h, n;
+  int w = 0, h = 0, n = 0;
+  int ok = stbi_info(path, &w, &h, &n);
+  valo_status st = check_size(ok, w, h, path, err);
+  if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());
   return from_8bit(t, img, w, h, n, srgb, path, err);

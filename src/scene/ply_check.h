@@ -1,0 +1,20 @@
+/* ply_check.h — owns valo's own check of a PLY file before Assimp reads it: the header
+ * (format, elements, properties), every element's data against the header (counts against
+ * the file's size, ASCII numbers and line lengths, binary lengths), and every face's vertex
+ * count and indices. Assimp 5.2.5 (Debian 12, libassimp5 5.2.5~ds0-1) keeps its
+ * assertions, and its PLY reader hands faces that disagree with the header to
+ * TriangulateProcess, which aborts the process (`numOut != pMesh->mNumFaces`); so a PLY
+ * reaches Assimp only once every face is known to be a polygon of valid indices. */
+#ifndef VALO_PLY_CHECK_H
+#define VALO_PLY_CHECK_H
+#include "valo/valo.h"
+#include <stddef.h>
+
+/* 1 when the first bytes are a PLY magic ("ply" then a line end). */
+int ply_is_ply(const unsigned char *data, size_t len);
+/* Checks the PLY held in data (len bytes, read from path, named in messages). Returns
+ * VALO_OK or an error "path: what is wrong" (with the line for header and ASCII faults). */
+valo_status ply_check(const char *path, const unsigned char *data, size_t len, valo_error *err);
+/* Reads path and checks it; VALO_OK for a file that is not a PLY. */
+valo_status ply_check_file(const char *path, valo_error *err);
+#endif
