@@ -14,6 +14,7 @@
 #include "valo/valo.h"
 #include "bench_util.h"
 #include "scene/scene.h"
+#include "load/load.h"
 #include "geometry/accel.h"
 #include "geometry/pointtree.h"
 #include "integrator/proximity.h"
@@ -90,7 +91,7 @@ static void count_visit(void *u, uint32_t i, float d2) { (void)i; (void)d2; ((vi
 static void breakdown(const char *json_path, int w, int h, double *t_splat, double *t_build, double *t_search, uint32_t *npts, double *per_query) {
   valo_error err;
   scene *s = scene_new(json_path);
-  if (load_json(s, json_path, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return; }
+  if (load_json(s, json_path, NULL, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return; }
   float r = 0.1f * s->radius, d = r / 6;
   splat_points sp;
   double t0 = bench_now();

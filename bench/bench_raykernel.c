@@ -8,6 +8,7 @@
  * [--classes] */
 #include "bench_util.h"
 #include "scene/scene.h"
+#include "load/load.h"
 #include "geometry/accel.h"
 #include "geometry/offset.h"
 #include "core/rng.h"
@@ -111,7 +112,7 @@ static ray *make_rays(const scene *s, const accel *a, long *count, ray **shadow,
 static int load(scene *s, const char *rel, const float *xf) {
   char buf[2048];
   valo_error err;
-  if (load_mesh(s, shared(rel, buf, sizeof buf), xf, UINT32_MAX, 0, &err)) { fprintf(stderr, "skip %s: %s\n", rel, err.message); return -1; }
+  if (load_mesh(s, shared(rel, buf, sizeof buf), xf, UINT32_MAX, 0, NULL, &err)) { fprintf(stderr, "skip %s: %s\n", rel, err.message); return -1; }
   return 0;
 }
 

@@ -6,7 +6,7 @@
  * the answers are exact for the tessellated geometry. Tolerances: region means within
  * 1 %, every pixel within 6 sigma-ish bounds stated per case; all pixels finite. */
 #include "harness.h"
-#include "scene/texture.h"
+#include "image/texture.h"
 #include "image/image_io.h"
 #include <math.h>
 #include <stdlib.h>

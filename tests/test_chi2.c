@@ -10,7 +10,7 @@
 #include "material/bsdf.h"
 #include "material/fresnel.h"
 #include "light/light.h"
-#include "light/envmap.h"
+#include "scene/envmap.h"
 #include "core/alias.h"
 #include "core/rng.h"
 #include "core/sampling.h"

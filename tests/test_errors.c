@@ -352,7 +352,17 @@ static int integrator_docs(void) {
       if (strncmp(line, "    ", 4) || !dot || !eq || dot > eq) continue;
       char want[96];
       snprintf(want, sizeof want, "| `%.*s` |", (int)(eq - dot - 1), dot + 1);
-      CHECK(strstr(doc, want), "docs/integrators.md does not list %s's parameter %s", *name, want);
+      /* the row in this integrator's own section, and its default cell starts with the
+       * code's default */
+      const char *sec = strstr(doc, heading), *next = strstr(sec + 1, "\n## ");
+      const char *row = strstr(sec, want);
+      CHECK(row && (!next || row < next), "docs/integrators.md does not list %s's parameter %s in its section", *name, want);
+      char def[32];
+      snprintf(def, sizeof def, "%.*s", (int)strcspn(eq + 3, " "), eq + 3);
+      const char *cell = row + strlen(want);
+      while (*cell == ' ') cell++;
+      CHECK(!strncmp(cell, def, strlen(def)) && (cell[strlen(def)] == ' ' || cell[strlen(def)] == '|'),
+            "docs/integrators.md gives %s's %s a default of \"%.20s\", the code %s", *name, want, cell, def);
       checked++;
     }
   }

@@ -8,6 +8,7 @@
  * starting exactly on a surface, kd-tree against brute force exactly and Embree within
  * tolerance (issue 8.1: nearly axis-aligned walls fell out of cells they reach). */
 #include "harness.h"
+#include "load/load.h"
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/triangle.h"
@@ -106,7 +107,7 @@ static int check_scene_rays(const char *path, int nrays, const char *kind, int a
   if (!strcmp(kind, "embree") && !embree_available()) { fprintf(stderr, "skipped: no embree\n"); return TEST_SKIP; }
   scene *s = scene_new(path);
   valo_error err;
-  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   accel *a;
   CHECK(accel_create(kind, s->pos, s->idx, s->ntris, 1, g_filter, &a, &err) == VALO_OK, "%s", err.message);
@@ -331,7 +332,7 @@ static int check_camera_scene(const cam_case *c, int scale) {
   if (!path) return TEST_SKIP;
   scene *s = scene_new(path);
   valo_error err;
-  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   accel *kd = NULL, *em = NULL;
   CHECK(accel_create("kdtree", s->pos, s->idx, s->ntris, 1, NULL, &kd, &err) == VALO_OK, "%s", err.message);

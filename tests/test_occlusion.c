@@ -10,6 +10,7 @@
  *    shape spacing; images bit-identical for 1 and 3 threads; per-shape strength;
  *  - on CornellBox-Original, proximity-ao correlates with converged ao. */
 #include "harness.h"
+#include "load/load.h"
 #include "integrator/proximity.h"
 #include "geometry/pointtree.h"
 #include <math.h>
@@ -114,7 +115,7 @@ static int load_internal(const char *path, scene **out) {
   valo_error err;
   scene *s = scene_new(path);
   if (!s) return -1;
-  if (load_json(s, path, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return -1; }
+  if (load_json(s, path, NULL, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return -1; }
   *out = s;
   return 0;
 }

@@ -84,7 +84,7 @@ static double correlation(const double *a, const double *b, int n) {
   return saa > 0 && sbb > 0 ? sab / sqrt(saa * sbb) : 0;
 }
 
-#include "scene/texture.h"
+#include "image/texture.h"
 static int veach_mis_tungsten(void) {
   const char *obj = shared_file("scenes/veach-mis/veach-mis.obj"), *png = shared_file("scenes/veach-mis/mitsuba-source/TungstenRender.png");
   if (!obj || !png) return TEST_SKIP;

@@ -3,6 +3,7 @@
  * boxes (Kd, Ke front-sided emitters, illum 5 mirror, illum 7 glass), automatic framing
  * of a mesh without a camera, and polygon triangulation. */
 #include "harness.h"
+#include "load/load.h"
 #include "scene/scene.h"
 #include "light/light.h"
 #include <math.h>
@@ -14,7 +15,7 @@ static int head_normals_unit(void) {
   if (!p) return TEST_SKIP;
   scene *s = scene_new(p);
   valo_error err;
-  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   uint32_t with = 0;
   for (uint32_t t = 0; t < s->ntris; t++) {
     if (!(s->tri_flags[t] & TRI_HAS_NORMALS)) continue;
@@ -39,7 +40,7 @@ static int transform_order(void) {
   const char *jp = scratch_file("tri.json", json);
   scene *s = scene_new(jp);
   valo_error err;
-  CHECK(load_json(s, jp, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_json(s, jp, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(s->ntris == 1, "%u triangles", s->ntris);
   vec3 a = s->pos[s->idx[0]], b = s->pos[s->idx[1]], c = s->pos[s->idx[2]];
   CHECK(fabsf(a.x - 10) < 1e-5f && fabsf(a.y) < 1e-5f && fabsf(a.z + 2) < 1e-5f, "v1 -> (%g %g %g), expected (10 0 -2)", a.x, a.y, a.z);
@@ -50,7 +51,7 @@ static int transform_order(void) {
   snprintf(json, sizeof json, "{ \"shapes\": [{\"file\": \"tri.obj\", \"transform\": {\"scale\": [-1,1,1]}}] }");
   jp = scratch_file("tri2.json", json);
   s = scene_new(jp);
-  CHECK(load_json(s, jp, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_json(s, jp, NULL, &err) == VALO_OK, "%s", err.message);
   vec3 n = scene_tri_ng(s, 0);
   CHECK(n.x < 0 && n.y > 0 && n.z > 0, "mirrored normal (%g %g %g), expected (-,+,+)", n.x, n.y, n.z);
   scene_free(s);
@@ -62,7 +63,7 @@ static int load_committed(const char *rel, scene **out) {
   if (!p) return TEST_SKIP;
   scene *s = scene_new(p);
   valo_error err;
-  if (load_mesh(s, p, NULL, UINT32_MAX, 1, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return 1; }
+  if (load_mesh(s, p, NULL, UINT32_MAX, 1, NULL, &err) || scene_commit(s, &err)) { fprintf(stderr, "%s\n", err.message); scene_free(s); return 1; }
   *out = s;
   return 0;
 }
@@ -131,7 +132,7 @@ static int gltf_lights(void) {
   const char *p = scratch_file("lights.gltf", LIGHTS_GLTF);
   scene *s = scene_new(p);
   valo_error err;
-  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 1, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 1, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(s->nlights == 3, "%u lights", s->nlights);
   const light *pt = &s->lights[0], *sp = &s->lights[1], *di = &s->lights[2];
   CHECK(pt->type == LIGHT_POINT && fabsf(pt->p.y - 2) < 1e-5f && fabsf(pt->L.r - 5) < 1e-5f && fabsf(pt->L.b - 1.25f) < 1e-5f,
@@ -159,7 +160,7 @@ static int mtl_pbr_extension(void) {
   if (!p) return TEST_SKIP;
   scene *s = scene_new(p);
   valo_error err;
-  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   static const struct { const char *name; float alpha; } plates[] = {
       {"SmoothBSDF", 0.01f}, {"GlossyBSDF", 0.05f}, {"RoughBSDF", 0.1f}, {"SuperRoughBSDF", 0.25f}};
   for (int i = 0; i < 4; i++) {
@@ -191,7 +192,7 @@ static int mtl_pbr_extension(void) {
   const char *obj = scratch_file("pbr.obj", "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\n"
                                             "f 1/1 2/2 3/3\nusemtl after\nf 1/1 3/3 2/2\n");
   s = scene_new(obj);
-  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   int m = mat_by_name(s, "m"), a = mat_by_name(s, "after");
   CHECK(m >= 0 && a >= 0, "materials missing (m %d, after %d)", m, a);
   CHECK(s->mats[m].type == MAT_PBR && fabsf(s->mats[m].roughness - 0.6f) < 1e-6f && s->mats[m].metallic == 0.5f,
@@ -210,7 +211,7 @@ static int obj_number_forms(void) {
   const char *obj = scratch_file("num.obj", "v 0 0 0\nv .8e-1 0 0\nv 0 1.0e-01 0\nv -.5 .25 +.5\nf 1 2 3\nf 1 2\nf 1 3 4\n");
   scene *s = scene_new(obj);
   valo_error err;
-  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(s->ntris == 2, "%u triangles, expected 2 (the two-vertex face dropped)", s->ntris);
   int seen = 0;
   for (uint32_t i = 0; i < s->nverts; i++) {
@@ -237,7 +238,7 @@ static int fallback_warnings(void) {
   const char *obj = scratch_file("nouv.obj", "mtllib nouv.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl painted\nf 1 2 3\nusemtl lost\nf 1 2 4\n");
   scene *s = scene_new(obj);
   warnings_capture(1);
-  valo_status st = load_mesh(s, obj, NULL, UINT32_MAX, 1, &err);
+  valo_status st = load_mesh(s, obj, NULL, UINT32_MAX, 1, NULL, &err);
   char said[4096];
   snprintf(said, sizeof said, "%s", warnings_text());
   warnings_capture(0);
@@ -273,7 +274,7 @@ static int fallback_warnings(void) {
   const char *cpath = scratch_file("badcam.gltf", gl);
   s = scene_new(cpath);
   warnings_capture(1);
-  st = load_mesh(s, cpath, NULL, UINT32_MAX, 1, &err);
+  st = load_mesh(s, cpath, NULL, UINT32_MAX, 1, NULL, &err);
   snprintf(said, sizeof said, "%s", warnings_text());
   warnings_capture(0);
   int has_cam = s->has_camera;

@@ -3,8 +3,9 @@
  * decoding against the raw 8-bit values, wrap modes, and alpha cutout honoured by camera
  * and shadow rays alike on the kd-tree and on Embree. */
 #include "harness.h"
+#include "load/load.h"
 #include "scene/scene.h"
-#include "scene/texture.h"
+#include "image/texture.h"
 #include "image/image_io.h"
 #include <stb_image.h>
 #include <stb_image_write.h>
@@ -19,7 +20,7 @@ static int helmet_texels(const char *rel) {
   if (!p || !jpg) return TEST_SKIP;
   scene *s = scene_new(p);
   valo_error err;
-  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, &err) == VALO_OK, "%s", err.message);
+  CHECK(load_mesh(s, p, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   int kd = s->mats[s->tri_mat[0]].tex_kd;
   CHECK(kd >= 0, "no base colour texture");

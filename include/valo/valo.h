@@ -115,6 +115,10 @@ typedef struct valo_load_options {
   double env_rotation;    /* its rotation about the up axis in degrees (default 0) */
   char up[4];             /* mesh files framed automatically: the model's up axis, "y"
                              (default) or "z" (scanned and CAD models) */
+  void (*on_warning)(void *user, const char *message); /* where this scene's warnings go,
+                             while loading and in every render of it (a valo_log_fn);
+                             NULL (default): the process-wide handler */
+  void *on_warning_user;
 } valo_load_options;
 VALO_API void valo_load_options_init(valo_load_options *o);
 /* valo_scene_load with options (NULL = defaults). A mesh file given directly (not through
@@ -221,9 +225,16 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out);
 VALO_API void valo_render_destroy(valo_render *r);
 
-/* Where warnings go (default: standard error, prefixed "valo: warning: "). */
+/* Where warnings and notes go. Each handle routes its own: a scene's come from
+ * valo_load_options.on_warning (inherited by its renders), a render's can be set with
+ * valo_render_set_warning_handler; calls on that handle send them there, from the
+ * calling thread. Without one they go to the process-wide handler set by
+ * valo_set_warning_handler (not thread-safe: set it before rendering), and without that
+ * to standard error, prefixed "valo: warning: " (notes: "valo: note: "); a handler gets
+ * notes prefixed "note: ". */
 typedef void (*valo_log_fn)(void *user, const char *message);
 VALO_API void valo_set_warning_handler(valo_log_fn fn, void *user);
+VALO_API void valo_render_set_warning_handler(valo_render *r, valo_log_fn fn, void *user);
 
 VALO_API const char *valo_version(void);
 VALO_API const char *valo_status_string(valo_status s);

@@ -5,6 +5,18 @@
 
 static valo_log_fn g_warn_fn;
 static void *g_warn_user;
+static _Thread_local valo_log_fn t_warn_fn; /* the calling handle's (log_scope) */
+static _Thread_local void *t_warn_user;
+
+void log_scope_enter(log_scope *saved, valo_log_fn fn, void *user) {
+  saved->fn = t_warn_fn;
+  saved->user = t_warn_user;
+  if (fn) { t_warn_fn = fn; t_warn_user = user; }
+}
+void log_scope_leave(const log_scope *saved) {
+  t_warn_fn = saved->fn;
+  t_warn_user = saved->user;
+}
 
 valo_status err_set(valo_error *err, valo_status s, const char *fmt, ...) {
   if (err) {
@@ -22,10 +34,12 @@ valo_status err_set(valo_error *err, valo_status s, const char *fmt, ...) {
 static void log_emit(const char *kind, const char *handler_prefix, const char *fmt, va_list ap) {
   char buf[1024];
   vsnprintf(buf, sizeof buf, fmt, ap);
-  if (!g_warn_fn) { fprintf(stderr, "valo: %s: %s\n", kind, buf); return; }
+  valo_log_fn fn = t_warn_fn ? t_warn_fn : g_warn_fn;
+  void *user = t_warn_fn ? t_warn_user : g_warn_user;
+  if (!fn) { fprintf(stderr, "valo: %s: %s\n", kind, buf); return; }
   char msg[1100];
   snprintf(msg, sizeof msg, "%s%s", handler_prefix, buf);
-  g_warn_fn(g_warn_user, msg);
+  fn(user, msg);
 }
 
 void log_warning(const char *fmt, ...) {

@@ -29,6 +29,8 @@ rgb tonemap_apply(tonemap_kind k, rgb c) {
   return c;
 }
 
+float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
+
 float srgb_encode(float v) {
   if (!(v > 0)) return 0;
   if (v >= 1) return 1;

@@ -12,6 +12,8 @@ typedef enum tonemap_kind { TONEMAP_CLAMP, TONEMAP_LOG, TONEMAP_REINHARD, TONEMA
 int tonemap_parse(const char *name, tonemap_kind *k);
 rgb tonemap_apply(tonemap_kind k, rgb c);
 float srgb_encode(float linear);
+/* The sRGB decoding curve (8-bit colour maps, and data AOVs stored linearly in PNG). */
+float srgb_to_linear(float encoded);
 /* Bloom (digest 000 §6.10): adds strength x (Gaussian blur, std. dev. sigma pixels, of
  * max(c - threshold, 0)) to the image in place. Returns 0, or -1 on OOM. */
 int bloom_apply(int w, int h, float *rgb, float threshold, float strength, float sigma);

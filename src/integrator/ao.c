@@ -26,5 +26,9 @@ static rgb ao_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
 }
 
 const integrator_ops integrator_ao = {
-    "ao", "ray-traced ambient occlusion: one cosine-weighted ray per sample up to a distance; the unoccluded fraction", ao_params,
-    ao_li, NULL, NULL, NULL, NULL};
+    .name = "ao",
+    .description = "ray-traced ambient occlusion: one cosine-weighted ray per sample up to a distance; the unoccluded fraction",
+    .kind = INTEGRATOR_RAY,
+    .params = ao_params,
+    .li = ao_li,
+};

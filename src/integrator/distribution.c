@@ -38,4 +38,8 @@ static rgb dist_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, 
 static rgb dist_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return dist_rec(c, r, smp, ts, 0, 1); }
 
 const integrator_ops integrator_distribution = {
-    "distribution", "distribution ray tracing: light sampling plus branching BSDF rays to a fixed depth", NULL, dist_li, NULL, NULL, NULL, NULL};
+    .name = "distribution",
+    .description = "distribution ray tracing: light sampling plus branching BSDF rays to a fixed depth",
+    .kind = INTEGRATOR_RAY,
+    .li = dist_li,
+};

@@ -2,96 +2,12 @@
  * integrator.h (surface interactions, shadow segments, next-event estimation + MIS). */
 #include "integrator/integrator.h"
 #include "core/sampling.h"
-#include "scene/texture.h"
+#include "image/texture.h"
 #include "core/error.h"
 #include <string.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <math.h>
-
-extern const integrator_ops integrator_path, integrator_whitted, integrator_distribution, integrator_ao,
-    integrator_proximity_ao, integrator_photon, integrator_vpl, integrator_vsl, integrator_restir_di, integrator_restir_gi;
-static const integrator_ops *const registry[] = {&integrator_path, &integrator_whitted, &integrator_distribution, &integrator_photon,
-                                                 &integrator_vpl, &integrator_vsl, &integrator_ao, &integrator_proximity_ao,
-                                                 &integrator_restir_di, &integrator_restir_gi, NULL};
-static const char *const names[] = {"path", "whitted", "distribution", "photon", "vpl", "vsl", "ao", "proximity-ao", "restir-di", "restir-gi", NULL};
-
-const integrator_ops *integrator_find(const char *name) {
-  for (int i = 0; registry[i]; i++)
-    if (!strcmp(registry[i]->name, name)) return registry[i];
-  return NULL;
-}
-
-int integrator_param_index(const integrator_ops *ops, const char *name) {
-  for (int i = 0; ops->params && ops->params[i].name; i++)
-    if (!strcmp(ops->params[i].name, name)) return i;
-  return -1;
-}
-
-static int is_sep(char ch) { return ch == ' ' || ch == ',' || ch == '\n' || ch == '\t' || ch == ';'; }
-
-valo_status integrator_params_parse(const integrator_ops *ops, const char *text, double *values, int prefixed_only, valo_error *err) {
-  int n = 0;
-  for (; ops->params && ops->params[n].name; n++) values[n] = ops->params[n].def;
-  const char *p = text ? text : "";
-  size_t own = strlen(ops->name);
-  while (*p) {
-    while (*p && is_sep(*p)) p++;
-    if (!*p) break;
-    const char *e = p;
-    while (*e && !is_sep(*e)) e++;
-    char item[256];
-    snprintf(item, sizeof item, "%.*s", (int)(e - p) < 255 ? (int)(e - p) : 255, p);
-    p = e;
-    char *eq = strchr(item, '=');
-    if (!eq || eq == item) return err_set(err, VALO_ERR_INVALID, "parameter \"%s\": expected name=value", item);
-    *eq = 0;
-    const char *name = item, *val = eq + 1;
-    char *dot = strchr(item, '.');
-    if (dot) {
-      /* "photon.count": for the photon integrator only */
-      if ((size_t)(dot - item) != own || strncmp(item, ops->name, own)) {
-        *dot = 0;
-        if (!integrator_find(item)) return err_set(err, VALO_ERR_INVALID, "parameter \"%s.%s\": there is no integrator \"%s\"", item, dot + 1, item);
-        continue;
-      }
-      name = dot + 1;
-    } else if (prefixed_only) {
-      continue;
-    }
-    int k = integrator_param_index(ops, name);
-    if (k < 0) {
-      char known[512] = "";
-      for (int i = 0; i < n; i++) {
-        strncat(known, i ? ", " : "", sizeof known - strlen(known) - 1);
-        strncat(known, ops->params[i].name, sizeof known - strlen(known) - 1);
-      }
-      return err_set(err, VALO_ERR_INVALID, "unknown parameter \"%s\" for the %s integrator (%s%s)", name, ops->name,
-                     n ? "it has: " : "it has none", known);
-    }
-    const integrator_param *d = &ops->params[k];
-    char *end;
-    double v = strtod(val, &end);
-    if (end == val || *end || !(v >= d->lo && v <= d->hi) || (d->type == IPARAM_INT && v != floor(v)))
-      return err_set(err, VALO_ERR_INVALID, "parameter %s.%s=%s: expected %s in [%g, %g]", ops->name, name, val,
-                     d->type == IPARAM_INT ? "a whole number" : "a number", d->lo, d->hi);
-    values[k] = v;
-  }
-  return VALO_OK;
-}
-
-VALO_API int valo_integrator_describe(const char *name, char *buf, size_t n) {
-  const integrator_ops *ops = integrator_find(name);
-  if (!ops || !buf || n == 0) return -1;
-  size_t used = (size_t)snprintf(buf, n, "%s: %s\n", ops->name, ops->description);
-  for (int i = 0; ops->params && ops->params[i].name && used < n; i++) {
-    const integrator_param *d = &ops->params[i];
-    used += (size_t)snprintf(buf + used, n - used, "    %s.%s = %g  (%s, %g..%g) %s\n", ops->name, d->name, d->def,
-                             d->type == IPARAM_INT ? "integer" : "number", d->lo, d->hi, d->doc);
-  }
-  return 0;
-}
-VALO_API const char *const *valo_integrator_names(void) { return names; }
 
 /* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
  * shading normal n by d(u,v) = scale * height(u,v) has tangents dp/du + d_u n and
@@ -395,10 +311,3 @@ int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler 
 
 float ao_ray_length(const scene *s, double d) { return d > 0 ? (float)d : 0.1f * s->radius; }
 
-VALO_API valo_status valo_integrator_check_params(const char *name, const char *params, valo_error *err) {
-  if (err) { err->status = VALO_OK; err->message[0] = 0; }
-  const integrator_ops *ops = integrator_find(name);
-  if (!ops) return err_set(err, VALO_ERR_INVALID, "unknown integrator \"%s\"", name);
-  double v[INTEGRATOR_MAX_PARAMS];
-  return integrator_params_parse(ops, params, v, 0, err);
-}

@@ -11,27 +11,8 @@
 #include "material/bsdf.h"
 #include "core/rng.h"
 #include "geometry/offset.h"
-
-/* Per-thread counters, 64 bytes each: rays traced, losses by cause (valo_loss) and
- * surface samples drawn (the base of the per-vertex loss fractions). */
-typedef struct thread_stats {
-  uint64_t rays;
-  uint64_t lost[VALO_LOSS_COUNT];
-  uint64_t surface_samples;
-  char pad[64 - (2 + VALO_LOSS_COUNT) * sizeof(uint64_t)]; /* arrays of these: no false sharing */
-} thread_stats;
-static inline void thread_stats_add(thread_stats *into, const thread_stats *from) {
-  into->rays += from->rays;
-  into->surface_samples += from->surface_samples;
-  for (int k = 0; k < VALO_LOSS_COUNT; k++) into->lost[k] += from->lost[k];
-}
-/* Counts L's loss cause and returns 0 when L is NaN, infinite or negative; 1 if usable. */
-static inline int sample_usable(thread_stats *ts, rgb L) {
-  if (c3_finite(L) && L.r >= 0 && L.g >= 0 && L.b >= 0) return 1;
-  int nan = isnan(L.r) || isnan(L.g) || isnan(L.b);
-  ts->lost[nan ? VALO_LOSS_NAN : !c3_finite(L) ? VALO_LOSS_INF : VALO_LOSS_NEGATIVE]++;
-  return 0;
-}
+#include "core/stats.h"
+#include "scene/camera.h"
 
 /* Parameters an integrator declares (docs/integrators.md lists the same tables): read
  * from the scene file ("render": {"photon": {"count": 200000}}) and from the command
@@ -68,32 +49,6 @@ typedef struct render_ctx {
  * pass's photons or VPLs into fresh buffers, deterministic for any thread count) and
  * destroy; li() then reads c->state. The render loop runs one sample per pixel per pass
  * for integrators with prepare, so each pass's camera samples see one independent set. */
-/* A pinhole camera on a film (render.c fills it per frame): unit basis, tangent of half
- * the vertical field of view and the film's aspect. Film coordinates are pixels from the
- * top-left corner (x right, y down). */
-typedef struct cam_view {
-  vec3 o, fwd, right, up;
-  float tan_half, aspect;
-  int width, height;
-} cam_view;
-/* Unit direction of the ray through film point (fx, fy). */
-static inline vec3 cam_view_dir(const cam_view *v, float fx, float fy) {
-  float sx = (2.0f * fx / (float)v->width - 1.0f) * v->tan_half * v->aspect;
-  float sy = (1.0f - 2.0f * fy / (float)v->height) * v->tan_half;
-  return v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
-}
-/* Film point where p is seen (the inverse of cam_view_dir); 0 when p is behind the camera
- * or off the film. */
-static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
-  vec3 d = v3_sub(p, v->o);
-  float z = v3_dot(d, v->fwd);
-  if (!(z > 0)) return 0;
-  float sx = v3_dot(d, v->right) / (z * v->tan_half * v->aspect), sy = v3_dot(d, v->up) / (z * v->tan_half);
-  *fx = (sx + 1.0f) * 0.5f * (float)v->width;
-  *fy = (1.0f - sy) * 0.5f * (float)v->height;
-  return *fx >= 0 && *fy >= 0 && *fx < (float)v->width && *fy < (float)v->height;
-}
-
 /* One frame of an image-wide integrator (render_frame). The render loop calls it once per
  * frame of a sequence (--frames), or once per pass of a still image on the static
  * camera, whose frames are averaged. */
@@ -105,11 +60,16 @@ typedef struct frame_ctx {
   const _Atomic int *cancel; /* non-zero: stop between stages and return VALO_ERR_CANCELLED */
   int sequence;         /* 1: frames of a sequence (--frames), shown one by one; 0: the frames of a
                            still, averaged */
+  const cam_lens *lens; /* this frame's camera with its lens (camera_ray): cam is lens->view */
 } frame_ctx;
+
+/* Per-ray integrators give li() and get the tile loop; image-wide ones give render_frame. */
+typedef enum integrator_kind { INTEGRATOR_RAY, INTEGRATOR_IMAGE } integrator_kind;
 
 typedef struct integrator_ops {
   const char *name;
   const char *description;
+  integrator_kind kind;
   const integrator_param *params; /* table ended by a NULL name, or NULL */
   /* Radiance arriving along camera ray r. */
   rgb (*li)(const render_ctx *c, ray r, sampler *smp, thread_stats *ts);
@@ -123,7 +83,10 @@ typedef struct integrator_ops {
   valo_status (*render_frame)(void *state, const render_ctx *c, const frame_ctx *f, valo_error *err);
 } integrator_ops;
 
+/* The registry (registry.c): every integrator, in the order --help lists them. */
 const integrator_ops *integrator_find(const char *name);
+/* The i-th registered integrator, or NULL past the last. */
+const integrator_ops *integrator_at(int i);
 /* Fills values[] (one per entry of ops->params) from the defaults, then from `text`:
  * entries "name=value" or "integrator.name=value" separated by spaces, commas or
  * newlines (later ones win; entries for another integrator are skipped, and with

@@ -42,4 +42,8 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
 static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return path_radiance(c, r, smp, ts, 1); }
 
 const integrator_ops integrator_path = {
-    "path", "unidirectional path tracing with next-event estimation, MIS and Russian roulette", NULL, path_li, NULL, NULL, NULL, NULL};
+    .name = "path",
+    .description = "unidirectional path tracing with next-event estimation, MIS and Russian roulette",
+    .kind = INTEGRATOR_RAY,
+    .li = path_li,
+};

@@ -76,4 +76,8 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
 }
 
 const integrator_ops integrator_path_spectral = {
-    "path", "spectral path tracing: hero wavelength + 3, dispersion, CIE XYZ to linear sRGB", NULL, path_spectral_li, NULL, NULL, NULL, NULL};
+    .name = "path-spectral",
+    .description = "spectral path tracing (what --spectral selects for path): hero wavelength + 3, dispersion, CIE XYZ to linear sRGB",
+    .kind = INTEGRATOR_RAY,
+    .li = path_spectral_li,
+};

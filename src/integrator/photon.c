@@ -313,6 +313,12 @@ static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, con
 static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return li_shade_through_delta(c, r, smp, ts, photon_shade); }
 
 const integrator_ops integrator_photon = {
-    "photon",
-    "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass",
-    photon_params, photon_li, photon_create, photon_prepare, photon_destroy, NULL};
+    .name = "photon",
+    .description = "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass",
+    .kind = INTEGRATOR_RAY,
+    .params = photon_params,
+    .li = photon_li,
+    .create = photon_create,
+    .prepare = photon_prepare,
+    .destroy = photon_destroy,
+};

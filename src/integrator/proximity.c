@@ -29,7 +29,7 @@
 
 enum { P_SPACING, P_RADIUS, P_STRENGTH };
 static const integrator_param prox_params[] = {
-    {"spacing", IPARAM_FLOAT, 0, 0, 1e30, "distance between splatted points d in scene units; 0 = automatic, radius / 8"},
+    {"spacing", IPARAM_FLOAT, 0, 0, 1e30, "distance between splatted points d in scene units; 0 = automatic, radius / 6"},
     {"radius", IPARAM_FLOAT, 0, 0, 1e30,
      "search radius r in scene units (like ao's ray length); 0 = automatic, 1/10 of the radius of the scene's bounding sphere"},
     {"strength", IPARAM_FLOAT, 1, 0, 1e6, "strength M multiplying the darkness (1: calibrated to match ao's mean)"},
@@ -379,6 +379,11 @@ static rgb prox_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
 }
 
 const integrator_ops integrator_proximity_ao = {
-    "proximity-ao",
-    "ambient proximity occlusion (digest 003): splatted points and a fixed-radius kd-tree search; noise-free",
-    prox_params, prox_li, prox_create, NULL, prox_destroy, NULL};
+    .name = "proximity-ao",
+    .description = "ambient proximity occlusion (digest 003): splatted points and a fixed-radius kd-tree search; noise-free",
+    .kind = INTEGRATOR_RAY,
+    .params = prox_params,
+    .li = prox_li,
+    .create = prox_create,
+    .destroy = prox_destroy,
+};

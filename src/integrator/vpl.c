@@ -297,8 +297,22 @@ static rgb vpl_shade(const render_ctx *c, const isect *it, const bsdf *b, const 
 static rgb vpl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return li_shade_through_delta(c, r, smp, ts, vpl_shade); }
 
 const integrator_ops integrator_vpl = {
-    "vpl", "instant radiosity (Keller 1997): virtual point lights from light paths, clamping, bias compensation (Kollig & Keller 2004)",
-    vpl_params, vpl_li, vpl_create, vpl_prepare, vpl_destroy, NULL};
+    .name = "vpl",
+    .description = "instant radiosity (Keller 1997): virtual point lights from light paths, clamping, bias compensation (Kollig & Keller 2004)",
+    .kind = INTEGRATOR_RAY,
+    .params = vpl_params,
+    .li = vpl_li,
+    .create = vpl_create,
+    .prepare = vpl_prepare,
+    .destroy = vpl_destroy,
+};
 const integrator_ops integrator_vsl = {
-    "vsl", "virtual spherical lights (Hasan et al. 2009): each VPL's flux spread over a sphere, integrated over the cone it subtends",
-    vsl_params, vpl_li, vsl_create, vpl_prepare, vpl_destroy, NULL};
+    .name = "vsl",
+    .description = "virtual spherical lights (Hasan et al. 2009): each VPL's flux spread over a sphere, integrated over the cone it subtends",
+    .kind = INTEGRATOR_RAY,
+    .params = vsl_params,
+    .li = vpl_li,
+    .create = vsl_create,
+    .prepare = vpl_prepare,
+    .destroy = vpl_destroy,
+};

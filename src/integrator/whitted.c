@@ -54,4 +54,8 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
 static rgb whitted_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return whitted_rec(c, r, smp, ts, 0); }
 
 const integrator_ops integrator_whitted = {
-    "whitted", "Whitted ray tracing: direct light and ideal reflection/refraction to a fixed depth", NULL, whitted_li, NULL, NULL, NULL, NULL};
+    .name = "whitted",
+    .description = "Whitted ray tracing: direct light and ideal reflection/refraction to a fixed depth",
+    .kind = INTEGRATOR_RAY,
+    .li = whitted_li,
+};

@@ -2,8 +2,8 @@
  * power-proportional light selector (see light.h). */
 #include "light/light.h"
 #include "core/sampling.h"
-#include "light/envmap.h"
-#include "scene/texture.h"
+#include "scene/envmap.h"
+#include "image/texture.h"
 #include <stdlib.h>
 #include <string.h>
 

@@ -2,8 +2,8 @@
  * automatic camera framing), tessellated spheres and conductor presets. */
 #include "scene/scene.h"
 #include "core/error.h"
-#include "light/envmap.h"
-#include "scene/texture.h"
+#include "scene/envmap.h"
+#include "image/texture.h"
 #include <stdlib.h>
 #include <string.h>
 #include <stdio.h>
@@ -12,7 +12,6 @@ scene *scene_new(const char *path) {
   scene *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   snprintf(s->path, sizeof s->path, "%s", path ? path : "");
-  valo_options_init(&s->file_opts);
   return s;
 }
 
@@ -20,7 +19,7 @@ void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
-  if (s->env_map) { envmap_free(s->env_map); free(s->env_map); }
+  envmap_destroy(s->env_map);
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
   free(s->tex);
   free(s);

@@ -1,8 +1,9 @@
 /* scene.h — owns the scene model: flattened world-space triangle geometry (flat arrays),
- * materials, lights, camera and the file's render settings. Loaders (load_json.c,
- * load_assimp.c) append through the scene_add_* builders; scene_commit() then validates
- * and derives what rendering needs (bounds, area lights). After commit the scene is
- * immutable and shared by all threads without locks. */
+ * materials, textures, lights and the environment as data, the camera and its keyframes.
+ * Loaders (src/load/) append through the scene_add_* builders; scene_commit() then
+ * validates and derives what rendering needs (bounds, area lights, tangents). After
+ * commit the scene is immutable and shared by all threads without locks. The model knows
+ * no file format and no render setting. */
 #ifndef VALO_SCENE_H
 #define VALO_SCENE_H
 #include "core/vec.h"
@@ -115,7 +116,6 @@ typedef struct scene {
   uint32_t ncam_keys;
   int up_z;                /* automatic framing: the model's up axis is +z (else +y) */
   int cam_auto;            /* the camera was framed automatically (scene_camera_fit) */
-  valo_options file_opts;
   shape_ao *shape_ao;      /* per-shape proximity-AO settings (JSON "proximity"), sorted by first */
   uint32_t nshape_ao;
   bbox bounds;
@@ -156,12 +156,6 @@ camera scene_camera_fit(const scene *s, float aspect);
  * else `still` (the lens of `still` is kept either way). */
 camera scene_camera_at(const scene *s, const camera *still, float f);
 
-/* Loaders (one per file kind). */
-valo_status load_json(scene *s, const char *path, valo_error *err);
-/* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
- * override_mat: material index for every triangle, or UINT32_MAX to keep the file's. */
-valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat,
-                      int take_camera, valo_error *err);
 /* Adds a tessellated sphere (icosphere with `subdiv` subdivisions); flip: normals
  * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,

@@ -1,6 +1,6 @@
 /* obj_check.c — see obj_check.h. Two passes over the OBJ: the first counts vertices and
  * reads the MTL files, the second checks each line and writes the repaired text. */
-#include "scene/obj_check.h"
+#include "load/obj_check.h"
 #include "core/error.h"
 #include <assimp/cfileio.h>
 #include <ctype.h>

@@ -3,7 +3,7 @@
  * MTL material meanings (../shared/scenes/README.md: Kd, Ke front-sided, illum 5 mirror,
  * illum 7 glass, illum 2 Phong), a file camera, and the input checks (NaN/Inf vertices,
  * out-of-range indices, degenerate or empty meshes). */
-#include "scene/scene.h"
+#include "load/load.h"
 #include "core/error.h"
 #include <strings.h>
 #include <assimp/cimport.h>
@@ -11,9 +11,9 @@
 #include <assimp/postprocess.h>
 #include <assimp/material.h>
 #include <assimp/ObjMaterial.h>
-#include "scene/texture.h"
-#include "scene/obj_check.h"
-#include "scene/ply_check.h"
+#include "image/texture.h"
+#include "load/obj_check.h"
+#include "load/ply_check.h"
 #include <assimp/cfileio.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/texture.h>
@@ -250,6 +250,7 @@ typedef struct load_ctx {
   uint64_t added, degenerate;
   valo_error *err;
   int gltf;          /* a .gltf/.glb file: its cameras and materials need glTF meanings */
+  valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
 } load_ctx;
 
 static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 *xf) {
@@ -387,9 +388,9 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   c->s->cam.aperture_radius = 0;
   c->s->cam.focus_distance = -1; /* glTF/Assimp cameras have none: autofocus (render.c) */
   c->s->has_camera = 1;
-  if (cam->mAspect > 0 && c->s->file_opts.width == VALO_UNSET) {
-    c->s->file_opts.height = 256;
-    c->s->file_opts.width = (int)lroundf(256 * cam->mAspect);
+  if (cam->mAspect > 0 && c->file && c->file->width == VALO_UNSET) {
+    c->file->height = 256;
+    c->file->width = (int)lroundf(256 * cam->mAspect);
   }
 }
 
@@ -429,7 +430,8 @@ static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
   return VALO_OK;
 }
 
-valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_error *err) {
+valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_options *file,
+                      valo_error *err) {
   /* A PLY (by its magic, whatever its name) is checked by valo first: Assimp aborts the
    * process on faces that disagree with the header (ply_check.h), and reads a PLY of
    * triangle strips as one bogus polygon without an error. */
@@ -455,7 +457,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
                    ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"))};
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb")), file};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)

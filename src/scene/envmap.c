@@ -1,7 +1,7 @@
 /* envmap.c — see envmap.h. */
-#include "light/envmap.h"
+#include "scene/envmap.h"
 #include "image/image_io.h"
-#include "scene/texture.h"
+#include "image/texture.h"
 #include "core/error.h"
 #include <stdlib.h>
 #include <string.h>
@@ -173,4 +173,27 @@ float envmap_pdf(const envmap *e, vec3 dir) {
   float st = sinf(v * PI_F);
   if (!(st > 0)) return 0;
   return distrib2d_pdf(&e->dist, u, v) / (2 * PI_F * PI_F * st);
+}
+
+static valo_status envmap_adopt(envmap *e, valo_status st, envmap **out) {
+  if (st) { free(e); return st; }
+  *out = e;
+  return VALO_OK;
+}
+valo_status envmap_create(const char *path, float scale, float rotation_deg, envmap **out, valo_error *err) {
+  *out = NULL;
+  envmap *e = calloc(1, sizeof *e);
+  if (!e) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  return envmap_adopt(e, envmap_load(e, path, scale, rotation_deg, err), out);
+}
+valo_status envmap_create_cube(const char *const faces[6], float scale, float rotation_deg, envmap **out, valo_error *err) {
+  *out = NULL;
+  envmap *e = calloc(1, sizeof *e);
+  if (!e) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  return envmap_adopt(e, envmap_load_cube(e, faces, scale, rotation_deg, err), out);
+}
+void envmap_destroy(envmap *e) {
+  if (!e) return;
+  envmap_free(e);
+  free(e);
 }

@@ -1,6 +1,7 @@
 /* texture.c — see texture.h. */
-#include "scene/texture.h"
+#include "image/texture.h"
 #include "image/image_io.h"
+#include "image/tonemap.h"
 #include "core/error.h"
 #include <stb_image.h>
 #include <stdlib.h>
@@ -21,7 +22,6 @@ static valo_status check_size(int ok, int w, int h, const char *name, valo_error
   return VALO_OK;
 }
 
-static float srgb_to_linear(float c) { return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
 
 static valo_status from_8bit(texture *t, unsigned char *data, int w, int h, int n, int srgb, const char *name, valo_error *err) {
   t->px = malloc((size_t)w * h * 4 * sizeof(float));

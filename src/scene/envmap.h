@@ -34,6 +34,11 @@ valo_status envmap_load(envmap *e, const char *path, float scale, float rotation
  * square and of one size. */
 valo_status envmap_load_cube(envmap *e, const char *const faces[6], float scale, float rotation_deg, valo_error *err);
 void envmap_free(envmap *e);
+/* The same as heap objects the scene owns: *out is a new map (NULL on error);
+ * envmap_destroy frees one (NULL is fine). */
+valo_status envmap_create(const char *path, float scale, float rotation_deg, envmap **out, valo_error *err);
+valo_status envmap_create_cube(const char *const faces[6], float scale, float rotation_deg, envmap **out, valo_error *err);
+void envmap_destroy(envmap *e);
 rgb envmap_eval(const envmap *e, vec3 dir);
 /* Samples a unit direction; returns 0 if the density there is zero. */
 int envmap_sample(const envmap *e, float u1, float u2, vec3 *dir, float *pdf);

@@ -1,7 +1,7 @@
 /* ply_check.c — see ply_check.h. One pass over the header, one over the body; nothing is
  * kept but the element layout. The body walk is bounded by the file's size, so a header
  * that claims billions of elements is refused before anything is read. */
-#include "scene/ply_check.h"
+#include "load/ply_check.h"
 #include "core/error.h"
 #include <ctype.h>
 #include <errno.h>

@@ -1,0 +1,123 @@
+/* api_render.c — owns the public render handle: valo_render is a render session
+ * (src/render/session.h) with the frame callback and warning handler the caller gave.
+ * Each function checks its handle, routes warnings to the handle's handler, resolves
+ * options (options.c) and calls inward. */
+#include "valo/valo.h"
+#include "api/api.h"
+#include "api/options.h"
+#include "render/session.h"
+#include "render/output.h"
+#include "core/error.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct valo_render {
+  session *ss;
+  valo_frame_fn on_frame;
+  void *on_frame_user;
+  valo_log_fn warn_fn;
+  void *warn_user;
+};
+
+static void clear_err(valo_error *err) {
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+}
+
+VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options *opts, valo_render **out, valo_error *err) {
+  *out = NULL;
+  clear_err(err);
+  if (!vs) return err_set(err, VALO_ERR_INVALID, "no scene");
+  log_scope scope;
+  log_scope_enter(&scope, vs->warn_fn, vs->warn_user);
+  resolved_options ro;
+  valo_render *r = NULL;
+  valo_status st = options_resolve(&vs->file_opts, opts, &ro, err);
+  if (!st && !(r = calloc(1, sizeof *r))) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
+  if (!st) {
+    r->warn_fn = vs->warn_fn;
+    r->warn_user = vs->warn_user;
+    st = session_create(vs->s, &ro.o, ro.integ, ro.param, ao_ray_length(vs->s, ro.ao_distance), &r->ss, err);
+  }
+  if (st) { free(r); r = NULL; }
+  log_scope_leave(&scope);
+  *out = r;
+  return st;
+}
+
+VALO_API void valo_render_set_warning_handler(valo_render *r, valo_log_fn fn, void *user) {
+  if (!r) return;
+  r->warn_fn = fn;
+  r->warn_user = user;
+}
+
+static valo_status frame_callback(void *user, int f, valo_error *err) {
+  valo_render *r = user;
+  return r->on_frame(r->on_frame_user, r, f, err);
+}
+
+VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user) {
+  if (!r) return;
+  r->on_frame = fn;
+  r->on_frame_user = user;
+  r->ss->on_frame = fn ? frame_callback : NULL;
+  r->ss->on_frame_user = r;
+}
+
+VALO_API const char *valo_loss_name(int cause) { return stats_loss_name(cause); }
+
+VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
+  clear_err(err);
+  if (!r) return err_set(err, VALO_ERR_INVALID, "no render");
+  log_scope scope;
+  log_scope_enter(&scope, r->warn_fn, r->warn_user);
+  valo_status st = session_run(r->ss, progress, user, err);
+  log_scope_leave(&scope);
+  return st;
+}
+
+VALO_API void valo_render_cancel(valo_render *r) {
+  if (r) atomic_store(&r->ss->cancel, 1);
+}
+
+VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
+  memset(o, 0, sizeof *o);
+  const session *ss = r->ss;
+  o->triangles = ss->s->ntris;
+  o->build_seconds = ss->build_seconds;
+  o->render_seconds = ss->render_seconds;
+  o->rays = ss->total.rays;
+  memcpy(o->lost, ss->total.lost, sizeof o->lost);
+  o->surface_samples = ss->total.surface_samples;
+  o->spp_done = ss->spp_done;
+  o->frames_done = ss->frames_done;
+  size_t np = film_pixels(&ss->film);
+  for (size_t i = 0; i < np; i++) o->samples += ss->film.count[i];
+  o->width = ss->opt.width;
+  o->height = ss->opt.height;
+  o->threads = ss->opt.threads;
+  snprintf(o->integrator, sizeof o->integrator, "%s", ss->opt.integrator);
+  snprintf(o->accel, sizeof o->accel, "%s", ss->opt.accel);
+  snprintf(o->sampler, sizeof o->sampler, "%s", ss->opt.sampler);
+  snprintf(o->light_sampler, sizeof o->light_sampler, "%s", ss->opt.light_sampler);
+}
+
+VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) { film_resolve(&r->ss->film, rgb_out); }
+
+VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {
+  clear_err(err);
+  if (!r || !path) return err_set(err, VALO_ERR_INVALID, "no render or no path");
+  valo_output_options def;
+  valo_output_options_init(&def);
+  log_scope scope;
+  log_scope_enter(&scope, r->warn_fn, r->warn_user);
+  valo_status st = output_write(r->ss, path, o ? o : &def, err);
+  log_scope_leave(&scope);
+  return st;
+}
+
+VALO_API void valo_render_destroy(valo_render *r) {
+  if (!r) return;
+  session_destroy(r->ss);
+  free(r);
+}

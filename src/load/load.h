@@ -1,0 +1,24 @@
+/* load.h — owns the loaders' front door: a scene file (JSON, or any mesh file Assimp
+ * reads) becomes a committed scene model plus the render settings the file asks for.
+ * The only module that knows file formats; the API calls it, nothing below does. */
+#ifndef VALO_LOAD_H
+#define VALO_LOAD_H
+#include "scene/scene.h"
+#include "valo/valo.h"
+
+/* Loads path (".json": the JSON scene format; anything else: a mesh file) with the load
+ * options lo (NULL: defaults): --env replaces the environment, `up` frames mesh files;
+ * a mesh file without any light is lit by a uniform white environment (a note says so),
+ * a JSON scene without one renders black (a warning says so). Then commits the scene.
+ * file receives the settings the file carries (valo_options_init first; unset fields
+ * stay VALO_UNSET). On error *out is NULL and err names the file. */
+valo_status scene_load(const char *path, const valo_load_options *lo, scene **out, valo_options *file, valo_error *err);
+
+/* The two loaders, appending to s; file (may be NULL) receives the settings they find. */
+valo_status load_json(scene *s, const char *path, valo_options *file, valo_error *err);
+/* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
+ * override_mat: material index for every triangle, or UINT32_MAX to keep the file's;
+ * take_camera: use the file's camera (its aspect sets the file's film size). */
+valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int take_camera, valo_options *file,
+                      valo_error *err);
+#endif

@@ -1,0 +1,445 @@
+/* load_json.c — owns the JSON scene format (docs/scene-format.md): camera, film, render
+ * settings, shapes (mesh files and spheres) with transforms, named materials, lights
+ * and the environment. Strict: unknown keys and wrong types are errors that name the
+ * file and the JSON path; syntax errors give line:column. */
+#include "load/load_json_internal.h"
+#include "core/error.h"
+#include "scene/envmap.h"
+#include "core/spectrum.h"
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A view is usable: position and look_at differ, up is not along the view direction. */
+static valo_status check_view(jctx *c, const char *where, vec3 pos, vec3 look_at, vec3 up) {
+  vec3 fwd = v3_sub(look_at, pos);
+  if (!(v3_len2(fwd) > 0)) return json_bad(c, where, "position and look_at must differ");
+  char w[96];
+  snprintf(w, sizeof w, "%s.up", where);
+  if (!(v3_len2(v3_cross(v3_norm(fwd), v3_norm(up))) > 1e-12f)) return json_bad(c, w, "must not be parallel to the view direction");
+  return VALO_OK;
+}
+
+/* camera.keyframes: [{"frame": F, "position", "look_at", "up", "fov"}, ...], frames
+ * increasing; a key's missing fields take the camera's. */
+static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
+  if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) < 1) return json_bad(c, "camera.keyframes", "must be a non-empty array of objects");
+  int n = cJSON_GetArraySize(a);
+  if (n > 100000) return json_bad(c, "camera.keyframes", "more than 100000 keyframes");
+  cam_key *k = calloc((size_t)n, sizeof *k);
+  if (!k) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->cam_keys = k;
+  c->s->ncam_keys = (uint32_t)n;
+  static const char *const keys[] = {"frame", "position", "look_at", "up", "fov", NULL};
+  int i = 0;
+  for (const cJSON *e = a->child; e; e = e->next, i++) {
+    char where[64];
+    snprintf(where, sizeof where, "camera.keyframes[%d]", i);
+    TRY(json_check_keys(c, e, where, keys));
+    if (!cJSON_GetObjectItemCaseSensitive(e, "frame")) return json_bad(c, where, "needs \"frame\"");
+    double d = 0;
+    TRY(json_get_num(c, e, "frame", where, -1e9, 1e9, &d));
+    k[i].frame = (float)d;
+    if (i > 0 && !(k[i].frame > k[i - 1].frame)) return json_bad(c, where, "frames must increase from key to key");
+    k[i].pos = cam->pos; k[i].look_at = cam->look_at; k[i].up = cam->up; k[i].fov_deg = cam->fov_deg;
+    TRY(json_get_vec(c, e, "position", where, 0, &k[i].pos));
+    TRY(json_get_vec(c, e, "look_at", where, 0, &k[i].look_at));
+    TRY(json_get_vec(c, e, "up", where, 0, &k[i].up));
+    d = k[i].fov_deg; TRY(json_get_num(c, e, "fov", where, 1e-3, 179.9, &d)); k[i].fov_deg = (float)d;
+    TRY(check_view(c, where, k[i].pos, k[i].look_at, k[i].up));
+  }
+  return VALO_OK;
+}
+
+static valo_status parse_camera(jctx *c, const cJSON *o) {
+  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", "from_file", "keyframes", NULL};
+  TRY(json_check_keys(c, o, "camera", keys));
+  camera *cam = &c->s->cam;
+  const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
+  if (ff && !cJSON_IsBool(ff)) return json_bad(c, "camera.from_file", "must be true or false");
+  if (cJSON_IsTrue(ff)) {
+    /* The first shape file with a camera supplies position, orientation and fov; the
+     * lens (and optionally fov) come from here. */
+    if (cJSON_GetObjectItemCaseSensitive(o, "position") || cJSON_GetObjectItemCaseSensitive(o, "look_at") ||
+        cJSON_GetObjectItemCaseSensitive(o, "up"))
+      return json_bad(c, "camera", "\"from_file\" takes position, look_at and up from the file; give only fov, aperture_radius, focus_distance");
+    double d = -1;
+    TRY(json_get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); c->cam_fov = (float)d;
+    d = 0; TRY(json_get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); c->cam_aperture = (float)d;
+    d = -1; TRY(json_get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); c->cam_focus = (float)d;
+    c->cam_from_file = 1;
+    return VALO_OK;
+  }
+  cam->pos = v3(0, 0, 5); cam->look_at = v3(0, 0, 0); cam->up = v3(0, 1, 0);
+  cam->fov_deg = 40; cam->aperture_radius = 0; cam->focus_distance = -1;
+  double d;
+  TRY(json_get_vec(c, o, "position", "camera", 0, &cam->pos));
+  TRY(json_get_vec(c, o, "look_at", "camera", 0, &cam->look_at));
+  TRY(json_get_vec(c, o, "up", "camera", 0, &cam->up));
+  d = cam->fov_deg; TRY(json_get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); cam->fov_deg = (float)d;
+  d = 0; TRY(json_get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); cam->aperture_radius = (float)d;
+  d = -1; TRY(json_get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); cam->focus_distance = (float)d;
+  TRY(check_view(c, "camera", cam->pos, cam->look_at, cam->up));
+  vec3 fwd = v3_sub(cam->look_at, cam->pos);
+  if (cam->focus_distance <= 0) cam->focus_distance = v3_len(fwd);
+  c->s->has_camera = 1;
+  const cJSON *kf = cJSON_GetObjectItemCaseSensitive(o, "keyframes");
+  if (kf) TRY(parse_keyframes(c, kf, cam));
+  return VALO_OK;
+}
+
+static valo_status parse_render(jctx *c, const cJSON *o) {
+  valo_options *op = c->file;
+  if (!cJSON_IsObject(o)) return json_bad(c, "render", "must be an object");
+  /* An object under "render" holds an integrator's parameters ("photon": {"count":
+   * 100000}); they become the options' parameter text "photon.count=100000", checked
+   * against that integrator's table (and its name against the registry) when rendering. */
+  for (const cJSON *it = o->child; it; it = it->next) {
+    if (!cJSON_IsObject(it)) continue;
+    char w[96];
+    snprintf(w, sizeof w, "render.%s", it->string);
+    for (const cJSON *p = it->child; p; p = p->next) {
+      char w2[160];
+      snprintf(w2, sizeof w2, "%s.%s", w, p->string);
+      if (!cJSON_IsNumber(p) && !cJSON_IsBool(p)) return json_bad(c, w2, "must be a number");
+      double v = cJSON_IsBool(p) ? (cJSON_IsTrue(p) ? 1 : 0) : p->valuedouble;
+      size_t used = strlen(op->params);
+      int n = snprintf(op->params + used, sizeof op->params - used, "%s%s.%s=%.17g", used ? " " : "", it->string, p->string, v);
+      if (n < 0 || (size_t)n >= sizeof op->params - used) return json_bad(c, w, "too many parameters");
+    }
+  }
+  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", "light_sampler", NULL};
+  for (const cJSON *it = o->child; it; it = it->next) {
+    int ok = cJSON_IsObject(it);
+    for (const char *const *a = keys; *a && !ok; a++) ok = !strcmp(it->string, *a);
+    if (!ok) {
+      char msg[400];
+      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed: integrator spp seed max_depth accel time sampler light_sampler, or an "
+                                "integrator's name with an object of its parameters)", it->string);
+      return json_bad(c, "render", msg);
+    }
+  }
+  const char *s = NULL;
+  TRY(json_get_str(c, o, "integrator", "render", &s));
+  if (s) snprintf(op->integrator, sizeof op->integrator, "%s", s);
+  s = NULL;
+  TRY(json_get_str(c, o, "accel", "render", &s));
+  if (s) snprintf(op->accel, sizeof op->accel, "%s", s);
+  s = NULL;
+  TRY(json_get_str(c, o, "sampler", "render", &s));
+  if (s && strcmp(s, "sobol") && strcmp(s, "independent")) return json_bad(c, "render.sampler", "must be \"sobol\" or \"independent\"");
+  if (s) snprintf(op->sampler, sizeof op->sampler, "%s", s);
+  s = NULL;
+  TRY(json_get_str(c, o, "light_sampler", "render", &s));
+  if (s && strcmp(s, "grid") && strcmp(s, "power")) return json_bad(c, "render.light_sampler", "must be \"grid\" or \"power\"");
+  if (s) snprintf(op->light_sampler, sizeof op->light_sampler, "%s", s);
+  TRY(json_get_int(c, o, "spp", "render", 1, 1048576, &op->spp));
+  double seed = -1;
+  TRY(json_get_num(c, o, "seed", "render", 0, 9007199254740992.0, &seed));
+  if (seed >= 0) op->seed = (int64_t)seed;
+  TRY(json_get_int(c, o, "max_depth", "render", -1, 100000, &op->max_depth));
+  TRY(json_get_num(c, o, "time", "render", 0, 1e9, &op->time_budget));
+  return VALO_OK;
+}
+
+static valo_status parse_transform(jctx *c, const cJSON *o, const char *where, float xf[12]) {
+  static const char *const keys[] = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate", NULL};
+  TRY(json_check_keys(c, o, where, keys));
+  vec3 sc = v3(1, 1, 1), tr = v3(0, 0, 0);
+  TRY(json_get_vec(c, o, "scale", where, 1, &sc));
+  TRY(json_get_vec(c, o, "translate", where, 0, &tr));
+  double ang[3] = {0, 0, 0};
+  TRY(json_get_num(c, o, "rotate_x", where, -1e6, 1e6, &ang[0]));
+  TRY(json_get_num(c, o, "rotate_y", where, -1e6, 1e6, &ang[1]));
+  TRY(json_get_num(c, o, "rotate_z", where, -1e6, 1e6, &ang[2]));
+  if (sc.x == 0 || sc.y == 0 || sc.z == 0) return json_bad(c, where, "scale must not be zero");
+  /* M = T * Rz * Ry * Rx * S (scale first, then x, y, z rotations, then translation). */
+  double m[3][3] = {{sc.x, 0, 0}, {0, sc.y, 0}, {0, 0, sc.z}};
+  for (int axis = 0; axis < 3; axis++) {
+    double a = ang[axis] * M_PI / 180.0, cs = cos(a), sn = sin(a), r[3][3];
+    if (axis == 0) { double t[3][3] = {{1, 0, 0}, {0, cs, -sn}, {0, sn, cs}}; memcpy(r, t, sizeof r); }
+    else if (axis == 1) { double t[3][3] = {{cs, 0, sn}, {0, 1, 0}, {-sn, 0, cs}}; memcpy(r, t, sizeof r); }
+    else { double t[3][3] = {{cs, -sn, 0}, {sn, cs, 0}, {0, 0, 1}}; memcpy(r, t, sizeof r); }
+    double n[3][3];
+    for (int i = 0; i < 3; i++)
+      for (int j = 0; j < 3; j++) n[i][j] = r[i][0] * m[0][j] + r[i][1] * m[1][j] + r[i][2] * m[2][j];
+    memcpy(m, n, sizeof m);
+  }
+  for (int i = 0; i < 3; i++) {
+    for (int j = 0; j < 3; j++) xf[4 * i + j] = (float)m[i][j];
+    xf[4 * i + 3] = v3_get(tr, i);
+  }
+  return VALO_OK;
+}
+
+static uint32_t find_material(const scene *s, const char *name, uint32_t first_named, uint32_t end_named) {
+  for (uint32_t i = first_named; i < end_named; i++)
+    if (!strcmp(s->mats[i].name, name)) return i;
+  return UINT32_MAX;
+}
+
+
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend);
+static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfirst, uint32_t mend) {
+  char where[64];
+  snprintf(where, sizeof where, "shapes[%d]", index);
+  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
+                                     "proximity", NULL};
+  TRY(json_check_keys(c, o, where, keys));
+  uint32_t first = c->s->ntris;
+  valo_status st = parse_shape_geometry(c, o, where, mfirst, mend);
+  if (st) return st;
+  const cJSON *px = cJSON_GetObjectItemCaseSensitive(o, "proximity");
+  if (!px) return VALO_OK;
+  char w2[96];
+  snprintf(w2, sizeof w2, "%s.proximity", where);
+  if (!cJSON_IsObject(px)) return json_bad(c, w2, "must be an object with spacing, radius, strength");
+  static const char *const pkeys[] = {"spacing", "radius", "strength", NULL};
+  TRY(json_check_keys(c, px, w2, pkeys));
+  double sp = -1, rad = -1, m = -1; /* -1: not given, the integrator's parameter applies */
+  TRY(json_get_num(c, px, "spacing", w2, 1e-9, 1e9, &sp));
+  TRY(json_get_num(c, px, "radius", w2, 1e-9, 1e9, &rad));
+  TRY(json_get_num(c, px, "strength", w2, 0, 1e9, &m));
+  shape_ao *na = realloc(c->s->shape_ao, (c->s->nshape_ao + 1) * sizeof *na);
+  if (!na) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->shape_ao = na;
+  shape_ao sa = {first, c->s->ntris, (float)sp, (float)rad, (float)m};
+  na[c->s->nshape_ao++] = sa;
+  return VALO_OK;
+}
+
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend) {
+  const char *type = "mesh", *file = NULL, *mname = NULL;
+  TRY(json_get_str(c, o, "type", where, &type));
+  TRY(json_get_str(c, o, "file", where, &file));
+  TRY(json_get_str(c, o, "material", where, &mname));
+  uint32_t mat = UINT32_MAX;
+  if (mname) {
+    mat = find_material(c->s, mname, mfirst, mend);
+    if (mat == UINT32_MAX) {
+      char msg[200];
+      snprintf(msg, sizeof msg, "material \"%.100s\" is not defined in \"materials\"", mname);
+      return json_bad(c, where, msg);
+    }
+  }
+  if (!strcmp(type, "mesh")) {
+    if (!file) return json_bad(c, where, "a mesh shape needs \"file\"");
+    float xf[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
+    if (t) {
+      char w2[80];
+      snprintf(w2, sizeof w2, "%s.transform", where);
+      TRY(parse_transform(c, t, w2, xf));
+    }
+    char full[2048];
+    json_resolve_path(c, file, full, sizeof full);
+    return load_mesh(c->s, full, xf, mat, c->cam_from_file && !c->s->has_camera, c->file, c->err);
+  }
+  if (!strcmp(type, "sphere")) {
+    vec3 center = v3(0, 0, 0);
+    double r = 1;
+    int sub = 4, flip = 0, smooth = 1;
+    TRY(json_get_bool(c, o, "smooth", where, &smooth));
+    TRY(json_get_vec(c, o, "center", where, 0, &center));
+    TRY(json_get_num(c, o, "radius", where, 1e-9, 1e9, &r));
+    TRY(json_get_int(c, o, "subdivisions", where, 0, 7, &sub));
+    TRY(json_get_bool(c, o, "flip_normals", where, &flip));
+    if (mat == UINT32_MAX) {
+      material d = material_default();
+      mat = scene_add_material(c->s, &d);
+      if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    }
+    if (material_has_maps(&c->s->mats[mat]))
+      log_warning("%s: %s: a sphere has no texture coordinates, so the maps of material '%s' are ignored", c->s->path, where, c->s->mats[mat].name);
+    return scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err);
+  }
+  return json_bad(c, where, "unknown shape type (mesh, sphere)");
+}
+
+static valo_status parse_light(jctx *c, const cJSON *o, int index) {
+  char where[64];
+  snprintf(where, sizeof where, "lights[%d]", index);
+  if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
+  const char *type = NULL;
+  TRY(json_get_str(c, o, "type", where, &type));
+  if (!type) return json_bad(c, where, "needs a \"type\" (point, spot, directional)");
+  light l;
+  memset(&l, 0, sizeof l);
+  l.L = c3(1, 1, 1);
+  if (!strcmp(type, "point")) {
+    static const char *const keys[] = {"type", "position", "intensity", NULL};
+    TRY(json_check_keys(c, o, where, keys));
+    l.type = LIGHT_POINT;
+    TRY(json_get_vec(c, o, "position", where, 0, &l.p));
+    TRY(json_get_rgb(c, o, "intensity", where, &l.L));
+  } else if (!strcmp(type, "spot")) {
+    static const char *const keys[] = {"type", "position", "look_at", "intensity", "cone_angle", "cone_delta_angle", NULL};
+    TRY(json_check_keys(c, o, where, keys));
+    l.type = LIGHT_SPOT;
+    vec3 at = v3(0, 0, 0);
+    double cone = 30, delta = 5;
+    TRY(json_get_vec(c, o, "position", where, 0, &l.p));
+    TRY(json_get_vec(c, o, "look_at", where, 0, &at));
+    TRY(json_get_rgb(c, o, "intensity", where, &l.L));
+    TRY(json_get_num(c, o, "cone_angle", where, 0.01, 180, &cone));
+    TRY(json_get_num(c, o, "cone_delta_angle", where, 0, 180, &delta));
+    if (delta > cone) delta = cone;
+    if (!(v3_len2(v3_sub(at, l.p)) > 0)) return json_bad(c, where, "position and look_at must differ");
+    l.dir = v3_norm(v3_sub(at, l.p));
+    l.cos_outer = cosf((float)(cone * M_PI / 180));
+    l.cos_inner = cosf((float)((cone - delta) * M_PI / 180));
+  } else if (!strcmp(type, "directional")) {
+    static const char *const keys[] = {"type", "direction", "irradiance", NULL};
+    TRY(json_check_keys(c, o, where, keys));
+    l.type = LIGHT_DIRECTIONAL;
+    l.dir = v3(0, -1, 0);
+    TRY(json_get_vec(c, o, "direction", where, 0, &l.dir));
+    TRY(json_get_rgb(c, o, "irradiance", where, &l.L));
+    if (!(v3_len2(l.dir) > 0)) return json_bad(c, where, "direction must not be zero");
+    l.dir = v3_norm(l.dir);
+  } else {
+    return json_bad(c, where, "unknown light type (point, spot, directional)");
+  }
+  if (scene_add_light(c->s, &l)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  return VALO_OK;
+}
+
+
+valo_status load_json(scene *s, const char *path, valo_options *settings, valo_error *err) {
+  valo_options unused;
+  valo_options_init(&unused);
+  jctx c = {.s = s, .path = path, .err = err, .file = settings ? settings : &unused};
+  const char *slash = strrchr(path, '/');
+  if (slash) snprintf(c.dir, sizeof c.dir, "%.*s", (int)(slash - path), path);
+  FILE *f = fopen(path, "rb");
+  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  char *text = NULL;
+  size_t len = 0, cap = 0;
+  for (;;) {
+    if (len + 4096 + 1 > cap) {
+      cap = cap ? cap * 2 : 65536;
+      if (cap > (64u << 20)) { fclose(f); free(text); return err_set(err, VALO_ERR_INVALID, "%s: scene file larger than 64 MiB", path); }
+      char *t = realloc(text, cap);
+      if (!t) { fclose(f); free(text); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+      text = t;
+    }
+    size_t n = fread(text + len, 1, 4096, f);
+    len += n;
+    if (n < 4096) break;
+  }
+  int rerr = ferror(f);
+  fclose(f);
+  if (rerr) { free(text); return err_set(err, VALO_ERR_IO, "%s: read error", path); }
+  text[len] = 0;
+  if (strlen(text) != len) { free(text); return err_set(err, VALO_ERR_PARSE, "%s: contains a NUL byte: not a JSON text file", path); }
+  const char *end = NULL;
+  cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
+  if (!root) {
+    int line, col;
+    const char *at = end ? end : cJSON_GetErrorPtr();
+    if (!at) at = text + len;
+    json_line_col(text, at, &line, &col);
+    free(text);
+    return err_set(err, VALO_ERR_PARSE, "%s:%d:%d: JSON syntax error", path, line, col);
+  }
+  free(text);
+  valo_status st = VALO_OK;
+  static const char *const keys[] = {"camera", "film", "render", "shapes", "materials", "lights", "environment", NULL};
+#undef TRY
+#define TRY(x) do { st = (x); if (st) goto done; } while (0)
+  TRY(json_check_keys(&c, root, "(top level)", keys));
+  const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
+  if (cam) TRY(parse_camera(&c, cam));
+  const cJSON *film = cJSON_GetObjectItemCaseSensitive(root, "film");
+  if (film) {
+    static const char *const fk[] = {"width", "height", NULL};
+    TRY(json_check_keys(&c, film, "film", fk));
+    TRY(json_get_int(&c, film, "width", "film", 1, 16384, &settings->width));
+    TRY(json_get_int(&c, film, "height", "film", 1, 16384, &settings->height));
+  }
+  const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
+  if (render) TRY(parse_render(&c, render));
+  uint32_t mfirst = s->nmats;
+  const cJSON *mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
+  if (mats) {
+    if (!cJSON_IsObject(mats)) { st = json_bad(&c, "materials", "must be an object of named materials"); goto done; }
+    for (const cJSON *m = mats->child; m; m = m->next) {
+      material mm;
+      TRY(json_parse_material(&c, m, m->string, &mm));
+      if (scene_add_material(s, &mm) == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+    }
+  }
+  uint32_t mend = s->nmats;
+  const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
+  if (shapes) {
+    if (!cJSON_IsArray(shapes)) { st = json_bad(&c, "shapes", "must be an array"); goto done; }
+    int i = 0;
+    for (const cJSON *sh = shapes->child; sh; sh = sh->next, i++) TRY(parse_shape(&c, sh, i, mfirst, mend));
+  }
+  if (c.cam_from_file) {
+    if (!s->has_camera) { st = json_bad(&c, "camera.from_file", "no shape file has a camera"); goto done; }
+    if (c.cam_fov > 0) s->cam.fov_deg = c.cam_fov;
+    s->cam.aperture_radius = c.cam_aperture;
+    s->cam.focus_distance = c.cam_focus; /* <= 0: autofocus */
+  }
+  const cJSON *lights = cJSON_GetObjectItemCaseSensitive(root, "lights");
+  if (lights) {
+    if (!cJSON_IsArray(lights)) { st = json_bad(&c, "lights", "must be an array"); goto done; }
+    int i = 0;
+    for (const cJSON *l = lights->child; l; l = l->next, i++) TRY(parse_light(&c, l, i));
+  }
+  const cJSON *env = cJSON_GetObjectItemCaseSensitive(root, "environment");
+  if (env) {
+    const char *type = "constant";
+    TRY(json_get_str(&c, env, "type", "environment", &type));
+    if (!strcmp(type, "constant")) {
+      static const char *const ek[] = {"type", "radiance", NULL};
+      TRY(json_check_keys(&c, env, "environment", ek));
+      s->env_radiance = c3(1, 1, 1);
+      TRY(json_get_rgb(&c, env, "radiance", "environment", &s->env_radiance));
+    } else if (!strcmp(type, "map")) {
+      static const char *const ek[] = {"type", "file", "scale", "rotation", NULL};
+      TRY(json_check_keys(&c, env, "environment", ek));
+      const char *file = NULL;
+      double scale = 1, rot = 0;
+      TRY(json_get_str(&c, env, "file", "environment", &file));
+      if (!file) { st = json_bad(&c, "environment", "a map needs \"file\" (an equirectangular .exr, .hdr or .pfm)"); goto done; }
+      TRY(json_get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
+      TRY(json_get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
+      char full[2048];
+      json_resolve_path(&c, file, full, sizeof full);
+      TRY(envmap_create(full, (float)scale, (float)rot, &s->env_map, err));
+    } else if (!strcmp(type, "cube")) {
+      static const char *const ek[] = {"type", "faces", "scale", "rotation", NULL};
+      TRY(json_check_keys(&c, env, "environment", ek));
+      const cJSON *faces = cJSON_GetObjectItemCaseSensitive(env, "faces");
+      if (!cJSON_IsArray(faces) || cJSON_GetArraySize(faces) != 6) {
+        st = json_bad(&c, "environment.faces", "must be an array of six image files: +x, -x, +y, -y, +z, -z");
+        goto done;
+      }
+      char full[6][2048];
+      const char *paths[6];
+      int i = 0;
+      for (const cJSON *fe = faces->child; fe; fe = fe->next, i++) {
+        if (!cJSON_IsString(fe)) { st = json_bad(&c, "environment.faces", "must hold file names (strings)"); goto done; }
+        json_resolve_path(&c, fe->valuestring, full[i], sizeof full[i]);
+        paths[i] = full[i];
+      }
+      double scale = 1, rot = 0;
+      TRY(json_get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
+      TRY(json_get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
+      TRY(envmap_create_cube(paths, (float)scale, (float)rot, &s->env_map, err));
+    } else {
+      st = json_bad(&c, "environment.type", "unknown environment type (constant, map, cube)");
+      goto done;
+    }
+    s->has_env = 1;
+  }
+done:
+  cJSON_Delete(root);
+  return st;
+}
+

@@ -1,0 +1,32 @@
+/* load_json_internal.h — owns what the JSON loader's files share: the parse context
+ * and the typed getters that name the file and the JSON path in every message. */
+#ifndef VALO_LOAD_JSON_INTERNAL_H
+#define VALO_LOAD_JSON_INTERNAL_H
+#include "load/load.h"
+#include <cjson/cJSON.h>
+
+typedef struct jctx {
+  scene *s; const char *path; char dir[1024]; valo_error *err;
+  valo_options *file;          /* the render settings the file asks for ("film", "render") */
+  int cam_from_file;           /* camera.from_file: take the first shape file's camera */
+  float cam_fov, cam_aperture, cam_focus; /* its overrides (fov <= 0: keep the file's) */
+} jctx;
+
+/* The getters: a missing key leaves *out as it is; a present one of the wrong type or
+ * out of [lo, hi] is an error "file: where.key: what". */
+valo_status json_bad(jctx *c, const char *where, const char *what);
+valo_status json_check_keys(jctx *c, const cJSON *obj, const char *where, const char *const *allowed);
+valo_status json_get_num(jctx *c, const cJSON *o, const char *key, const char *where, double lo, double hi, double *out);
+valo_status json_get_int(jctx *c, const cJSON *o, const char *key, const char *where, double lo, double hi, int *out);
+valo_status json_get_vec(jctx *c, const cJSON *o, const char *key, const char *where, int allow_scalar, vec3 *out);
+valo_status json_get_rgb(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out);
+valo_status json_get_str(jctx *c, const cJSON *o, const char *key, const char *where, const char **out);
+valo_status json_get_bool(jctx *c, const cJSON *o, const char *key, const char *where, int *out);
+void json_resolve_path(const jctx *c, const char *rel, char *out, size_t n);
+void json_line_col(const char *text, const char *at, int *line, int *col);
+/* Materials (load_json_material.c): the material object `o` named `name`. */
+valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, material *m);
+
+#define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
+
+#endif

@@ -1,0 +1,195 @@
+/* load_json_material.c — owns the JSON scene format's materials (docs/scene-format.md,
+ * "materials"): types, colours or texture maps, conductor presets and spectra, maps. */
+#include "load/load_json_internal.h"
+#include "core/error.h"
+#include "core/spectrum.h"
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
+ * then multiplies 1. */
+/* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
+static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
+  const char *file = NULL;
+  valo_status st = json_get_str(c, o, key, where, &file);
+  if (st || !file) return st;
+  char full[2048];
+  json_resolve_path(c, file, full, sizeof full);
+  valo_error terr;
+  *tex = scene_texture_file(c->s, full, 0, &terr);
+  if (*tex >= 0) return VALO_OK;
+  char w[300], msg[sizeof terr.message + 200];
+  snprintf(w, sizeof w, "%s.%s", where, key);
+  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
+  return json_bad(c, w, msg);
+}
+
+static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (v && cJSON_IsString(v)) {
+    char full[2048];
+    json_resolve_path(c, v->valuestring, full, sizeof full);
+    FILE *f = fopen(full, "rb");
+    if (!f) {
+      char w[300];
+      snprintf(w, sizeof w, "%s.%s", where, key);
+      char msg[2200];
+      snprintf(msg, sizeof msg, "cannot open texture %s: %s", full, strerror(errno));
+      return json_bad(c, w, msg);
+    }
+    fclose(f);
+    valo_error terr;
+    *tex = scene_texture_file(c->s, full, 1, &terr);
+    if (*tex < 0) {
+      char w[300], msg[sizeof terr.message + 40];
+      snprintf(w, sizeof w, "%s.%s", where, key);
+      snprintf(msg, sizeof msg, "texture could not be decoded: %s", terr.message);
+      return json_bad(c, w, msg);
+    }
+    *out = c3(1, 1, 1);
+    return VALO_OK;
+  }
+  return json_get_rgb(c, o, key, where, out);
+}
+
+/* "spectrum": {"wavelengths": [nm...], "eta": [...], "k": [...]}, e.g. a table of
+ * measured optical constants: stored in the scene for --spectral; RGB mode takes their
+ * colourimetric projection (tab_to_rgb). */
+static valo_status parse_nk_spectrum(jctx *c, const cJSON *o, const char *where0, material *m) {
+  char where[300];
+  snprintf(where, sizeof where, "%s.spectrum", where0);
+  static const char *const keys[] = {"wavelengths", "eta", "k", NULL};
+  TRY(json_check_keys(c, o, where, keys));
+  nk_curve cv = {0};
+  float *dst[3] = {cv.nm, cv.eta, cv.k};
+  for (int a = 0; a < 3; a++) {
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(o, keys[a]);
+    char msg[200];
+    int n = cJSON_GetArraySize(arr);
+    if (!cJSON_IsArray(arr) || n < 2 || n > NK_MAX) {
+      snprintf(msg, sizeof msg, "\"%s\" must be an array of 2 to %d numbers", keys[a], NK_MAX);
+      return json_bad(c, where, msg);
+    }
+    if (a > 0 && n != cv.n) {
+      snprintf(msg, sizeof msg, "\"%s\" has %d values for %d wavelengths", keys[a], n, cv.n);
+      return json_bad(c, where, msg);
+    }
+    cv.n = n;
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+      double v = cJSON_IsNumber(e) ? e->valuedouble : NAN;
+      int ok = isfinite(v) && (a == 0 ? v >= 100 && v <= 20000 && (i == 0 || v > dst[0][i - 1]) : a == 1 ? v > 0 : v >= 0);
+      if (!ok) {
+        snprintf(msg, sizeof msg, "\"%s\"[%d] %s", keys[a], i,
+                 a == 0 ? "must be a wavelength in nm (100 to 20000), increasing" : a == 1 ? "must be a number > 0" : "must be a number >= 0");
+        return json_bad(c, where, msg);
+      }
+      dst[a][i] = (float)v;
+    }
+  }
+  nk_curve *q = realloc(c->s->nk, (c->s->nnk + 1) * sizeof *q);
+  if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->s->nk = q;
+  q[c->s->nnk++] = cv;
+  m->nk = (int)c->s->nnk;
+  m->eta = tab_to_rgb(cv.nm, cv.eta, cv.n);
+  m->k = tab_to_rgb(cv.nm, cv.k, cv.n);
+  /* An index is not a colour: a projection with a negative channel is clamped. */
+  m->eta = c3(fmaxf(m->eta.r, 1e-3f), fmaxf(m->eta.g, 1e-3f), fmaxf(m->eta.b, 1e-3f));
+  m->k = c3(fmaxf(m->k.r, 0), fmaxf(m->k.g, 0), fmaxf(m->k.b, 0));
+  return VALO_OK;
+}
+
+valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, material *m) {
+  char where[256];
+  snprintf(where, sizeof where, "materials.%s", name);
+  if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
+  const char *type = NULL;
+  TRY(json_get_str(c, o, "type", where, &type));
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor, pbr)");
+  *m = material_default();
+  snprintf(m->name, sizeof m->name, "%s", name);
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
+                                      "two_sided", "bump_map", "bump_scale", NULL};
+  if (!strcmp(type, "pbr")) {
+    TRY(json_check_keys(c, o, where, k_pbr));
+    m->type = MAT_PBR;
+    m->roughness = 0.5f;
+    TRY(get_rgb_tex(c, o, "base_color", where, &m->kd, &m->tex_kd));
+    double metal = 0;
+    TRY(json_get_num(c, o, "metallic", where, 0, 1, &metal));
+    m->metallic = (float)metal;
+    TRY(get_data_map(c, o, "metallic_roughness_map", where, "metallic-roughness map", &m->tex_mr));
+  } else if (!strcmp(type, "diffuse")) {
+    TRY(json_check_keys(c, o, where, k_diffuse));
+    m->type = MAT_DIFFUSE;
+    TRY(get_rgb_tex(c, o, "reflectance", where, &m->kd, &m->tex_kd));
+  } else if (!strcmp(type, "phong")) {
+    TRY(json_check_keys(c, o, where, k_phong));
+    m->type = MAT_PHONG;
+    m->kd = c3(0.5f, 0.5f, 0.5f); m->ks = c3(0.2f, 0.2f, 0.2f); m->exponent = 20;
+    TRY(get_rgb_tex(c, o, "diffuse", where, &m->kd, &m->tex_kd));
+    TRY(get_rgb_tex(c, o, "specular", where, &m->ks, &m->tex_ks));
+    double e = m->exponent;
+    TRY(json_get_num(c, o, "exponent", where, 0, 1e6, &e));
+    m->exponent = (float)e;
+  } else if (!strcmp(type, "mirror")) {
+    TRY(json_check_keys(c, o, where, k_mirror));
+    m->type = MAT_MIRROR;
+    m->kd = c3(0, 0, 0); m->ks = c3(1, 1, 1);
+    TRY(json_get_rgb(c, o, "reflectance", where, &m->ks));
+    TRY(json_get_rgb(c, o, "diffuse", where, &m->kd));
+  } else if (!strcmp(type, "dielectric")) {
+    TRY(json_check_keys(c, o, where, k_dielectric));
+    m->type = MAT_DIELECTRIC;
+    double ior = 1.5;
+    TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
+    m->ior = (float)ior;
+    const char *disp = NULL;
+    TRY(json_get_str(c, o, "dispersion", where, &disp));
+    if (disp) {
+      dispersion d;
+      if (dispersion_parse(disp, &d)) return json_bad(c, where, "unknown dispersion (fused_silica, sapphire, water, cauchy_glass, dense_flint)");
+      m->dispersion = (int)d;
+      m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
+    }
+  } else if (!strcmp(type, "conductor")) {
+    TRY(json_check_keys(c, o, where, k_conductor));
+    m->type = MAT_CONDUCTOR;
+    const char *preset = NULL;
+    TRY(json_get_str(c, o, "preset", where, &preset));
+    if (cJSON_GetObjectItemCaseSensitive(o, "spectrum")) {
+      if (preset || cJSON_GetObjectItemCaseSensitive(o, "eta") || cJSON_GetObjectItemCaseSensitive(o, "k"))
+        return json_bad(c, where, "give either \"spectrum\" or \"preset\" / \"eta\" and \"k\", not both");
+      TRY(parse_nk_spectrum(c, cJSON_GetObjectItemCaseSensitive(o, "spectrum"), where, m));
+    } else if (preset) {
+      if (conductor_preset(preset, &m->eta, &m->k)) return json_bad(c, where, "unknown conductor preset (Au, Ag, Cu, Al)");
+    } else {
+      if (!cJSON_GetObjectItemCaseSensitive(o, "eta") || !cJSON_GetObjectItemCaseSensitive(o, "k"))
+        return json_bad(c, where, "a conductor needs \"preset\" or both \"eta\" and \"k\"");
+    }
+    TRY(json_get_rgb(c, o, "eta", where, &m->eta));
+    TRY(json_get_rgb(c, o, "k", where, &m->k));
+  } else {
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr)");
+  }
+  TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
+  TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));
+  double bscale = 1;
+  TRY(json_get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
+  m->bump_scale = (float)bscale;
+  double rough = m->roughness;
+  TRY(json_get_num(c, o, "roughness", where, 0, 1, &rough));
+  m->roughness = (float)rough;
+  TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
+  TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
+  return VALO_OK;
+}
+

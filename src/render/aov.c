@@ -1,0 +1,40 @@
+/* aov.c — see aov.h. */
+#include "render/aov.h"
+#include <string.h>
+
+const char *const aov_prefixes[AOV_KIND_COUNT] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
+
+int aov_kind_of(const char *output, size_t *plen) {
+  for (int k = 0; k < AOV_KIND_COUNT; k++) {
+    size_t n = strlen(aov_prefixes[k]);
+    if (!strncmp(output, aov_prefixes[k], n)) {
+      if (plen) *plen = n;
+      return k;
+    }
+  }
+  if (plen) *plen = 0;
+  return -1;
+}
+
+void aov_record(const session *ss, ray ry, float *acc, sampler *smp, thread_stats *ts) {
+  hit h;
+  if (!ctx_intersect(&ss->ctx, &ry, &h, ts)) return;
+  isect it;
+  isect_from_hit(ss->s, &ry, &h, &it);
+  bsdf b = bsdf_at(ss->s, &it);
+  material tm = *it.m;
+  tm.kd = b.kd;
+  tm.ks = b.ks;
+  rgb a = material_albedo(&tm, v3_dot(it.ns, v3_neg(ry.d)));
+  vec3 n = v3_faceforward(it.ns, v3_neg(ry.d));
+  acc[AOV_ALBEDO] += a.r; acc[AOV_ALBEDO + 1] += a.g; acc[AOV_ALBEDO + 2] += a.b;
+  acc[AOV_NORMAL] += n.x; acc[AOV_NORMAL + 1] += n.y; acc[AOV_NORMAL + 2] += n.z;
+  acc[AOV_DEPTH] += h.t * v3_len(ry.d);
+  if (!(ss->opt.aovs & VALO_AOVS_AO)) return;
+  vec3 dir;
+  sampler_set_dim(smp, SDIM_AOV);
+  if (ao_sample(&ss->ctx, &it, n, ss->ao_dist, smp, ts, &dir)) {
+    acc[AOV_AO] += 1;
+    acc[AOV_BENT] += dir.x; acc[AOV_BENT + 1] += dir.y; acc[AOV_BENT + 2] += dir.z;
+  }
+}

@@ -1,0 +1,41 @@
+/* film.h — owns the film: per pixel the sum of its samples' radiance (double, summed in
+ * sample order, so images are the same for any thread count), their count, for adaptive
+ * sampling the sums of squares, and the AOV sums of the first camera hits. A box filter:
+ * each jittered sample counts for its own pixel. */
+#ifndef VALO_FILM_H
+#define VALO_FILM_H
+#include "core/stats.h"
+#include <stddef.h>
+#include <stdint.h>
+
+/* The AOV sums of one pixel, AOV_FLOATS floats at film.aov + AOV_FLOATS * pixel. */
+enum {
+  AOV_ALBEDO = 0,   /* 3: albedo rgb */
+  AOV_NORMAL = 3,   /* 3: shading normal facing the camera */
+  AOV_DEPTH = 6,    /* 1: hit distance */
+  AOV_AO = 7,       /* 1: unoccluded ao rays */
+  AOV_BENT = 8,     /* 3: sum of their directions (the bent normal) */
+  AOV_FLOATS = 11
+};
+
+typedef struct film {
+  int width, height;
+  double *sum;      /* 3 per pixel */
+  uint32_t *count;  /* samples per pixel */
+  double *sq;       /* adaptive sampling: sums of squares of r, g, b and luminance, or NULL */
+  float *aov;       /* AOV_FLOATS per pixel, or NULL */
+} film;
+
+/* Allocates a black film; with_sq / with_aov add those arrays. -1 on out of memory (the
+ * film is then freed). */
+int film_init(film *f, int width, int height, int with_sq, int with_aov);
+void film_free(film *f);
+/* Zeroes the radiance sums and counts (a new frame of a sequence). */
+void film_clear(film *f);
+/* Adds one sample's radiance to pixel pix: NaN, infinite and negative ones count as
+ * taken but are dropped (counted by cause in ts). */
+void film_add(film *f, size_t pix, rgb L, thread_stats *ts);
+/* The mean radiance of every pixel (black where no sample landed), rgb_out w*h*3. */
+void film_resolve(const film *f, float *rgb_out);
+static inline size_t film_pixels(const film *f) { return (size_t)f->width * (size_t)f->height; }
+#endif

@@ -1,0 +1,84 @@
+/* output.c — see output.h. */
+#include "render/output.h"
+#include "render/aov.h"
+#include "image/image_io.h"
+#include "image/tonemap.h"
+#include "core/error.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static int ends_with(const char *s, const char *suf) {
+  size_t n = strlen(s), m = strlen(suf);
+  return n >= m && !strcasecmp(s + n - m, suf);
+}
+
+/* Data AOVs written as PNG: mapped into [0, 1] so that they are visible, then stored
+ * linearly in the 8 bits (each value pre-decoded from sRGB, so the PNG writer's sRGB
+ * encoding gives back byte = round(255 v)). kind 0: normals, n/2 + 1/2; 1: depth, divided
+ * by the largest in the image (black where nothing was hit); 2: sample counts, divided by
+ * the largest. */
+static void png_data_map(float *px, size_t np, int kind) {
+  float mx = 0;
+  for (size_t i = 0; i < 3 * np; i++) mx = px[i] > mx ? px[i] : mx;
+  for (size_t i = 0; i < 3 * np; i++) {
+    float v = kind == 0 ? px[i] * 0.5f + 0.5f : (mx > 0 ? px[i] / mx : 0);
+    v = clampf(v, 0, 1);
+    px[i] = srgb_to_linear(v);
+  }
+}
+
+/* The per-pixel values of AOV kind k (AOV_KIND_SPP: the sample counts) into px. */
+static void aov_resolve(const session *ss, int k, float *px) {
+  const film *f = &ss->film;
+  size_t np = film_pixels(f);
+  for (size_t i = 0; i < np; i++) {
+    if (k == AOV_KIND_SPP) { px[3 * i] = px[3 * i + 1] = px[3 * i + 2] = (float)f->count[i]; continue; }
+    const float *a = &f->aov[AOV_FLOATS * i];
+    float inv = f->count[i] > 0 ? 1.0f / (float)f->count[i] : 0;
+    if (k == AOV_KIND_BENT) {
+      /* the mean unoccluded direction, normalised (0 where all occluded) */
+      vec3 b = v3(a[AOV_BENT], a[AOV_BENT + 1], a[AOV_BENT + 2]);
+      float l = v3_len(b);
+      b = l > 0 ? v3_scale(b, 1 / l) : v3(0, 0, 0);
+      px[3 * i] = b.x; px[3 * i + 1] = b.y; px[3 * i + 2] = b.z;
+      continue;
+    }
+    for (int c = 0; c < 3; c++)
+      px[3 * i + c] = (k == AOV_KIND_DEPTH ? a[AOV_DEPTH] : k == AOV_KIND_AO ? a[AOV_AO] : a[3 * k + c]) * inv;
+  }
+}
+
+valo_status output_write(const session *ss, const char *path, const valo_output_options *o, valo_error *err) {
+  size_t plen;
+  int k = aov_kind_of(path, &plen);
+  int w = ss->opt.width, h = ss->opt.height;
+  size_t np = film_pixels(&ss->film);
+  if (k < 0) {
+    tonemap_kind tk;
+    if (tonemap_parse(o->tonemap, &tk)) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp, log, reinhard, aces)", o->tonemap);
+  } else if (k != AOV_KIND_SPP) {
+    if (!ss->film.aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", path);
+    if ((k == AOV_KIND_AO || k == AOV_KIND_BENT) && !(ss->opt.aovs & VALO_AOVS_AO))
+      return err_set(err, VALO_ERR_INVALID, "%s: the render was made without the ao AOV (aovs needs VALO_AOVS_AO)", path);
+  }
+  float *px = malloc(np * 3 * sizeof(float));
+  if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  const valo_output_options *use = o;
+  valo_output_options raw;
+  valo_output_options_init(&raw);
+  if (k < 0) {
+    film_resolve(&ss->film, px);
+  } else {
+    aov_resolve(ss, k, px);
+    int data = k == AOV_KIND_NORMAL || k == AOV_KIND_DEPTH || k == AOV_KIND_BENT || k == AOV_KIND_SPP;
+    if (ends_with(path, ".png") && data) {
+      png_data_map(px, np, k == AOV_KIND_SPP ? 2 : k == AOV_KIND_DEPTH ? 1 : 0);
+      use = &raw;
+    }
+  }
+  valo_status st = image_write(path + plen, w, h, px, use, err);
+  free(px);
+  return st;
+}

@@ -1,0 +1,61 @@
+/* session.h — owns one render (Cycles' word for it: a session): the film, the camera of
+ * this frame and the last, the accelerator, the light sampler, the integrator instance,
+ * the budgets, passes, frames, cancellation and progress, and the counters. The public
+ * valo_render (src/api/) is a handle on one session. Options reach it resolved and
+ * checked (src/api/options.c). */
+#ifndef VALO_SESSION_H
+#define VALO_SESSION_H
+#include "integrator/integrator.h"
+#include "render/film.h"
+#include "scene/camera.h"
+#include <stdatomic.h>
+
+#define TILE 16 /* tiles of TILE x TILE pixels: the unit of work and of cancellation */
+
+typedef struct session session;
+/* Called after each frame of a sequence (opt.frames > 0), from the thread that runs it. */
+typedef valo_status (*session_frame_fn)(void *user, int frame, valo_error *err);
+
+struct session {
+  const scene *s;
+  valo_options opt;        /* resolved: every field set */
+  render_ctx ctx;
+  const integrator_ops *integ;
+  sampler_kind sampler_kind;
+  accel *acc;
+  accel_filter alpha_filter;
+  film film;
+  double param[INTEGRATOR_MAX_PARAMS];
+  void *istate;            /* the integrator's create() result */
+  float ao_dist;           /* ray length of the ao AOV */
+  int spp_done;
+  double build_seconds, render_seconds;
+  thread_stats total;      /* rays, losses and surface samples of every run so far */
+  thread_stats prep;       /* create's and prepare's, added to total at the end of a run */
+  atomic_int cancel;
+  camera cam_still;        /* the scene camera fitted to the film (frame 0 of an animation) */
+  cam_lens lens;           /* this frame's camera and lens */
+  cam_view view_prev;      /* the previous frame's */
+  int frames_done;         /* a sequence: frames finished */
+  int image_frames;        /* render_frame calls made (the integrator's frame index) */
+  float *frame_rgb;        /* render_frame output, width*height*3 */
+  session_frame_fn on_frame;
+  void *on_frame_user;
+};
+
+/* Builds the accelerator, the light sampler, the camera (autofocus included) and the
+ * integrator for scene s with resolved options o; params/ao_param are the integrator's
+ * and the ao AOV's parameter values. */
+valo_status session_create(const scene *s, const valo_options *o, const integrator_ops *integ, const double *params, float ao_dist,
+                           session **out, valo_error *err);
+void session_destroy(session *ss);
+/* Renders: passes until the sample or time budget, or a sequence of frames. */
+valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo_error *err);
+/* The pinhole basis of frame f (the scene's camera animation in a sequence, else the
+ * still camera) into ss->lens.view; -1 when up is parallel to the view direction. */
+int session_set_view(session *ss, int f);
+/* Calls the progress callback (if any) with the larger of frac and the share of the time
+ * budget spent; non-zero when it asks to cancel. */
+int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget);
+static inline int session_cancelled(const session *ss) { return atomic_load_explicit(&ss->cancel, memory_order_relaxed); }
+#endif

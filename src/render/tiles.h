@@ -1,0 +1,16 @@
+/* tiles.h — owns the per-ray tile loop (pbrt's ImageTileIntegrator): TILE x TILE tiles
+ * claimed by the thread pool, each pixel's samples taken in sample order, each sample a
+ * camera ray through the lens, the AOVs of its first hit, and the integrator's li(). */
+#ifndef VALO_TILES_H
+#define VALO_TILES_H
+#include "render/session.h"
+
+/* Takes samples [s0, s1) of every pixel (integrators with prepare: one sample index at a
+ * time, each after its prepare). VALO_ERR_CANCELLED when the session was cancelled. */
+valo_status tiles_render(session *ss, int s0, int s1, thread_stats *ts, valo_error *err);
+/* Takes each pixel from its count up to target[pix] (adaptive sampling), tile by tile;
+ * the caller checks for cancellation. */
+void tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts);
+/* Takes samples [s0, s1) of pixel (x, y) in order. */
+void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts);
+#endif
