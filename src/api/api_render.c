@@ -2,6 +2,7 @@
  * (src/render/session.h) with the frame callback and warning handler the caller gave.
  * Each function checks its handle, routes warnings to the handle's handler, resolves
  * options (options.c) and calls inward. */
+#include "integrator/ao.h"
 #include "valo/valo.h"
 #include "api/api.h"
 #include "api/options.h"

@@ -4,6 +4,8 @@
  * distance; the pixel is the unoccluded fraction (1 open, 0 closed), camera rays that
  * escape give 0. The same estimator, ao_sample() in integrator.c, makes the ao and bent-
  * normal AOVs beside any integrator (-o ao:FILE, -o bent:FILE). */
+#include "integrator/ao.h"
+#include "core/sampling.h"
 #include "integrator/integrator.h"
 
 static const integrator_param ao_params[] = {
@@ -32,3 +34,21 @@ const integrator_ops integrator_ao = {
     .params = ao_params,
     .li = ao_li,
 };
+
+int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler *smp, thread_stats *ts, vec3 *dir) {
+  float u1, u2;
+  sampler_2d(smp, &u1, &u2);
+  frame f = frame_from_n(n);
+  vec3 d = frame_to_world(&f, sample_cosine_hemisphere(u1, u2));
+  /* a direction under the geometric surface is blocked by it */
+  if (v3_dot(d, it->ng) * v3_dot(n, it->ng) <= 0) return 0;
+  ray r = spawn_ray(it, d);
+  r.tmax = dist;
+  ts->rays++;
+  if (accel_occluded(c->acc, &r)) return 0;
+  *dir = d;
+  return 1;
+}
+
+float ao_ray_length(const scene *s, double d) { return d > 0 ? (float)d : 0.1f * s->radius; }
+

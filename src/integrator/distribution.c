@@ -6,6 +6,7 @@
  * depth-truncated light transport — it agrees with `path` at the same max_depth — and so
  * darker than unlimited `path` by the energy of the longer paths. Cost grows as
  * DIST_BRANCH^depth. */
+#include "integrator/path_common.h"
 #include "integrator/integrator.h"
 
 #define DIST_BRANCH 4

@@ -1,5 +1,6 @@
 /* lightpath.c — owns light-path shooting (lightpath.h): emission, adjoint BSDF sampling,
  * Russian roulette, and the deterministic chunked rounds. */
+#include "integrator/path_common.h"
 #include "integrator/lightpath.h"
 #include "core/threadpool.h"
 #include "core/error.h"

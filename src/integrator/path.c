@@ -4,6 +4,7 @@
  * Russian roulette (digest 000: divide by the continuation probability). Emission found
  * by BSDF-sampled rays is MIS-weighted against the NEE that could have found it, so
  * nothing is counted twice. */
+#include "integrator/path_common.h"
 #include "integrator/integrator.h"
 #include "core/sampling.h"
 

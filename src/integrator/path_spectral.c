@@ -8,6 +8,7 @@
  * refracts at its own angle. A conductor given per wavelength (JSON "spectrum") has its
  * BSDF evaluated with F = 1 and the Fresnel term of each wavelength's eta, k applied
  * here. The result is converted through CIE XYZ to linear sRGB. */
+#include "integrator/path_common.h"
 #include "integrator/integrator.h"
 #include "core/sampling.h"
 #include "core/spectrum.h"

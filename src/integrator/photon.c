@@ -21,6 +21,7 @@
  *    within the maximum radius, distance measured in a disc squeezed along the surface
  *    normal (|v|^2 + 16 (v.n)^2) against leaks at corners and through thin walls.
  * Biased (blur of the density estimate), consistent as the photon counts grow. */
+#include "integrator/camera_path.h"
 #include "integrator/integrator.h"
 #include "geometry/pointtree.h"
 #include "integrator/lightpath.h"

@@ -16,6 +16,8 @@
  * moves the camera ray (antialiasing). d, r and M are parameters, per shape in a JSON
  * scene ("proximity": {"spacing", "radius", "strength"}); r and M are those of the shape
  * being shaded, d that of the shape splatted. */
+#include "integrator/direct.h"
+#include "integrator/ao.h"
 #include "integrator/integrator.h"
 #include "integrator/proximity.h"
 #include "geometry/pointtree.h"

@@ -15,6 +15,7 @@
  * Jacobian; GI samples are surface points x_s found from x_v in solid angle, so reuse
  * multiplies by the Jacobian |cos phi_r| / |cos phi_q| * |x_q - x_s|^2 / |x_r - x_s|^2.
  * Geometry is static between frames; only the camera moves. */
+#include "integrator/camera_path.h"
 #include "integrator/restir_internal.h"
 #include "core/threadpool.h"
 #include "core/sampling.h"

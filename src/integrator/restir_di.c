@@ -1,6 +1,7 @@
 /* restir_di.c — owns restir-di (digest 001; Bitterli et al. 2020): its parameters, the DI
  * target (unshadowed f Le |cos| g in the light's measure), RIS candidates, the merge of
  * DI reservoirs and shading; the frame's stages are in restir_common.c. */
+#include "integrator/direct.h"
 #include "integrator/restir_internal.h"
 #include "core/threadpool.h"
 #include "core/sampling.h"

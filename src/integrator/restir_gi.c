@@ -1,6 +1,7 @@
 /* restir_gi.c — owns restir-gi (digest 001; Ouyang et al. 2021): its parameters, the GI
  * target, the solid-angle Jacobian, the initial sample points and the merge of GI
  * reservoirs; the frame's stages are in restir_common.c. */
+#include "integrator/path_common.h"
 #include "integrator/restir_internal.h"
 #include "core/threadpool.h"
 #include "core/sampling.h"

@@ -23,6 +23,7 @@
  *    over the cone the sphere subtends at x (the whole sphere of directions when x is
  *    inside), estimated with `cone_samples` directions drawn uniformly in the cone. No
  *    1/d^2 singularity: no splotches on glossy surfaces; consistent as count grows. */
+#include "integrator/camera_path.h"
 #include "integrator/integrator.h"
 #include "integrator/lightpath.h"
 #include "geometry/pointtree.h"

@@ -5,6 +5,7 @@
  * metals, to a fixed depth (max_depth; 5 when unlimited). No diffuse or glossy
  * interreflection: it equals `path` where every light path is light -> one diffuse or
  * glossy surface -> ideal specular surfaces -> camera, and is darker elsewhere. */
+#include "integrator/path_common.h"
 #include "integrator/integrator.h"
 #include "material/fresnel.h"
 

@@ -1,4 +1,6 @@
 /* aov.c — see aov.h. */
+#include "integrator/direct.h"
+#include "integrator/ao.h"
 #include "render/aov.h"
 #include <string.h>
 

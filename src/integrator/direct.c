@@ -1,0 +1,79 @@
+/* direct.c — see direct.h. */
+#include "integrator/direct.h"
+#include "core/sampling.h"
+#include <math.h>
+
+int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
+  vec3 d0 = v3_sub(p_to, it->p);
+  vec3 o = offset_origin_isect(it, d0);
+  vec3 target = p_to;
+  if (v3_len2(n_to) > 0) {
+    vec3 err = v3_scale(v3_abs(p_to), fp_gamma(7));
+    target = offset_origin(p_to, err, n_to, v3_neg(d0));
+  }
+  ray r;
+  r.o = o;
+  r.d = v3_sub(target, o);
+  r.tmax = 1 - 1e-4f;
+  ts->rays++;
+  return accel_occluded(c->acc, &r);
+}
+
+int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                  thread_stats *ts, int mis, direct_sample *out) {
+  float ul = sampler_1d(smp), u1, u2;
+  sampler_2d(smp, &u1, &u2);
+  float pmf;
+  uint32_t li = light_select(&c->ls, c->s, it->p, ul, &pmf);
+  if (li == UINT32_MAX) return 0;
+  const light *l = &c->s->lights[li];
+  light_li ls;
+  if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return 0;
+  vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
+  rgb f = bsdf_eval(b, wo_l, wi_l);
+  ts->surface_samples++;
+  if (!c3_finite(f)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; return 0; }
+  if (c3_black(f)) return 0;
+  /* Reflection vs transmission must agree between the shading frame and the true
+   * surface (no leaks through shading normals). */
+  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(ls.wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
+  float bpdf = (ls.delta || !mis) ? 0 : bsdf_pdf(b, wo_l, wi_l);
+  if (!isfinite(bpdf)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; return 0; }
+  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return 0;
+  float light_pdf = pmf * ls.pdf;
+  float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bpdf);
+  out->f_cos = c3_scale(f, fabsf(wi_l.z));
+  out->Li = ls.L;
+  out->scale = w / light_pdf;
+  out->wi = ls.wi;
+  return 1;
+}
+
+static rgb direct_rgb(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                      thread_stats *ts, int mis) {
+  direct_sample d;
+  if (!sample_direct(c, it, b, fr, wo, smp, ts, mis, &d)) return c3(0, 0, 0);
+  return c3_scale(c3_mul(d.f_cos, d.Li), d.scale);
+}
+
+rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                    thread_stats *ts) {
+  return direct_rgb(c, it, b, fr, wo, smp, ts, 1);
+}
+rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                          thread_stats *ts) {
+  return direct_rgb(c, it, b, fr, wo, smp, ts, 0);
+}
+
+rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, const isect *it) {
+  const scene *s = c->s;
+  if (!found) {
+    if (c->ls.env_index < 0) return c3(0, 0, 0);
+    return light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
+  }
+  int32_t lid = s->tri_light[h->tri];
+  if (lid < 0) return c3(0, 0, 0);
+  return light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
+}
+

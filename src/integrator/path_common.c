@@ -1,0 +1,87 @@
+/* path_common.c — see path_common.h. */
+#include "integrator/direct.h"
+#include "integrator/path_common.h"
+#include "core/sampling.h"
+#include <math.h>
+
+int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_stats *ts, int depth, int max_depth, int count_emission,
+                     rgb *L, isect *it, bsdf *b, frame *fr, vec3 *wo) {
+  hit h;
+  int found = ctx_intersect(c, r, &h, ts);
+  if (found) isect_from_hit(c->s, r, &h, it);
+  *L = count_emission ? emitted_along(c, r, &h, found, it) : c3(0, 0, 0);
+  if (!found || depth >= max_depth) return 0;
+  *b = bsdf_at(c->s, it);
+  *wo = v3_neg(r->d);
+  *fr = shading_frame(it, b, *wo);
+  if (bsdf_has_smooth(b)) *L = c3_add(*L, estimate_direct_nomis(c, it, b, fr, *wo, smp, ts));
+  return 1;
+}
+
+static float path_emission_weight(const render_ctx *c, const path_state *st, int env, vec3 d, int32_t lid, const isect *it) {
+  if (st->specular) return 1;
+  const scene *s = c->s;
+  if (env) return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)c->ls.env_index, st->prev_p) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
+  return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)lid, st->prev_p) * light_pdf_area(s, &s->lights[lid], st->prev_p, it->p, it->ng));
+}
+
+int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
+  const scene *s = c->s;
+  hit h;
+  *Le = c3(0, 0, 0);
+  *w = 1;
+  if (!ctx_intersect(c, r, &h, ts)) {
+    if (c->ls.env_index >= 0) {
+      *Le = light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
+      *w = path_emission_weight(c, st, 1, r->d, -1, NULL);
+    }
+    return 0;
+  }
+  isect_from_hit(s, r, &h, it);
+  int32_t lid = s->tri_light[h.tri];
+  if (lid >= 0) {
+    *Le = light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
+    if (!c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
+  }
+  return 1;
+}
+
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi) {
+  float ul = sampler_1d(smp), u1, u2;
+  sampler_2d(smp, &u1, &u2);
+  vec3 wo_l = frame_to_local(fr, wo);
+  ts->surface_samples++;
+  if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, bs)) {
+    if (bs->nonfinite) ts->lost[VALO_LOSS_BSDF_NONFINITE]++;
+    return 0;
+  }
+  *wi = v3_norm(frame_to_world(fr, bs->wi));
+  /* The sampled direction must agree with the geometric normal about reflection vs
+   * transmission, or shading normals would leak light. */
+  int refl_l = (bs->wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(*wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
+  return 1;
+}
+
+int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, path_state *st, rgb *weight,
+                  ray *r) {
+  bsdf_sample bs;
+  vec3 wi;
+  if (!sample_bsdf_world(it, b, fr, wo, smp, ts, &bs, &wi)) return 0;
+  *weight = bs.weight;
+  st->specular = bs.delta;
+  st->prev_pdf = bs.pdf;
+  st->prev_p = it->p;
+  st->eta_acc /= bs.eta_scale;
+  *r = spawn_ray(it, wi);
+  return 1;
+}
+
+float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp) {
+  float rr = max_beta * st->eta_acc;
+  if (depth < 2 || rr >= 1) return 1;
+  float q = fmaxf(0.0f, 1 - rr);
+  if (sampler_1d(smp) < q) return 0;
+  return 1 / (1 - q);
+}
+

@@ -1,0 +1,96 @@
+/* shading.c — see shading.h. */
+#include "material/shading.h"
+#include "image/texture.h"
+#include <math.h>
+
+/* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
+ * shading normal n by d(u,v) = scale * height(u,v) has tangents dp/du + d_u n and
+ * dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is the new shading
+ * normal. dp/du and dp/dv are the triangle's own UV derivatives, made orthogonal to n so
+ * that a flat height map leaves n unchanged; d_u and d_v are central differences over
+ * half a texel of the bilinearly filtered map, so the slope of a linear ramp is exact. */
+static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
+  const texture *tx = &s->tex[it->m->tex_bump];
+  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
+  float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
+  float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
+  float det = du1 * dv2 - du2 * dv1;
+  if (!(fabsf(det) > 1e-20f) || tx->w < 1 || tx->h < 1) return;
+  float r = 1 / det;
+  vec3 n = it->ns;
+  vec3 dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), r);
+  vec3 dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), r);
+  dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
+  dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
+  float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
+  texture_lookup(tx, it->u + hu, it->v, px); a = px[0] + px[1] + px[2];
+  texture_lookup(tx, it->u - hu, it->v, px); b = px[0] + px[1] + px[2];
+  float d_u = it->m->bump_scale * (a - b) / (3 * 2 * hu);
+  texture_lookup(tx, it->u, it->v + hv, px); a = px[0] + px[1] + px[2];
+  texture_lookup(tx, it->u, it->v - hv, px); b = px[0] + px[1] + px[2];
+  float d_v = it->m->bump_scale * (a - b) / (3 * 2 * hv);
+  vec3 nb = v3_cross(v3_add(dpdu, v3_scale(n, d_u)), v3_add(dpdv, v3_scale(n, d_v)));
+  if (v3_dot(nb, n) < 0) nb = v3_neg(nb);
+  if (v3_len2(nb) > 1e-30f && v3_finite(nb)) it->ns = v3_norm(nb);
+}
+
+void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
+  (void)r;
+  const uint32_t *ix = &s->idx[3 * h->tri];
+  vec3 p0 = s->pos[ix[0]], p1 = s->pos[ix[1]], p2 = s->pos[ix[2]];
+  it->p = tri_point(p0, p1, p2, h->b1, h->b2, &it->perr);
+  it->ng = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
+  it->tri = h->tri;
+  it->m = &s->mats[s->tri_mat[h->tri]];
+  float b0 = 1 - h->b1 - h->b2;
+  it->ns = it->ng;
+  if (s->tri_flags[h->tri] & TRI_HAS_NORMALS) {
+    vec3 n = v3_add(v3_add(v3_scale(s->nrm[ix[0]], b0), v3_scale(s->nrm[ix[1]], h->b1)), v3_scale(s->nrm[ix[2]], h->b2));
+    float l2 = v3_len2(n);
+    if (l2 > 0 && isfinite(l2)) it->ns = v3_scale(n, 1 / sqrtf(l2));
+  }
+  it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
+  it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+  if (it->m->tex_normal >= 0 && s->tan && (s->tri_flags[h->tri] & TRI_HAS_UVS)) {
+    /* Tangent-space normal map: n = 2 rgb - 1 in the (T, B, N) frame at the hit. */
+    const float *t0 = &s->tan[4 * ix[0]], *t1 = &s->tan[4 * ix[1]], *t2 = &s->tan[4 * ix[2]];
+    vec3 T = v3(b0 * t0[0] + h->b1 * t1[0] + h->b2 * t2[0], b0 * t0[1] + h->b1 * t1[1] + h->b2 * t2[1],
+                b0 * t0[2] + h->b1 * t1[2] + h->b2 * t2[2]);
+    vec3 N = it->ns;
+    T = v3_sub(T, v3_scale(N, v3_dot(N, T)));
+    if (v3_len2(T) > 1e-12f) {
+      T = v3_norm(T);
+      vec3 B = v3_scale(v3_cross(N, T), t0[3]);
+      float px[4];
+      texture_lookup(&s->tex[it->m->tex_normal], it->u, it->v, px);
+      vec3 nm = v3(2 * px[0] - 1, 2 * px[1] - 1, 2 * px[2] - 1);
+      vec3 n2 = v3_add(v3_add(v3_scale(T, nm.x), v3_scale(B, nm.y)), v3_scale(N, nm.z));
+      if (v3_len2(n2) > 1e-12f && v3_finite(n2)) it->ns = v3_norm(n2);
+    }
+  }
+  if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
+}
+
+bsdf bsdf_at(const scene *s, const isect *it) {
+  const material *m = it->m;
+  if (m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0) return bsdf_from_material(m);
+  material mm = *m;
+  float px[4];
+  if (m->tex_kd >= 0) { texture_lookup(&s->tex[m->tex_kd], it->u, it->v, px); mm.kd = c3_mul(mm.kd, c3(px[0], px[1], px[2])); }
+  if (m->tex_ks >= 0) { texture_lookup(&s->tex[m->tex_ks], it->u, it->v, px); mm.ks = c3_mul(mm.ks, c3(px[0], px[1], px[2])); }
+  if (m->tex_ns >= 0) { texture_lookup(&s->tex[m->tex_ns], it->u, it->v, px); mm.exponent *= (px[0] + px[1] + px[2]) / 3; }
+  if (m->tex_mr >= 0) { texture_lookup(&s->tex[m->tex_mr], it->u, it->v, px); mm.roughness *= px[1]; mm.metallic *= px[2]; }
+  if (m->tex_rough >= 0) { texture_lookup(&s->tex[m->tex_rough], it->u, it->v, px); mm.roughness *= sqrtf(fmaxf((px[0] + px[1] + px[2]) / 3, 0)); }
+  if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
+  return bsdf_from_material(&mm);
+}
+
+frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
+  vec3 ns = it->ns;
+  if (!bsdf_transmits(b)) {
+    if (v3_dot(it->ng, wo) < 0) it->ng = v3_neg(it->ng);
+    if (v3_dot(ns, wo) < 0) ns = v3_neg(ns);
+  }
+  return frame_from_n(ns);
+}
+

@@ -1,0 +1,37 @@
+/* shading.h — owns surface interactions: the hit point with its error bound, geometric
+ * and shading normals (interpolated, normal-mapped, bump-mapped), UVs and material; the
+ * BSDF there with the material's texture maps applied (pbrt's Material::GetBSDF);
+ * the shading frame; and rays spawned off the surface with robust offsets. */
+#ifndef VALO_SHADING_H
+#define VALO_SHADING_H
+#include "material/bsdf.h"
+#include "geometry/accel.h"
+#include "geometry/offset.h"
+#include "scene/scene.h"
+
+typedef struct isect {
+  vec3 p, perr;       /* point and its floating-point error bound */
+  vec3 ng;            /* unit geometric normal (counter-clockwise winding side) */
+  vec3 ns;            /* unit shading normal (interpolated, or ng) */
+  float u, v;
+  uint32_t tri;
+  const material *m;
+} isect;
+
+void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
+/* The BSDF at it, with the material's texture maps applied at its UV. */
+bsdf bsdf_at(const scene *s, const isect *it);
+static inline vec3 offset_origin_isect(const isect *it, vec3 d) { return offset_origin(it->p, it->perr, it->ng, d); }
+/* Shading frame at it for viewer direction wo, faced for opaque BSDFs (geometric normal
+ * too); returns the frame and updates it->ng. */
+frame shading_frame(isect *it, const bsdf *b, vec3 wo);
+/* A ray leaving it in direction d, from an origin offset past its error bound. */
+static inline ray spawn_ray(const isect *it, vec3 d) {
+  ray r;
+  r.o = offset_origin_isect(it, d);
+  r.d = d;
+  r.tmax = INFINITY;
+  return r;
+}
+
+#endif
