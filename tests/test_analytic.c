@@ -531,6 +531,34 @@ static int thin_lens_circle_of_confusion(void) {
   return 0;
 }
 
+/* The same lens through restir-di and restir-gi: their G-buffer's camera rays are the
+ * tile loop's (camera_ray), so the spot spreads to the same predicted radius and stays
+ * sharp in focus. */
+static int thin_lens_restir(void) {
+  double A = 0.1, F = 2, D = 4;
+  double predicted = A * fabs(1 - F / D) / F / tan(10.0 * M_PI / 180) * 48;
+  const char *integ[2] = {"restir-di", "restir-gi"};
+  for (int k = 0; k < 2; k++) {
+    char json[1024];
+    valo_options o;
+    valo_options_init(&o);
+    snprintf(o.integrator, sizeof o.integrator, "%s", integ[k]);
+    o.spp = 64;
+    double r[2];
+    for (int focus = 0; focus < 2; focus++) {
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0,0,0], \"look_at\": [0,0,-1], \"fov\": 20, \"aperture_radius\": %g, \"focus_distance\": %g},\n" SPOT_SCENE_TAIL,
+               A, focus ? D : F, "", 0.0);
+      r[focus] = spot_radius(json, &o);
+    }
+    fprintf(stderr, "%s spot radius: defocused %.2f px (predicted %.2f), in focus %.2f px\n", integ[k], r[0], predicted, r[1]);
+    CHECK(r[0] > 0 && r[1] >= 0, "%s: render failed", integ[k]);
+    CHECK(fabs(r[0] - predicted) < 0.05 * predicted + 0.5, "%s: defocus radius %.2f px, predicted %.2f", integ[k], r[0], predicted);
+    CHECK(r[1] < 1.5, "%s: in focus the spot should stay within a pixel or so (%.2f)", integ[k], r[1]);
+  }
+  return 0;
+}
+
 /* The same lens on a glTF camera (glTF has no aperture): the camera node sits at x = 1
  * looking down -z with a 20 degree yfov; the JSON file takes it with camera.from_file
  * and adds the lens, or the render options add it (as --aperture/--focus do). With no
@@ -715,7 +743,7 @@ int main(int argc, char **argv) {
                                     {"envmap_orientation", envmap_orientation}, {"envmap_cube", envmap_cube}, {"envmap_irradiance", envmap_irradiance},
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
-                                    {"thin_lens_gltf_camera", thin_lens_gltf_camera},
+                                    {"thin_lens_gltf_camera", thin_lens_gltf_camera}, {"thin_lens_restir", thin_lens_restir},
                                     {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased},
                                     {"adaptive_pays_caustic", adaptive_pays_caustic}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};

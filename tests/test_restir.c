@@ -33,9 +33,12 @@
 #define W 80
 #define H 60
 
+static double g_aperture = VALO_UNSET, g_focus = VALO_UNSET; /* a lens for render_room (threads_identical) */
 static float *render_room_depth(const char *integ, const char *params, int spp, int threads, uint64_t seed, int max_depth) {
   valo_options o;
   valo_options_init(&o);
+  o.aperture_radius = g_aperture;
+  o.focus_distance = g_focus;
   if (max_depth >= 0) o.max_depth = max_depth;
   snprintf(o.integrator, sizeof o.integrator, "%s", integ);
   if (params) snprintf(o.params, sizeof o.params, "%s", params);
@@ -417,17 +420,30 @@ static int reuse_rejects_other_surfaces(void) {
 }
 
 /* ---- determinism and options */
+/* The same image for 1, 2 and 7 threads, through a pinhole and through a thin lens
+ * (--aperture 0.02 --focus 3.4, as the layering check asks). */
 static int threads_identical(void) {
   const char *integ[2] = {"restir-di", "restir-gi"};
+  for (int lens = 0; lens < 2; lens++)
   for (int k = 0; k < 2; k++) {
+    g_aperture = lens ? 0.02 : VALO_UNSET;
+    g_focus = lens ? 3.4 : VALO_UNSET;
     float *a = render_room(integ[k], "temporal=1", 3, 1, 4);
     float *b = render_room(integ[k], "temporal=1", 3, 2, 4);
     float *c = render_room(integ[k], "temporal=1", 3, 7, 4);
     CHECK(a && b && c, "render failed");
     CHECK(!memcmp(a, b, (size_t)W * H * 3 * sizeof(float)) && !memcmp(a, c, (size_t)W * H * 3 * sizeof(float)),
-          "%s: images differ between 1, 2 and 7 threads", integ[k]);
+          "%s%s: images differ between 1, 2 and 7 threads", integ[k], lens ? " with a lens" : "");
+    if (lens) {
+      /* and the lens did something: the image is not the pinhole's */
+      g_aperture = g_focus = VALO_UNSET;
+      float *p = render_room(integ[k], "temporal=1", 3, 2, 4);
+      CHECK(p && memcmp(a, p, (size_t)W * H * 3 * sizeof(float)), "%s: the lens changed nothing", integ[k]);
+      free(p);
+    }
     free(a); free(b); free(c);
   }
+  g_aperture = g_focus = VALO_UNSET;
   return 0;
 }
 

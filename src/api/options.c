@@ -125,7 +125,6 @@ valo_status options_resolve(const valo_options *file, const valo_options *caller
   if (integ->kind == INTEGRATOR_IMAGE) {
     if (o.adaptive) return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with the %s integrator (it renders whole frames)", integ->name);
     if (o.aovs) return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator records no AOVs (albedo:, normal:, depth:, ao:, bent: outputs)", integ->name);
-    if (o.aperture_radius > 0) return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator has a pinhole camera (no aperture)", integ->name);
   }
   out->o = o;
   out->integ = integ;

@@ -4,6 +4,7 @@
  * distance; the pixel is the unoccluded fraction (1 open, 0 closed), camera rays that
  * escape give 0. The same estimator, ao_sample() in integrator.c, makes the ao and bent-
  * normal AOVs beside any integrator (-o ao:FILE, -o bent:FILE). */
+#include "core/streams.h"
 #include "integrator/ao.h"
 #include "core/sampling.h"
 #include "integrator/integrator.h"
@@ -22,7 +23,7 @@ static rgb ao_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   isect_from_hit(c->s, &r, &h, &it);
   vec3 n = v3_faceforward(c->param[1] > 0 ? it.ns : it.ng, v3_neg(r.d));
   vec3 dir;
-  sampler_set_dim(smp, SDIM_EXTRA);
+  sampler_set_dim(smp, SDIM_AO);
   float v = (float)ao_sample(c, &it, n, ao_ray_length(c->s, c->param[0]), smp, ts, &dir);
   return c3(v, v, v);
 }

@@ -1,44 +1,58 @@
 /* camera_path.c — see camera_path.h. */
-#include "integrator/path_common.h"
 #include "integrator/camera_path.h"
 #include "core/sampling.h"
 
-int delta_chain_vertex(const render_ctx *c, const ray *r, rgb beta, int depth, int max_depth, thread_stats *ts, rgb *L, isect *it, bsdf *b,
-                       frame *fr, vec3 *wo) {
+static int walk_max_depth(const render_ctx *c) { return c->max_depth >= 0 ? c->max_depth : CAMERA_PATH_MAX_DEPTH; }
+
+void delta_walk_start(delta_walk *w, ray r, int depth) {
+  w->r = r;
+  w->beta = c3(1, 1, 1);
+  w->L = c3(0, 0, 0);
+  w->depth = depth;
+  w->hit_any = 0;
+}
+
+/* Traces w->r: adds the emission found, and at a surface below the depth limit fills the
+ * vertex and returns 1. */
+static int walk_vertex(delta_walk *w, const render_ctx *c, thread_stats *ts) {
   rgb Le;
-  float w;
-  path_state st0 = path_state_start(r->o); /* emission along a delta chain counts fully */
-  int surface = path_trace_vertex(c, r, &st0, ts, it, &Le, &w);
-  *L = c3_add(*L, c3_mul(beta, Le));
-  if (!surface || depth >= max_depth) return 0;
-  *wo = v3_neg(r->d);
-  *b = bsdf_at(c->s, it);
-  *fr = shading_frame(it, b, *wo);
+  float wgt;
+  path_state st0 = path_state_start(w->r.o); /* emission along a delta chain counts fully */
+  int surface = path_trace_vertex(c, &w->r, &st0, ts, &w->it, &Le, &wgt);
+  w->L = c3_add(w->L, c3_mul(w->beta, Le));
+  if (surface && !w->hit_any) { w->first_p = w->it.p; w->hit_any = 1; }
+  if (!surface || w->depth >= walk_max_depth(c)) return 0;
+  w->wo = v3_neg(w->r.d);
+  w->b = bsdf_at(c->s, &w->it);
+  w->fr = shading_frame(&w->it, &w->b, w->wo);
   return 1;
 }
 
-int delta_chain_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, rgb *beta, ray *r) {
-  path_state st = path_state_start(r->o);
+int delta_walk_continue(delta_walk *w, const render_ctx *c, sampler *smp, thread_stats *ts) {
+  (void)c;
+  sampler_set_dim(smp, sdim_bounce(w->depth, SDIM_LOBE));
+  path_state st = path_state_start(w->r.o);
   rgb wgt;
-  if (!path_continue(it, b, fr, wo, smp, ts, &st, &wgt, r) || !st.specular) return 0;
-  *beta = c3_mul(*beta, wgt);
-  return !c3_black(*beta) && c3_finite(*beta);
+  if (!path_continue(&w->it, &w->b, &w->fr, w->wo, smp, ts, &st, &wgt, &w->r) || !st.specular) return 0;
+  w->beta = c3_mul(w->beta, wgt);
+  w->depth++;
+  return !c3_black(w->beta) && c3_finite(w->beta);
+}
+
+int delta_walk_next(delta_walk *w, const render_ctx *c, sampler *smp, thread_stats *ts) {
+  for (;;) {
+    if (!walk_vertex(w, c, ts)) return 0;
+    if (bsdf_has_smooth(&w->b)) return 1;
+    if (!delta_walk_continue(w, c, smp, ts)) return 0;
+  }
 }
 
 rgb li_shade_through_delta(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, surface_shade_fn shade) {
-  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
-  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
-  for (int depth = 0;; depth++) {
-    isect it;
-    bsdf b;
-    frame fr;
-    vec3 wo;
-    if (!delta_chain_vertex(c, &r, beta, depth, max_depth, ts, &L, &it, &b, &fr, &wo)) break;
-    if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, shade(c, &it, &b, &fr, wo, depth, smp, ts)));
-    /* delta lobes carry the camera path on; a non-delta sample ends it */
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    if (!delta_chain_continue(&it, &b, &fr, wo, smp, ts, &beta, &r)) break;
+  delta_walk w;
+  delta_walk_start(&w, r, 0);
+  while (delta_walk_next(&w, c, smp, ts)) {
+    w.L = c3_add(w.L, c3_mul(w.beta, shade(c, &w.it, &w.b, &w.fr, w.wo, w.depth, smp, ts)));
+    if (!delta_walk_continue(&w, c, smp, ts)) break;
   }
-  return L;
+  return w.L;
 }
-

@@ -21,6 +21,7 @@
  *    within the maximum radius, distance measured in a disc squeezed along the surface
  *    normal (|v|^2 + 16 (v.n)^2) against leaks at corners and through thin walls.
  * Biased (blur of the density estimate), consistent as the photon counts grow. */
+#include "core/streams.h"
 #include "integrator/camera_path.h"
 #include "integrator/integrator.h"
 #include "geometry/pointtree.h"
@@ -235,7 +236,7 @@ static rgb radiance_lookup(const rad_map *rm, vec3 p, vec3 n, float r2max) {
 
 static valo_status photon_prepare(void *state, const render_ctx *c, int sample_index, valo_error *err) {
   photon_state *ps = state;
-  uint64_t k = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + 0x70686f746f6eULL);
+  uint64_t k = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + STREAM_PHOTON);
   valo_status st = shoot_map(c, &ps->global, 0, (uint64_t)c->param[P_GLOBAL], k, err);
   if (st) return st;
   st = build_radiance_photons(ps, c, err);
@@ -266,25 +267,14 @@ static rgb estimate(const photon_map *m, float r2max, int k, const isect *it, co
   return c3_scale(sum, 1 / (PI_F * r2));
 }
 
-/* Outgoing radiance at the hit of gather ray r from the global map, after up to 4 delta
- * bounces. */
-static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, sampler *smp, thread_stats *ts) {
-  rgb beta = c3(1, 1, 1);
-  for (int depth = 0; depth < 5; depth++) {
-    hit h;
-    if (!ctx_intersect(c, &r, &h, ts)) return c3(0, 0, 0);
-    isect it;
-    isect_from_hit(c->s, &r, &h, &it);
-    bsdf b = bsdf_at(c->s, &it);
-    vec3 wo = v3_neg(r.d);
-    frame fr = shading_frame(&it, &b, wo);
-    if (bsdf_has_smooth(&b)) return c3_mul(beta, radiance_lookup(&ps->rad, it.p, fr.n, ps->r2_global));
-    path_state st = path_state_start(r.o);
-    rgb w;
-    if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &w, &r)) return c3(0, 0, 0);
-    beta = c3_mul(beta, w);
-  }
-  return c3(0, 0, 0);
+/* Outgoing radiance at the first non-delta surface gather ray r reaches (the walk through
+ * delta lobes, starting at depth `depth`), from the global map; its emission is direct
+ * light, which next-event estimation counts. */
+static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, int depth, sampler *smp, thread_stats *ts) {
+  delta_walk w;
+  delta_walk_start(&w, r, depth);
+  if (!delta_walk_next(&w, c, smp, ts)) return c3(0, 0, 0);
+  return c3_mul(w.beta, radiance_lookup(&ps->rad, w.it.p, w.fr.n, ps->r2_global));
 }
 
 /* At a camera path's first non-delta surface: direct light by NEE, the caustic map, and
@@ -303,7 +293,7 @@ static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, con
     bsdf_sample bs;
     vec3 wi;
     if (!sample_bsdf_world(it, b, fr, wo, &gs, ts, &bs, &wi) || bs.delta) continue; /* delta lobes: the camera chain */
-    G = c3_add(G, c3_mul(bs.weight, gather_radiance(c, ps, spawn_ray(it, wi), &gs, ts)));
+    G = c3_add(G, c3_mul(bs.weight, gather_radiance(c, ps, spawn_ray(it, wi), depth + 1, &gs, ts)));
   }
   sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
   rgb L = estimate_direct_nomis(c, it, b, fr, wo, smp, ts);

@@ -36,38 +36,24 @@ int restir_wrs_take(float *w_sum, float w, float u) {
   return u * *w_sum < w;
 }
 
-/* ---- G-buffer: the camera ray of pixel (x, y) this frame, followed through delta lobes */
+/* ---- G-buffer: the camera ray of pixel (x, y) this frame (through the lens), walked
+ * through delta lobes to the first surface with a non-delta lobe (camera_path.h) */
 static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y, gpix *g, thread_stats *ts) {
   memset(g, 0, sizeof *g);
   uint64_t pix = (uint64_t)y * (uint64_t)c->width + (uint64_t)x;
   sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)f->frame, (sampler_kind)c->sampler_kind);
-  float jx, jy;
-  sampler_set_dim(&smp, RD_FILM);
-  sampler_2d(&smp, &jx, &jy);
-  ray r = {f->cam.o, cam_view_dir(&f->cam, (float)x + jx, (float)y + jy), INFINITY};
   ts->rays++;
-  rgb beta = c3(1, 1, 1), L = c3(0, 0, 0);
-  int max_depth = c->max_depth >= 0 ? c->max_depth : 32;
-  for (int depth = 0;; depth++) {
-    isect it;
-    bsdf b;
-    frame fr;
-    vec3 wo;
-    if (!delta_chain_vertex(c, &r, beta, depth, max_depth, ts, &L, &it, &b, &fr, &wo)) break;
-    if (depth == 0) g->depth = v3_len(v3_sub(it.p, f->cam.o));
-    if (bsdf_has_smooth(&b)) {
-      g->it = it; g->fr = fr; g->b = b; g->wo = wo; g->beta = beta; g->valid = 1; g->chain = depth > 0;
-      break;
-    }
-    sampler_set_dim(&smp, RD_DELTA + depth);
-    if (!delta_chain_continue(&it, &b, &fr, wo, &smp, ts, &beta, &r) || depth >= 16) break;
+  delta_walk w;
+  delta_walk_start(&w, camera_ray(f->lens, x, y, &smp), 0);
+  if (delta_walk_next(&w, c, &smp, ts)) {
+    g->it = w.it; g->fr = w.fr; g->b = w.b; g->wo = w.wo; g->beta = w.beta; g->valid = 1; g->chain = w.depth > 0;
   }
-  g->Le = L;
+  if (w.hit_any) g->depth = v3_len(v3_sub(w.first_p, f->cam.o));
+  g->Le = w.L;
 }
 
-
 sampler restir_pixel_stream(const render_ctx *c, const frame_ctx *f, size_t pix, uint32_t dim) {
-  sampler s = sampler_make(c->seed ^ 0x5bd1e995u, pix, (uint64_t)f->frame);
+  sampler s = sampler_make(c->seed ^ STREAM_RESTIR_PIXEL, pix, (uint64_t)f->frame);
   sampler_set_dim(&s, dim);
   return s;
 }
@@ -224,12 +210,12 @@ static void stage_reuse(void *user, int64_t row, int thread) {
     float cap = 0;
     sampler rng;
     if (temporal) {
-      rng = restir_pixel_stream(j->c, j->f, pix, RD_TEMPORAL + 7 * (uint32_t)rj->gi);
+      rng = restir_pixel_stream(j->c, j->f, pix, RDIM_TEMPORAL + 7 * (uint32_t)rj->gi);
       int64_t q = reproject(s, cfg, j->f, g);
       if (q >= 0) { from[1] = (size_t)q; gs[1] = &s->g_prev[q]; n = 2; }
       cap = rj->gi ? cfg->history : cfg->history * (float)cfg->candidates;
     } else if (g->valid) {
-      rng = restir_pixel_stream(j->c, j->f, pix, RD_SPATIAL + 256 * (uint32_t)rj->round + 7 * (uint32_t)rj->gi);
+      rng = restir_pixel_stream(j->c, j->f, pix, RDIM_SPATIAL + 256 * (uint32_t)rj->round + 7 * (uint32_t)rj->gi);
       n += neighbours(s, cfg, x, (int)row, g, &rng, from + 1);
       for (int i = 1; i < n; i++) gs[i] = &s->g[from[i]];
     }
@@ -264,7 +250,7 @@ static void stage_shade(void *user, int64_t row, int thread) {
       if (!s->gi || s->direct_restir) Lr = restir_di_shade(c, g, &s->di[s->di_final][pix]);
       else {
         sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)c->sampler_kind);
-        sampler_set_dim(&smp, RD_NEE);
+        sampler_set_dim(&smp, SDIM_RESTIR_NEE);
         isect it = g->it;
         Lr = estimate_direct_nomis(c, &it, &g->b, &g->fr, g->wo, &smp, ts);
       }

@@ -94,8 +94,8 @@ void restir_stage_di_initial(void *user, int64_t row, int thread) {
     memset(r, 0, sizeof *r);
     if (!g->valid) continue;
     sampler smp = sampler_make_kind(j->c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)j->c->sampler_kind);
-    sampler_set_dim(&smp, RD_CAND);
-    sampler rng = restir_pixel_stream(j->c, j->f, pix, RD_CAND);
+    sampler_set_dim(&smp, SDIM_RESTIR_CAND);
+    sampler rng = restir_pixel_stream(j->c, j->f, pix, RDIM_CAND);
     light_li li;
     /* visibility reuse: a shadowed survivor passes nothing on */
     if (restir_di_candidates(j->c, &g->it, &g->b, &g->fr, g->wo, s->dcfg.candidates, &smp, &rng, r, &li) && !di_visible(j->c, g, &li, &j->f->ts[thread]))

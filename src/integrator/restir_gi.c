@@ -71,7 +71,7 @@ void restir_stage_gi_initial(void *user, int64_t row, int thread) {
     if (!g->valid) continue;
     r->M = 1;
     sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)c->sampler_kind);
-    sampler_set_dim(&smp, RD_GI_DIR);
+    sampler_set_dim(&smp, SDIM_RESTIR_GI_DIR);
     bsdf_sample bs;
     vec3 wi;
     isect it = g->it;
@@ -81,7 +81,7 @@ void restir_stage_gi_initial(void *user, int64_t row, int thread) {
     if (!ctx_intersect(c, &ry, &h, ts)) continue; /* the environment is direct light */
     isect hs;
     isect_from_hit(c->s, &ry, &h, &hs);
-    sampler_set_dim(&smp, RD_GI_PATH);
+    sampler_set_dim(&smp, SDIM_RESTIR_GI_PATH);
     sampler ps = sampler_child(&smp, 0, 1);
     rgb Lo = path_radiance(c, ry, &ps, ts, 0);
     if (!sample_usable(ts, Lo)) continue; /* never kept: it would live on as history */

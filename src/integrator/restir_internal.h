@@ -4,6 +4,7 @@
 #ifndef VALO_RESTIR_INTERNAL_H
 #define VALO_RESTIR_INTERNAL_H
 #include "integrator/restir.h"
+#include "core/streams.h"
 
 /* Parameter indices: restir-gi's table extends restir-di's (the first nine are the same). */
 enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIASED, P_NORMAL, P_DEPTH, P_DIRECT, P_JACOBIAN, P_DIRECT_SPATIAL,
@@ -11,7 +12,7 @@ enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIA
 extern const integrator_param restir_di_params[];
 
 /* ---- per-pixel random streams: (seed, pixel, frame); stages use fixed dimensions */
-enum { RD_FILM = 0, RD_DELTA = 1, RD_GI_DIR = 40, RD_GI_PATH = 42, RD_NEE = 43, RD_CAND = 64, RD_TEMPORAL = 0x1000, RD_SPATIAL = 0x2000 };
+/* Random dimensions: core/streams.h (SDIM_RESTIR_*, RDIM_*). */
 
 typedef struct gpix {
   isect it;

@@ -23,6 +23,7 @@
  *    over the cone the sphere subtends at x (the whole sphere of directions when x is
  *    inside), estimated with `cone_samples` directions drawn uniformly in the cone. No
  *    1/d^2 singularity: no splotches on glossy surfaces; consistent as count grows. */
+#include "core/streams.h"
 #include "integrator/camera_path.h"
 #include "integrator/integrator.h"
 #include "integrator/lightpath.h"
@@ -106,12 +107,12 @@ static valo_status vpl_prepare(void *state, const render_ctx *c, int sample_inde
   free(vs->v);
   vs->v = NULL;
   vs->n = 0;
-  uint64_t key = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + 0x76706c73ULL);
+  uint64_t key = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + STREAM_VPL);
   lp_set set;
   if (vs->paths == 0) {
     /* How many paths give `count` lights: measured once on a pilot set of its own (so the
      * number of paths does not depend on the paths used: the estimate stays unbiased). */
-    valo_status st = lightpath_shoot_paths(c, rng_mix64(c->seed + 0x70696c6f74ULL), 16384, sizeof(vpl), visit, NULL, &set, err);
+    valo_status st = lightpath_shoot_paths(c, rng_mix64(c->seed + STREAM_VPL_PILOT), 16384, sizeof(vpl), visit, NULL, &set, err);
     if (st) return st;
     free(set.rec);
     double per_path = set.emitted ? (double)set.n / (double)set.emitted : 0;
@@ -187,7 +188,7 @@ static rgb vpl_contrib(const render_ctx *c, const vpl_state *vs, const vpl *l, u
   frame cf = frame_from_n(w);
   rgb acc = c3(0, 0, 0);
   sampler ls = sampler_child(smp, i, vs->n);
-  sampler_set_dim(&ls, SDIM_EXTRA);
+  sampler_set_dim(&ls, CDIM_VSL_CONE);
   for (int m = 0; m < cone; m++) {
     float u1, u2;
     sampler_2d(&ls, &u1, &u2);
@@ -227,7 +228,7 @@ static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, con
     }
     if (!(total > 0)) return sum;
     sampler us = sampler_child(smp, 0, 1);
-    sampler_set_dim(&us, SDIM_EXTRA + 16); /* apart from compensate's SDIM_EXTRA stream */
+    sampler_set_dim(&us, CDIM_VPL_SAMPLED);
     float u0 = sampler_1d(&us);
     uint32_t i = 0;
     for (int m = 0; m < S; m++) {
@@ -255,7 +256,7 @@ static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, con
 static rgb compensate(const render_ctx *c, const vpl_state *vs, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                       thread_stats *ts) {
   sampler cs = sampler_child(smp, 0, 1);
-  sampler_set_dim(&cs, SDIM_EXTRA);
+  sampler_set_dim(&cs, CDIM_VPL_COMPENSATE);
   bsdf_sample bs;
   vec3 wi, wo_l = frame_to_local(fr, wo);
   if (!sample_bsdf_world(it, b, fr, wo, &cs, ts, &bs, &wi) || bs.delta || !(bs.pdf > 0)) return c3(0, 0, 0);
