@@ -50,52 +50,30 @@ static void usage_render(FILE *f) {
           "                         repeat for several outputs (default: SCENE-NAME.png);\n"
           "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs,\n"
           "                         ao:FILE ambient occlusion (ao.distance), bent:FILE the bent normal,\n"
-          "                         spp:FILE the samples each pixel received\n"
-          "  --spp N                samples per pixel (default 16)\n"
-          "  --time SECONDS         time budget: stop after the pass that reaches it\n"
-          "                         (with --spp, whichever comes first)\n"
-          "  --frames N             render a sequence of N frames (the scene's camera keyframes,\n"
-          "                         or a static camera), each at --spp; outputs with a frame\n"
-          "                         pattern (out_%%04d.png) get every frame, plain names the last\n"
-          "  --threads N            worker threads (default: all cores)\n"
-          "  --seed N               random seed (default 1); same seed, same image, any thread count\n"
-          "  --res WxH              film resolution (default 256x256)\n"
-          "  --integrator NAME      integrator:");
-  for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(f, " %s", *n);
+          "                         spp:FILE the samples each pixel received\n");
+  /* the declared options (one table: their flags, defaults, ranges and help) */
+  for (int i = 0; valo_option_at(i); i++) {
+    const valo_option_info *o = valo_option_at(i);
+    if (!o->flag) continue;
+    char head[64];
+    snprintf(head, sizeof head, "%s%s%s", o->flag, o->metavar ? " " : "", o->metavar ? o->metavar : "");
+    const char *h = o->help;
+    int first = 1;
+    while (*h) {
+      size_t n = strcspn(h, "\n");
+      fprintf(f, "  %-22s %.*s\n", first ? head : "", (int)n, h);
+      first = 0;
+      h += n;
+      if (*h) h++;
+    }
+    if (!strcmp(o->flag, "--integrator")) {
+      fprintf(f, "  %-22s one of:", "");
+      for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(f, " %s", *n);
+      fprintf(f, "\n");
+    }
+  }
   fprintf(f,
-          " (default path)\n"
-          "  --param NAME=VALUE     an integrator parameter (repeatable; NAME or INTEGRATOR.NAME);\n"
-          "                         --help-integrators lists them with defaults\n"
-          "  --accel NAME           kdtree (default) or embree\n"
-          "  --sampler NAME         sobol (default: Owen-scrambled Sobol) or independent\n"
-          "  --light-sampler NAME   grid (default: lights near the point first, in scenes\n"
-          "                         with more than 64 lights) or power\n"
-          "  --max-depth N          maximum path length (default -1: unlimited, Russian roulette\n"
-          "                         ends paths)\n"
-          "  --env FILE             light by this environment map (.exr/.hdr/.pfm), replacing\n"
-          "                         the scene's; a mesh file without lights gets a uniform\n"
-          "                         white environment otherwise\n"
-          "  --env-scale S          multiply the --env map by S (default 1)\n"
-          "  --env-rotation DEG     turn the --env map about the up axis (default 0)\n"
-          "  --up y|z               up axis of a mesh file framed automatically (default y;\n"
-          "                         z for scans and CAD models)\n"
-          "  --aperture R           thin-lens radius in scene units (0 = pinhole); overrides\n"
-          "                         the scene camera's\n"
-          "  --focus D              focus distance along the view axis (default: the scene's; for\n"
-          "                         a file camera, the surface at the image centre)\n"
-          "  --spectral             spectral rendering (path): 4 wavelengths per path, dispersion\n"
-          "  --adaptive             adaptive sampling: --spp is the average per pixel; the\n"
-          "                         noisiest pixels get more (spp:FILE writes the count map)\n"
-          "  --adaptive-rule R      error (default: relative error from the neighbours,\n"
-          "                         unbiased) or digest (the design digest's priority on the\n"
-          "                         pixel itself: biased dark on rare bright paths); implies\n"
-          "                         --adaptive\n"
-          "  --noise-threshold X    adaptive sampling that stops once every pixel's relative\n"
-          "                         standard error is below X (e.g. 0.01); implies --adaptive\n"
-          "  --exposure STOPS       PNG exposure (default 0)\n"
-          "  --tonemap NAME         PNG tone curve: clamp (default), log, reinhard, aces\n"
-          "  --bloom STRENGTH       PNG bloom: add STRENGTH x a Gaussian blur of what exceeds 1\n"
-          "  --bloom-radius PIXELS  bloom blur standard deviation (default 1/100 of the width)\n"
+          "  --help-integrators     the integrators' parameters, with defaults and ranges\n"
           "  -q, --quiet            no progress or summary\n"
           "  -h, --help             this text\n");
 }
@@ -105,23 +83,6 @@ static size_t aov_prefix(const char *out) {
   static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
   for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++)
     if (!strncmp(out, prefixes[k], strlen(prefixes[k]))) return strlen(prefixes[k]);
-  return 0;
-}
-
-static int parse_int(const char *s, long lo, long hi, long *out) {
-  char *end;
-  errno = 0;
-  long v = strtol(s, &end, 10);
-  if (errno || end == s || *end || v < lo || v > hi) return -1;
-  *out = v;
-  return 0;
-}
-static int parse_double(const char *s, double lo, double hi, double *out) {
-  char *end;
-  errno = 0;
-  double v = strtod(s, &end);
-  if (errno || end == s || *end || !(v >= lo && v <= hi)) return -1;
-  *out = v;
   return 0;
 }
 
@@ -216,18 +177,6 @@ static int cmd_render(int argc, char **argv) {
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
     const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-    long lv;
-    double dv;
-#define NEED_VALUE()                                                            \
-  do {                                                                          \
-    if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; } \
-    i++;                                                                        \
-  } while (0)
-#define BAD_VALUE(what)                                                                             \
-  do {                                                                                              \
-    fprintf(stderr, "valo: %s: invalid value \"%s\" (%s)\n", a, val, what);                         \
-    return EXIT_USAGE;                                                                              \
-  } while (0)
     if (!strcmp(a, "-h") || !strcmp(a, "--help")) { usage_render(stdout); return 0; }
     if (!strcmp(a, "--help-integrators")) {
       char buf[8192];
@@ -235,126 +184,30 @@ static int cmd_render(int argc, char **argv) {
         if (!valo_integrator_describe(*n, buf, sizeof buf)) fputs(buf, stdout);
       return 0;
     }
-    else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) quiet = 1;
-    else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-      NEED_VALUE();
+    if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) { quiet = 1; continue; }
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+      if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
+      i++;
       if (nout == MAX_OUTPUTS) { fprintf(stderr, "valo: at most %d outputs\n", MAX_OUTPUTS); return EXIT_USAGE; }
       outputs[nout++] = val;
-    } else if (!strcmp(a, "--spp")) {
-      NEED_VALUE();
-      if (parse_int(val, 1, 1048576, &lv)) BAD_VALUE("a whole number from 1 to 1048576");
-      opt.spp = (int)lv;
-    } else if (!strcmp(a, "--time")) {
-      NEED_VALUE();
-      if (parse_double(val, 0.001, 1e8, &dv)) BAD_VALUE("seconds, > 0");
-      opt.time_budget = dv;
-    } else if (!strcmp(a, "--frames")) {
-      NEED_VALUE();
-      if (parse_int(val, 1, 1000000, &lv)) BAD_VALUE("a whole number from 1 to 1000000");
-      opt.frames = (int)lv;
-    } else if (!strcmp(a, "--threads")) {
-      NEED_VALUE();
-      if (parse_int(val, 1, 1024, &lv)) BAD_VALUE("a whole number from 1 to 1024");
-      opt.threads = (int)lv;
-    } else if (!strcmp(a, "--seed")) {
-      NEED_VALUE();
-      if (parse_int(val, 0, LONG_MAX, &lv)) BAD_VALUE("a whole number >= 0");
-      opt.seed = lv;
-    } else if (!strcmp(a, "--res")) {
-      NEED_VALUE();
-      int w = 0, h = 0;
-      char extra;
-      if (sscanf(val, "%dx%d%c", &w, &h, &extra) != 2 || w < 1 || h < 1 || w > 16384 || h > 16384)
-        BAD_VALUE("WIDTHxHEIGHT, each 1..16384");
-      opt.width = w; opt.height = h;
-    } else if (!strcmp(a, "--integrator")) {
-      NEED_VALUE();
-      int known = 0;
-      for (const char *const *n = valo_integrator_names(); *n; n++) known |= !strcmp(*n, val);
-      if (!known) {
-        fprintf(stderr, "valo: --integrator: unknown integrator \"%s\" (one of:", val);
-        for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(stderr, " %s", *n);
-        fprintf(stderr, ")\n");
+      continue;
+    }
+    if (a[0] == '-' && a[1]) {
+      /* a declared option (valo_option_at): a flag alone, or a flag and its value */
+      const valo_option_info *info = NULL;
+      for (int k = 0; valo_option_at(k); k++)
+        if (valo_option_at(k)->flag && !strcmp(valo_option_at(k)->flag, a)) info = valo_option_at(k);
+      if (!info) { fprintf(stderr, "valo: unknown option \"%s\" (see valo render --help)\n", a); return EXIT_USAGE; }
+      if (info->metavar && !val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
+      valo_error perr;
+      if (valo_option_set(a, info->metavar ? val : NULL, &opt, &lo, &oo, &perr)) {
+        fprintf(stderr, "valo: %s: %s\n", a, perr.message);
         return EXIT_USAGE;
       }
-      snprintf(opt.integrator, sizeof opt.integrator, "%s", val);
-    } else if (!strcmp(a, "--param")) {
-      NEED_VALUE();
-      if (!strchr(val, '=')) { fprintf(stderr, "valo: --param: expected NAME=VALUE, got \"%s\"\n", val); return EXIT_USAGE; }
-      size_t used = strlen(opt.params);
-      if (used + strlen(val) + 2 > sizeof opt.params) { fprintf(stderr, "valo: --param: too many parameters\n"); return EXIT_USAGE; }
-      snprintf(opt.params + used, sizeof opt.params - used, "%s%s", used ? " " : "", val);
-    } else if (!strcmp(a, "--light-sampler")) {
-      NEED_VALUE();
-      if (strcmp(val, "grid") && strcmp(val, "power")) BAD_VALUE("grid or power");
-      snprintf(opt.light_sampler, sizeof opt.light_sampler, "%s", val);
-    } else if (!strcmp(a, "--sampler")) {
-      NEED_VALUE();
-      if (strcmp(val, "sobol") && strcmp(val, "independent")) BAD_VALUE("sobol or independent");
-      snprintf(opt.sampler, sizeof opt.sampler, "%s", val);
-    } else if (!strcmp(a, "--env")) {
-      NEED_VALUE();
-      snprintf(lo.env_file, sizeof lo.env_file, "%s", val);
-    } else if (!strcmp(a, "--env-scale")) {
-      NEED_VALUE();
-      if (parse_double(val, 0, 1e9, &dv)) BAD_VALUE("a scale >= 0");
-      lo.env_scale = dv;
-    } else if (!strcmp(a, "--env-rotation")) {
-      NEED_VALUE();
-      if (parse_double(val, -36000, 36000, &dv)) BAD_VALUE("degrees");
-      lo.env_rotation = dv;
-    } else if (!strcmp(a, "--up")) {
-      NEED_VALUE();
-      if (strcmp(val, "y") && strcmp(val, "z")) BAD_VALUE("y or z");
-      snprintf(lo.up, sizeof lo.up, "%s", val);
-    } else if (!strcmp(a, "--accel")) {
-      NEED_VALUE();
-      if (strcmp(val, "kdtree") && strcmp(val, "embree")) BAD_VALUE("kdtree or embree");
-      snprintf(opt.accel, sizeof opt.accel, "%s", val);
-    } else if (!strcmp(a, "--max-depth")) {
-      NEED_VALUE();
-      if (parse_int(val, -1, 100000, &lv)) BAD_VALUE("-1 or a whole number >= 0");
-      opt.max_depth = (int)lv;
-    } else if (!strcmp(a, "--aperture")) {
-      NEED_VALUE();
-      if (parse_double(val, 0, 1e6, &dv)) BAD_VALUE("a lens radius in scene units, >= 0");
-      opt.aperture_radius = dv;
-    } else if (!strcmp(a, "--focus")) {
-      NEED_VALUE();
-      if (parse_double(val, 1e-6, 1e9, &dv)) BAD_VALUE("a distance in scene units, > 0");
-      opt.focus_distance = dv;
-    } else if (!strcmp(a, "--spectral")) {
-      opt.spectral = 1;
-    } else if (!strcmp(a, "--adaptive")) {
-      opt.adaptive = VALO_ADAPTIVE_ERROR;
-    } else if (!strcmp(a, "--adaptive-rule")) {
-      NEED_VALUE();
-      if (strcmp(val, "error") && strcmp(val, "digest")) BAD_VALUE("error or digest");
-      opt.adaptive = !strcmp(val, "digest") ? VALO_ADAPTIVE_DIGEST : VALO_ADAPTIVE_ERROR;
-    } else if (!strcmp(a, "--noise-threshold")) {
-      NEED_VALUE();
-      if (parse_double(val, 1e-6, 10, &dv)) BAD_VALUE("a relative error, 1e-6..10");
-      opt.noise_threshold = dv;
-    } else if (!strcmp(a, "--exposure")) {
-      NEED_VALUE();
-      if (parse_double(val, -100, 100, &dv)) BAD_VALUE("stops, -100..100");
-      oo.exposure = (float)dv;
-    } else if (!strcmp(a, "--bloom")) {
-      NEED_VALUE();
-      if (parse_double(val, 0, 100, &dv)) BAD_VALUE("0..100");
-      oo.bloom = (float)dv;
-    } else if (!strcmp(a, "--bloom-radius")) {
-      NEED_VALUE();
-      if (parse_double(val, 0.1, 500, &dv)) BAD_VALUE("pixels, 0.1..500");
-      oo.bloom_radius = (float)dv;
-    } else if (!strcmp(a, "--tonemap")) {
-      NEED_VALUE();
-      if (strcmp(val, "clamp") && strcmp(val, "log") && strcmp(val, "reinhard") && strcmp(val, "aces")) BAD_VALUE("clamp, log, reinhard or aces");
-      snprintf(oo.tonemap, sizeof oo.tonemap, "%s", val);
-    } else if (a[0] == '-' && a[1]) {
-      fprintf(stderr, "valo: unknown option \"%s\" (see valo render --help)\n", a);
-      return EXIT_USAGE;
-    } else if (!scene_path) scene_path = a;
+      if (info->metavar) i++;
+      continue;
+    }
+    if (!scene_path) scene_path = a;
     else { fprintf(stderr, "valo: more than one scene given (\"%s\" and \"%s\")\n", scene_path, a); return EXIT_USAGE; }
   }
   if (!scene_path) { fprintf(stderr, "valo: no scene given\n"); usage_render(stderr); return EXIT_USAGE; }
@@ -408,7 +261,7 @@ static int cmd_render(int argc, char **argv) {
   valo_scene_file_options(sc, &file_opts);
   /* --time alone: the scene file's spp (if any) still bounds the render, whichever comes
    * first; otherwise only the time does. */
-  if (opt.time_budget != VALO_UNSET && opt.spp == VALO_UNSET) opt.spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
+  if (opt.time_budget > 0 && opt.spp == VALO_UNSET) opt.spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
   double load_s = now_seconds() - t0;
   valo_render *r = NULL;
   if (opt.params[0]) {

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "scene/envmap.h"
 #include "core/spectrum.h"
+#include "core/options.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <limits.h>
@@ -91,6 +92,40 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
   return VALO_OK;
 }
 
+/* The keys of `section` ("render", "film") that the declared options table names
+ * ("render.spp", ...): each value, a number or a string, is set through the same
+ * declaration the command line uses (core/options.h), so ranges and names agree. Objects
+ * (an integrator's parameters) are left to the caller. */
+static valo_status json_settings(jctx *c, const cJSON *o, const char *section) {
+  for (const cJSON *it = o->child; it; it = it->next) {
+    if (cJSON_IsObject(it)) continue;
+    char key[160];
+    snprintf(key, sizeof key, "%s.%s", section, it->string);
+    const option_decl *d = option_find_json(key);
+    if (!d) {
+      char allowed[600] = "";
+      size_t n = strlen(section);
+      for (const option_decl *e = option_table; e->info.flag || e->info.json; e++)
+        if (e->info.json && !strncmp(e->info.json, section, n) && e->info.json[n] == '.') {
+          strncat(allowed, " ", sizeof allowed - strlen(allowed) - 1);
+          strncat(allowed, e->info.json + n + 1, sizeof allowed - strlen(allowed) - 1);
+        }
+      char msg[900];
+      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed:%s%s)", it->string, allowed,
+               strcmp(section, "render") ? "" : ", or an integrator's name with an object of its parameters");
+      return json_bad(c, section, msg);
+    }
+    char text[256];
+    int name = d->type == OPT_NAME || d->type == OPT_CHOICE;
+    if (!name && cJSON_IsNumber(it)) snprintf(text, sizeof text, "%.17g", it->valuedouble);
+    else if (name && cJSON_IsString(it)) snprintf(text, sizeof text, "%s", it->valuestring);
+    else return json_bad(c, key, name ? "must be a string" : "must be a number");
+    valo_error e;
+    if (option_set(d, text, c->file, NULL, NULL, &e)) return json_bad(c, key, e.message);
+  }
+  return VALO_OK;
+}
+
 static valo_status parse_render(jctx *c, const cJSON *o) {
   valo_options *op = c->file;
   if (!cJSON_IsObject(o)) return json_bad(c, "render", "must be an object");
@@ -111,38 +146,7 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
       if (n < 0 || (size_t)n >= sizeof op->params - used) return json_bad(c, w, "too many parameters");
     }
   }
-  static const char *const keys[] = {"integrator", "spp", "seed", "max_depth", "accel", "time", "sampler", "light_sampler", NULL};
-  for (const cJSON *it = o->child; it; it = it->next) {
-    int ok = cJSON_IsObject(it);
-    for (const char *const *a = keys; *a && !ok; a++) ok = !strcmp(it->string, *a);
-    if (!ok) {
-      char msg[400];
-      snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed: integrator spp seed max_depth accel time sampler light_sampler, or an "
-                                "integrator's name with an object of its parameters)", it->string);
-      return json_bad(c, "render", msg);
-    }
-  }
-  const char *s = NULL;
-  TRY(json_get_str(c, o, "integrator", "render", &s));
-  if (s) snprintf(op->integrator, sizeof op->integrator, "%s", s);
-  s = NULL;
-  TRY(json_get_str(c, o, "accel", "render", &s));
-  if (s) snprintf(op->accel, sizeof op->accel, "%s", s);
-  s = NULL;
-  TRY(json_get_str(c, o, "sampler", "render", &s));
-  if (s && strcmp(s, "sobol") && strcmp(s, "independent")) return json_bad(c, "render.sampler", "must be \"sobol\" or \"independent\"");
-  if (s) snprintf(op->sampler, sizeof op->sampler, "%s", s);
-  s = NULL;
-  TRY(json_get_str(c, o, "light_sampler", "render", &s));
-  if (s && strcmp(s, "grid") && strcmp(s, "power")) return json_bad(c, "render.light_sampler", "must be \"grid\" or \"power\"");
-  if (s) snprintf(op->light_sampler, sizeof op->light_sampler, "%s", s);
-  TRY(json_get_int(c, o, "spp", "render", 1, 1048576, &op->spp));
-  double seed = -1;
-  TRY(json_get_num(c, o, "seed", "render", 0, 9007199254740992.0, &seed));
-  if (seed >= 0) op->seed = (int64_t)seed;
-  TRY(json_get_int(c, o, "max_depth", "render", -1, 100000, &op->max_depth));
-  TRY(json_get_num(c, o, "time", "render", 0, 1e9, &op->time_budget));
-  return VALO_OK;
+  return json_settings(c, o, "render");
 }
 
 static valo_status parse_transform(jctx *c, const cJSON *o, const char *where, float xf[12]) {
@@ -355,10 +359,8 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
   if (cam) TRY(parse_camera(&c, cam));
   const cJSON *film = cJSON_GetObjectItemCaseSensitive(root, "film");
   if (film) {
-    static const char *const fk[] = {"width", "height", NULL};
-    TRY(json_check_keys(&c, film, "film", fk));
-    TRY(json_get_int(&c, film, "width", "film", 1, 16384, &settings->width));
-    TRY(json_get_int(&c, film, "height", "film", 1, 16384, &settings->height));
+    if (!cJSON_IsObject(film)) { st = json_bad(&c, "film", "must be an object"); goto done; }
+    TRY(json_settings(&c, film, "film"));
   }
   const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
   if (render) TRY(parse_render(&c, render));
