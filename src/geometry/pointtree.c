@@ -43,18 +43,23 @@ static void build(point_tree *t, uint32_t lo, uint32_t hi) {
   }
 }
 
-int point_tree_build(point_tree *t, const vec3 *pts, uint32_t n) {
+int point_tree_build(point_tree *t, const vec3 *pts, uint32_t n) { return point_set_build(t, pts, n, sizeof *pts, 0, NULL); }
+
+int point_set_build(point_tree *t, const void *recs, uint32_t n, size_t stride, size_t pos_offset, void **out) {
   memset(t, 0, sizeof *t);
+  if (out) *out = NULL;
   t->p = malloc((size_t)(n ? n : 1) * sizeof *t->p);
   t->id = malloc((size_t)(n ? n : 1) * sizeof *t->id);
   t->axis = malloc(n ? n : 1);
   if (!t->p || !t->id || !t->axis) { point_tree_free(t); return -1; }
-  if (n) memcpy(t->p, pts, (size_t)n * sizeof *pts);
+  for (uint32_t i = 0; i < n; i++) memcpy(&t->p[i], (const char *)recs + (size_t)i * stride + pos_offset, sizeof(vec3));
+  const vec3 *pts = t->p;
   for (uint32_t i = 0; i < n; i++) t->id[i] = i;
   t->n = n;
   t->bounds = bbox_empty();
   for (uint32_t i = 0; i < n; i++) t->bounds = bbox_add(t->bounds, pts[i]);
   build(t, 0, n);
+  if (out && point_tree_gather(t, recs, stride, out)) { point_tree_free(t); return -1; }
   return 0;
 }
 
@@ -171,4 +176,12 @@ void point_tree_radius_halfspace(const point_tree *t, vec3 q, float r2, vec3 n, 
   hs_q s = {q, n, r2, eps, fn, user};
   const float bmin[3] = {t->bounds.lo.x, t->bounds.lo.y, t->bounds.lo.z}, bmax[3] = {t->bounds.hi.x, t->bounds.hi.y, t->bounds.hi.z};
   hs_rec(t, &s, 0, t->n, bmin, bmax);
+}
+
+int point_tree_gather(const point_tree *t, const void *in, size_t size, void **out) {
+  char *o = malloc((size_t)(t->n ? t->n : 1) * size);
+  *out = o;
+  if (!o) return -1;
+  for (uint32_t i = 0; i < t->n; i++) memcpy(o + (size_t)i * size, (const char *)in + (size_t)t->id[i] * size, size);
+  return 0;
 }

@@ -8,6 +8,7 @@
 #ifndef VALO_POINTTREE_H
 #define VALO_POINTTREE_H
 #include "core/vec.h"
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct point_tree {
@@ -20,6 +21,13 @@ typedef struct point_tree {
 
 /* Builds the tree over pts[0..n) (copied). Returns 0, or -1 when out of memory. */
 int point_tree_build(point_tree *t, const vec3 *pts, uint32_t n);
+/* The one point-set build (photon maps, VPL radii, proximity points): the tree over the
+ * positions at byte `pos_offset` of n records of `stride` bytes, and, when out is not
+ * NULL, the records in tree order in *out (malloc'd; free it). 0, or -1 out of memory. */
+int point_set_build(point_tree *t, const void *recs, uint32_t n, size_t stride, size_t pos_offset, void **out);
+/* Another array of the same points into tree order: (*out)[i] = in[t->id[i]], elements
+ * of `size` bytes (malloc'd). 0, or -1 out of memory. */
+int point_tree_gather(const point_tree *t, const void *in, size_t size, void **out);
 void point_tree_free(point_tree *t);
 
 typedef struct point_near { float d2; uint32_t i; } point_near; /* i: tree order */

@@ -29,6 +29,7 @@
 #include "core/threadpool.h"
 #include "core/error.h"
 #include "core/sampling.h"
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -158,16 +159,9 @@ static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, ui
   uint32_t n = set.n;
   float inv = set.emitted ? 1.0f / (float)set.emitted : 0;
   for (uint32_t i = 0; i < n; i++) all[i].power = c3_scale(all[i].power, inv);
-  vec3 *pos = malloc((size_t)(n ? n : 1) * sizeof *pos);
-  if (!pos) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (uint32_t i = 0; i < n; i++) pos[i] = all[i].p;
-  int rc = point_tree_build(&m->tree, pos, n);
-  free(pos);
-  if (rc) { free(all); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  m->ph = malloc((size_t)(n ? n : 1) * sizeof *m->ph);
-  if (!m->ph) { free(all); map_free(m); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (uint32_t i = 0; i < n; i++) m->ph[i] = all[m->tree.id[i]];
+  int rc = point_set_build(&m->tree, all, n, sizeof *all, offsetof(photon, p), (void **)&m->ph);
   free(all);
+  if (rc) { map_free(m); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   m->n = n;
   return VALO_OK;
 }
@@ -212,14 +206,16 @@ static valo_status build_radiance_photons(photon_state *ps, const render_ctx *c,
   rad_job j = {ps, rm, src, (int)c->param[P_K], ps->r2_global};
   parallel_for(c->threads, (n + 255) / 256, rad_chunk, &j);
   /* into tree order */
+  for (uint32_t i = 0; i < n; i++) rm->n[i] = oct_unpack(m->ph[src[i]].nrm);
+  vec3 *nn = NULL;
+  rgb *lo = NULL;
   int rc = point_tree_build(&rm->tree, pos, n);
-  vec3 *nn = malloc(n * sizeof *nn);
-  rgb *lo = malloc(n * sizeof *lo);
-  if (rc || !nn || !lo) { free(src); free(pos); free(nn); free(lo); rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (uint32_t i = 0; i < n; i++) { nn[i] = oct_unpack(m->ph[src[rm->tree.id[i]]].nrm); lo[i] = rm->Lo[rm->tree.id[i]]; }
+  if (!rc) rc = point_tree_gather(&rm->tree, rm->n, sizeof *rm->n, (void **)&nn);
+  if (!rc) rc = point_tree_gather(&rm->tree, rm->Lo, sizeof *rm->Lo, (void **)&lo);
   free(rm->n); free(rm->Lo);
   rm->n = nn; rm->Lo = lo;
   free(src); free(pos);
+  if (rc) { rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   return VALO_OK;
 }
 

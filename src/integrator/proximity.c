@@ -335,10 +335,11 @@ static valo_status prox_create(const render_ctx *c, void **out, valo_error *err)
   }
   if (point_tree_build(&ps->tree, ps->pts.p, ps->pts.n_pts)) { prox_destroy(ps); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   /* normals and areas in tree order, beside the positions */
-  ps->n = malloc((ps->pts.n_pts + 1) * sizeof *ps->n);
-  ps->area = malloc((ps->pts.n_pts + 1) * sizeof *ps->area);
-  if (!ps->n || !ps->area) { prox_destroy(ps); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (uint32_t i = 0; i < ps->pts.n_pts; i++) { ps->n[i] = ps->pts.n[ps->tree.id[i]]; ps->area[i] = ps->pts.area[ps->tree.id[i]]; }
+  if (point_tree_gather(&ps->tree, ps->pts.n, sizeof *ps->n, (void **)&ps->n) ||
+      point_tree_gather(&ps->tree, ps->pts.area, sizeof *ps->area, (void **)&ps->area)) {
+    prox_destroy(ps);
+    return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  }
   *out = ps;
   return VALO_OK;
 }

@@ -30,6 +30,7 @@
 #include "geometry/pointtree.h"
 #include "core/sampling.h"
 #include "core/error.h"
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -130,13 +131,8 @@ static valo_status vpl_prepare(void *state, const render_ctx *c, int sample_inde
       for (uint32_t i = 0; i < vs->n; i++) vs->v[i].radius = (float)c->param[S_RADIUS];
     } else {
       /* the distance to the k-th nearest light of the pass */
-      vec3 *pos = malloc(vs->n * sizeof *pos);
       point_tree t;
-      if (!pos) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-      for (uint32_t i = 0; i < vs->n; i++) pos[i] = vs->v[i].p;
-      int rc = point_tree_build(&t, pos, vs->n);
-      free(pos);
-      if (rc) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+      if (point_set_build(&t, vs->v, vs->n, sizeof *vs->v, offsetof(vpl, p), NULL)) return err_set(err, VALO_ERR_NOMEM, "out of memory");
       int k = (int)c->param[S_K] + 1; /* the light itself is its own nearest */
       point_near nb[POINT_KNN_MAX];
       for (uint32_t i = 0; i < vs->n; i++) {
