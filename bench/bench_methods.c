@@ -17,7 +17,7 @@
 #include "load/load.h"
 #include "geometry/accel.h"
 #include "geometry/pointtree.h"
-#include "integrator/proximity.h"
+#include "scene/splat.h"
 #include "image/image_io.h"
 #include <math.h>
 #include <stdio.h>

@@ -11,7 +11,7 @@
  *  - on CornellBox-Original, proximity-ao correlates with converged ao. */
 #include "harness.h"
 #include "load/load.h"
-#include "integrator/proximity.h"
+#include "scene/splat.h"
 #include "geometry/pointtree.h"
 #include <math.h>
 #include <stdlib.h>

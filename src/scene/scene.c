@@ -375,3 +375,16 @@ camera scene_camera_at(const scene *s, const camera *still, float f) {
   c.pos = k[i].pos; c.look_at = k[i].look_at; c.up = k[i].up; c.fov_deg = k[i].fov_deg;
   return c;
 }
+
+const shape_ao *scene_shape_ao(const scene *s, uint32_t t) {
+  uint32_t lo = 0, hi = s->nshape_ao;
+  while (lo < hi) { /* last range with first <= t */
+    uint32_t m = (lo + hi) / 2;
+    if (s->shape_ao[m].first <= t) lo = m + 1;
+    else hi = m;
+  }
+  if (lo == 0) return NULL;
+  const shape_ao *a = &s->shape_ao[lo - 1];
+  return t < a->end ? a : NULL;
+}
+

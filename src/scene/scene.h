@@ -143,6 +143,8 @@ int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2);
 int material_has_maps(const material *m);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
 valo_status scene_commit(scene *s, valo_error *err);
+/* The proximity-AO settings of the JSON shape triangle t belongs to (NULL: none). */
+const shape_ao *scene_shape_ao(const scene *s, uint32_t t);
 /* Geometric (unnormalised cross product) normal of triangle t. */
 static inline vec3 scene_tri_ng(const scene *s, uint32_t t) {
   const uint32_t *i = &s->idx[3 * t];

@@ -1,7 +1,9 @@
-/* proximity.h — the splatting step of proximity-ao (digest 003, "ambient proximity
- * occlusion"), exposed for its tests and benchmark. */
-#ifndef VALO_PROXIMITY_H
-#define VALO_PROXIMITY_H
+/* splat.h — owns splatting points evenly over the scene's surfaces (digest 003, "ambient
+ * proximity occlusion": proximity-ao's points; its tests and benchmark read them too).
+ * Geometry over the scene model, so it sits in the model's module (a module below it
+ * could not read the scene's per-shape settings). */
+#ifndef VALO_SPLAT_H
+#define VALO_SPLAT_H
 #include "scene/scene.h"
 
 typedef struct splat_points {
@@ -21,6 +23,4 @@ typedef struct splat_points {
  * (out of memory, or more than max_points points: spacing too fine). */
 int splat_scene(const scene *s, float default_spacing, uint32_t max_points, int threads, splat_points *out);
 void splat_free(splat_points *sp);
-/* The proximity settings of the shape triangle t belongs to (NULL: none). */
-const shape_ao *shape_ao_of(const scene *s, uint32_t t);
 #endif
