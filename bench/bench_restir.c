@@ -2,7 +2,7 @@
  * equal time, on the many-light scenes (docs/performance.md):
  *  - direct light: restir-di against path limited to direct light (--max-depth 1: one NEE
  *    sample, MIS with BSDF sampling), with power-proportional light selection (the
- *    papers' baseline, which the issue's bar names) and with valo's default light grid;
+ *    papers' baseline, the baseline the papers name) and with valo's default light grid;
  *  - global illumination: restir-gi against path (both with the light grid).
  * restir draws its candidates from the default light grid as well.
  * For each: per-frame relMSE at 1 sample per pixel per frame (the baseline given as many

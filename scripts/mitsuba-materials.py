@@ -1,4 +1,4 @@
-# mitsuba-materials.py — the material scenes of issue 12 and their independent references:
+# mitsuba-materials.py — the material scenes and their independent references:
 # writes each scene once as valo JSON + OBJ meshes (tests/data/materials/) and renders the
 # same meshes with Mitsuba 3 into <name>-mitsuba.exr beside them (optional tooling: the
 # files it makes are committed; valo builds, renders and tests without Python).
@@ -9,7 +9,7 @@
 #   ... --variant llvm_ad_spectral --only glass-rough   (writes NAME-mitsuba-spectral.exr)
 #   ... --max-depth 2 --only gold-rough   (valo's max_depth 2 = Mitsuba's 3: NAME-mitsuba-depth2.exr)
 #
-# Conventions matched (docs/testing.md, "Issue 12"):
+# Conventions matched (docs/testing.md, "Materials and textures"):
 #  - geometry: the OBJ files written here, read by both (valo through Assimp, Mitsuba's own
 #    OBJ loader); the sphere is a 64 x 32 UV sphere with per-vertex normals, interpolated
 #    by both; floor and lamp are single quads (flat);

@@ -179,7 +179,7 @@ static int furnace_constant_map(void) {
   return 0;
 }
 
-/* Adaptive sampling keeps the image unbiased where paths are rare and bright (issue 12):
+/* Adaptive sampling keeps the image unbiased where paths are rare and bright:
  * the glass sphere's caustic (scenes/caustic.json, path, 64x64, 16 spp), 24 seeds each
  * uniform and adaptive; the mean over the image and over the caustic's block must agree
  * (|z| < 4; a false failure about 1 in 16 000). The digest's rule, which decides on the
@@ -230,7 +230,7 @@ static int adaptive_unbiased(void) {
   return 0;
 }
 
-/* Adaptive sampling pays where noise is uneven (issue 9): on the glass sphere's caustic
+/* Adaptive sampling pays where noise is uneven: on the glass sphere's caustic
  * (scenes/caustic.json, path, 128x128, 256 spp) the default rule's relMSE against
  * tests/data/caustic-path.exr (32 768 spp), summed over two seeds, is at least 1.5x below
  * uniform sampling's at the same samples (measured 1.85x; with a 9x9 neighbourhood 1.57x;
@@ -306,7 +306,7 @@ static int envmap_orientation(void) {
   return 0;
 }
 
-/* Irradiance from a map (issue 12): a 64x32 map with a vertical gradient and a hot spot,
+/* Irradiance from a map: a 64x32 map with a vertical gradient and a hot spot,
  * turned 30 degrees, lights a diffuse quad facing +x (albedo 0.8, nothing else in the
  * scene). Its radiance must be 0.8 E / pi, with E integrated here over the map as the
  * docs define it (texel (i, j) centred at ((i + .5)/W, (j + .5)/H), bilinear, u wrapping,
@@ -460,7 +460,7 @@ static int aovs(void) {
   float expect = 3 * sqrtf(1 + 2 * tanh * tanh);
   CHECK(fabsf(dc[0] - expect) < 0.05f, "corner depth %g, expected about %g", dc[0], expect);
   for (int k = 0; k < 3; k++) image_free(&im[k]);
-  /* As PNG (issue 8.7): normals n/2 + 1/2, depth over its largest value, sample counts
+  /* As PNG: normals n/2 + 1/2, depth over its largest value, sample counts
    * over the largest, stored linearly in the 8 bits. */
   static const char *const pngs[3] = {"normal", "depth", "spp"};
   for (int k = 0; k < 3; k++) {
@@ -683,7 +683,7 @@ static int adaptive_sampling(void) {
   return 0;
 }
 
-/* Automatic framing (issue 8.9): a mesh file without a camera is framed tightly from the
+/* Automatic framing: a mesh file without a camera is framed tightly from the
  * front: the open Cornell box fills the frame (before: two thirds of it); with --up z a
  * z-up scan (nefertiti) stands upright, so what it covers is taller than wide. */
 static int frame_coverage(const char *path, const char *up, int w, int h, double *cover, int *bw, int *bh) {

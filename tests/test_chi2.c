@@ -266,7 +266,7 @@ static double eval_quadrature(const bsdf *b, vec3 wo, int n) {
 
 /* GGX single-scattering albedo of an F = 1 conductor against values computed outside
  * valo: double-precision quadrature of D G / (4 cos_o cos_i) cos_i with the height-
- * correlated Smith G and alpha = roughness^2 (issue 12 quotes the same six numbers).
+ * correlated Smith G and alpha = roughness^2 (the same six numbers as docs/testing.md).
  * valo gets them two independent ways: the mean sample weight (its sampling routine) and
  * midpoint quadrature of its eval; the two must also agree with each other. */
 static int ggx_albedo(void) {

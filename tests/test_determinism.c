@@ -116,7 +116,7 @@ static int adaptive_threads_identical(void) {
   return 0;
 }
 
-/* Cancelling keeps what is finished (issue 8.2): a progress callback that cancels after
+/* Cancelling keeps what is finished: a progress callback that cancels after
  * the third pass leaves the film holding exactly those passes, bit-identical to a render
  * asked for that many samples; a cancel from another thread mid-pass leaves a finite,
  * lit image with every pixel holding at least the whole passes. */

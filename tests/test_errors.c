@@ -112,7 +112,7 @@ static int index_out_of_range(void) {
   return 0;
 }
 
-/* Malformed and unusual OBJ files (issue 8.6): errors name file and line in valo's words
+/* Malformed and unusual OBJ files: errors name file and line in valo's words
  * (never Assimp's internals); what valo drops is said; valid number forms load. */
 static int malformed_obj(void) {
   static const struct { const char *name, *text; int code; const char *said, *said2; } cases[] = {
@@ -148,7 +148,7 @@ static int malformed_obj(void) {
   return 0;
 }
 
-/* A scene without light (issue 8.3): a mesh file given directly is lit by a white
+/* A scene without light: a mesh file given directly is lit by a white
  * environment and says so (the image is not black); --env lights it by a map; a JSON
  * scene without light is warned about and renders black as asked. */
 /* Sum of all channels of an image file, or -1 if it cannot be read. */
@@ -184,7 +184,7 @@ static int no_light(void) {
   return 0;
 }
 
-/* Command-line behaviour (issue 8.8 and 8.5). */
+/* Command-line behaviour. */
 static int cli_behaviour(void) {
   const char *obj = write_file("ok.obj", CUBE_OBJ);
   char out[1200];
@@ -442,7 +442,7 @@ static int frames_cli(void) {
 }
 
 /* Ctrl-C (a real SIGINT) stops the render, writes every -o with the finished passes, says
- * how many spp they hold and exits 130 (issue 8.2). */
+ * how many spp they hold and exits 130. */
 static int sigint_writes_image(void) {
   const char *obj = write_file("ok.obj", CUBE_OBJ);
   char a[1200], b[1200];

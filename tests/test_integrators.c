@@ -137,7 +137,7 @@ static int distribution_equals_path_at_depth(void) {
   return 0;
 }
 
-/* The bundled default scene looks clean at its own budget (issue 8.10): isolated bright
+/* The bundled default scene looks clean at its own budget: isolated bright
  * pixels (fireflies: luminance, clamped to the PNG's range, above twice the median of the
  * 8 neighbours plus 0.1) are at most 0.05 % of the image. Rendered at half resolution, so
  * with 4x fewer samples per unit of image area the count is if anything pessimistic. */

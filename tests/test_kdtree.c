@@ -6,7 +6,7 @@
  * sees every real scene with a camera (veach-mis, veach-bidir, torus, Sponza, the Cornell
  * boxes) through it: camera rays, one bounce, rays grazing the largest triangles and rays
  * starting exactly on a surface, kd-tree against brute force exactly and Embree within
- * tolerance (issue 8.1: nearly axis-aligned walls fell out of cells they reach). */
+ * tolerance (nearly axis-aligned walls fell out of cells they reach). */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"

@@ -1,4 +1,4 @@
-/* test_mitsuba.c — valo's `path` against Mitsuba 3 on the material scenes of issue 12
+/* test_mitsuba.c — valo's `path` against Mitsuba 3 on the material scenes
  * (tests/data/materials: the JSON scenes, the OBJ meshes both renderers read, and the
  * Mitsuba EXRs, all made by scripts/mitsuba-materials.py, whose header lists the
  * conventions matched). Mean per channel within 1 %, lit 16x16 blocks within 3 % (32x32

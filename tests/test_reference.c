@@ -55,7 +55,7 @@ static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int 
 static int cornell_original(void) { return run_reference("scenes/cornell/CornellBox-Original.obj", "references/cornell-original.exr", 512, 16); }
 static int cornell_mirror(void) { return run_reference("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", 2048, 32); }
 
-/* veach-mis against the Tungsten render beside it (issue 8.4): with its own camera, the
+/* veach-mis against the Tungsten render beside it: with its own camera, the
  * four rough plates must show the lights' highlights where Tungsten does. For each plate,
  * the luminance profile across the plate (clamped to [0,1], as the PNG is) is compared
  * with the reference's by correlation. Tungsten uses Beckmann, valo GGX, whose longer

@@ -1,4 +1,4 @@
-/* test_restir.c — restir-di and restir-gi (digest 001, src/integrator/restir.c) and the
+/* test_restir.c — restir-di and restir-gi (digest 001, src/integrator/restir_*.c) and the
  * frames they run on:
  *  - streaming reservoir sampling keeps w_sum, M and each candidate's selection
  *    probability exact (enumeration of every decision on a grid where the ratios are

@@ -152,7 +152,7 @@ static int mat_by_name(const scene *s, const char *name) {
   return -1;
 }
 
-/* MTL's PBR extension (issue 8.4): Pr is the microfacet alpha, Pm metallic; illum 3
+/* MTL's PBR extension: Pr is the microfacet alpha, Pm metallic; illum 3
  * metals with black Kd take Ks; map_Pr/map_Pm are read; Ps/Pc/Pcr/aniso are warned about
  * and do not stop the MTL parser (Assimp 5.2's stops at aniso). */
 static int mtl_pbr_extension(void) {
@@ -204,7 +204,7 @@ static int mtl_pbr_extension(void) {
   return 0;
 }
 
-/* OBJ text Assimp 5.2 misreads or hides (issue 8.6): numbers with a leading dot or a zero
+/* OBJ text Assimp 5.2 misreads or hides: numbers with a leading dot or a zero
  * in the exponent load with their values; faces with fewer than three vertices are
  * dropped, not fatal. */
 static int obj_number_forms(void) {
@@ -225,7 +225,7 @@ static int obj_number_forms(void) {
   return 0;
 }
 
-/* Issue 12's silent fallbacks now warn, naming the file and what was done instead: maps
+/* Silent fallbacks now warn, naming the file and what was done instead: maps
  * on a mesh without UVs, an unreadable MTL texture, a glTF camera without a usable field
  * of view, and autofocus whose centre ray hits nothing. */
 static int fallback_warnings(void) {

@@ -349,7 +349,7 @@ static char *uv_sphere_obj(int n) {
   return t;
 }
 
-/* The stress scene of issue 12: rough glass (roughness 0.3 and 0.01) and a near-mirror
+/* The stress scene: rough glass (roughness 0.3 and 0.01) and a near-mirror
  * rough metal, all under a normal map of random normals tilted up to 70 degrees, on a
  * normal-mapped floor seen at grazing angles, lit by a small area light and an
  * environment. Every integrator must finish it with no NaN, infinite or negative sample
@@ -485,7 +485,7 @@ static int write_gltf_quad(const char *name, const unsigned char *png, size_t pn
   return fclose(f) == 0 && ok ? 0 : -1;
 }
 
-/* UV orientation (issue 12): the same four-quadrant texture (red, green, blue, yellow from
+/* UV orientation: the same four-quadrant texture (red, green, blue, yellow from
  * the image's top-left: tests/data/materials/quad-texture.png) on a quad through OBJ
  * (v = 0 at the image's bottom), glTF and glb (v = 0 at its top, the image embedded in
  * the .glb), under a uniform white sky: each quadrant of the render shows its colour. */
@@ -535,7 +535,7 @@ static int uv_orientation(void) {
   return 0;
 }
 
-/* Alpha cutoff (issue 12): a glTF quad whose base colour has alpha 128/255 = 0.502,
+/* Alpha cutoff: a glTF quad whose base colour has alpha 128/255 = 0.502,
  * alphaMode MASK at cutoffs 0.25, 0.49 (opaque) and 0.51, 0.75 (cut out), 1 unit above a
  * floor under a point light. Camera rays: from above, the centre shows the quad (red) or
  * the floor (grey). Shadow rays: from below the quad's plane, the floor under it is dark
@@ -590,7 +590,7 @@ static int alpha_cutoff(void) {
   return 0;
 }
 
-/* Normal maps in shading (issue 12): a map tilting the normal 30 degrees towards +T on a
+/* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
  * from 30 degrees off towards where the normal should tilt: 0.5 * 2 / pi (60 degrees

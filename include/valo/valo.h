@@ -225,6 +225,24 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out);
 VALO_API void valo_render_destroy(valo_render *r);
 
+/* The declared options (one table: the command line's flags, the JSON scene file's
+ * keys, defaults, ranges and help all come from it). valo_option_at(i) is entry i (NULL
+ * past the last): its flag ("--spp", or NULL for a scene-file key only), the value it
+ * takes ("N"; NULL for a flag without a value), its JSON key ("render.spp", or NULL) and
+ * its help (lines separated by '\n'). Thread-safe. */
+typedef struct valo_option_info {
+  const char *flag;
+  const char *metavar;
+  const char *json;
+  const char *help;
+} valo_option_info;
+VALO_API const valo_option_info *valo_option_at(int i);
+/* Sets the option with this flag from its text value (NULL for a flag without one) in the
+ * struct it belongs to. VALO_ERR_INVALID for an unknown flag or a bad value, with a
+ * message saying what a valid value is. */
+VALO_API valo_status valo_option_set(const char *flag, const char *value, valo_options *render, valo_load_options *load,
+                                     valo_output_options *output, valo_error *err);
+
 /* Where warnings and notes go. Each handle routes its own: a scene's come from
  * valo_load_options.on_warning (inherited by its renders), a render's can be set with
  * valo_render_set_warning_handler; calls on that handle send them there, from the

@@ -1,5 +1,5 @@
 /* accel.h — owns the one ray-query interface (ARCHITECTURE "Acceleration"): a small ops
- * table {intersect, occluded, destroy} implemented by the SAH kd-tree (kdtree.c) and by
+ * table {intersect, occluded, destroy} implemented by the SAH kd-tree (kdtree_build.c, kdtree_traverse.c) and by
  * Embree 3 (embree.c), chosen by name when a render is created. Rays have no tmin: origins
  * are offset robustly instead (offset.h), and hits need t > 0. */
 #ifndef VALO_ACCEL_H

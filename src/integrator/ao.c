@@ -2,7 +2,7 @@
  * Landis 2002). At the surface a camera ray sees, one cosine-weighted ray per sample
  * (Owen-scrambled Sobol, so --spp 256 is the seed's 256-ray reference) up to a maximum
  * distance; the pixel is the unoccluded fraction (1 open, 0 closed), camera rays that
- * escape give 0. The same estimator, ao_sample() in integrator.c, makes the ao and bent-
+ * escape give 0. The same estimator, ao_sample() below, makes the ao and bent-
  * normal AOVs beside any integrator (-o ao:FILE, -o bent:FILE). */
 #include "core/streams.h"
 #include "integrator/ao.h"

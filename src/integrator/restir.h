@@ -1,4 +1,4 @@
-/* restir.h — owns the reservoir types and the pieces of restir.c that tests check on
+/* restir.h — owns the reservoir types and the pieces of restir-di and restir-gi that tests check on
  * their own: candidate generation by RIS, the DI target, the GI Jacobian and the
  * similarity test (digest 001). */
 #ifndef VALO_RESTIR_H

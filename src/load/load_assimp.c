@@ -386,7 +386,7 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
   c->s->cam.up = v3_norm(up);
   c->s->cam.fov_deg = vfov * 180.0f / PI_F;
   c->s->cam.aperture_radius = 0;
-  c->s->cam.focus_distance = -1; /* glTF/Assimp cameras have none: autofocus (render.c) */
+  c->s->cam.focus_distance = -1; /* glTF/Assimp cameras have none: autofocus (render/session.c) */
   c->s->has_camera = 1;
   if (cam->mAspect > 0 && c->file && c->file->width == VALO_UNSET) {
     c->file->height = 256;

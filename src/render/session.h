@@ -1,8 +1,8 @@
 /* session.h — owns one render (Cycles' word for it: a session): the film, the camera of
  * this frame and the last, the accelerator, the light sampler, the integrator instance,
  * the budgets, passes, frames, cancellation and progress, and the counters. The public
- * valo_render (src/api/) is a handle on one session. Options reach it resolved and
- * checked (src/api/options.c). */
+ * valo_render handle (src/api/) wraps it. Options reach it resolved and checked
+ * (src/api/options.c). */
 #ifndef VALO_SESSION_H
 #define VALO_SESSION_H
 #include "integrator/integrator.h"

@@ -255,7 +255,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
   }
   if (!s->has_camera) {
     /* Framed automatically (docs/scene-format.md): a front view, 40 degree vertical fov;
-     * render.c fits the distance to the bounds for the film's aspect (camera_frame). */
+     * scene_camera_fit fits the distance to the bounds for the film's aspect (camera_frame). */
     s->cam.fov_deg = 40;
     s->cam.look_at = s->center;
     s->cam.up = s->up_z ? v3(0, 0, 1) : v3(0, 1, 0);
