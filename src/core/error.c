@@ -56,17 +56,7 @@ void log_note(const char *fmt, ...) {
   va_end(ap);
 }
 
-VALO_API void valo_set_warning_handler(valo_log_fn fn, void *user) { g_warn_fn = fn; g_warn_user = user; }
-
-VALO_API const char *valo_status_string(valo_status s) {
-  switch (s) {
-  case VALO_OK: return "ok";
-  case VALO_ERR_IO: return "i/o error";
-  case VALO_ERR_PARSE: return "parse error";
-  case VALO_ERR_INVALID: return "invalid input";
-  case VALO_ERR_UNSUPPORTED: return "unsupported";
-  case VALO_ERR_NOMEM: return "out of memory";
-  case VALO_ERR_CANCELLED: return "cancelled";
-  }
-  return "unknown";
+void log_set_default_handler(valo_log_fn fn, void *user) {
+  g_warn_fn = fn;
+  g_warn_user = user;
 }
