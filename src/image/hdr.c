@@ -1,9 +1,9 @@
 /* hdr.c — owns reading Radiance HDR (RGBE) images: the header (#?RADIANCE or #?RGBE,
  * FORMAT=32-bit_rle_rgbe, a "-Y H +X W" resolution), flat scanlines and the adaptive RLE
  * of Greg Ward's format, every read bounded by the file's size. valo decodes HDR itself
- * because Debian 12's stb_image (libstb 0.0~git20220908) loops forever on a scanline cut
- * off inside its RLE data: at the end of the file its byte reader returns 0, a run length
- * of 0 never advances, and stbi_loadf never returns. Pixels come out exactly as stb_image
+ * because Debian 12's stb_image (libstb0 0.0~git20220908.8b5f1f3+ds-1) loops forever on
+ * a scanline cut off inside its RLE data: at the end of the file its byte reader returns
+ * 0, a run length of 0 never advances, and stbi_loadf never returns. Pixels come out exactly as stb_image
  * made them (the same ldexp(1, e - 136) scaling), so valid maps render as before. */
 #include "image/hdr.h"
 #include "core/error.h"

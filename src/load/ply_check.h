@@ -1,7 +1,7 @@
 /* ply_check.h — owns valo's own check of a PLY file before Assimp reads it: the header
  * (format, elements, properties), every element's data against the header (counts against
  * the file's size, ASCII numbers and line lengths, binary lengths), and every face's vertex
- * count and indices. Assimp 5.2.5 (Debian 12, libassimp5 5.2.5~ds0-1) keeps its
+ * count and indices. Assimp 5.2.5 (Debian 12, libassimp5 5.2.5~ds0-1+b1) keeps its
  * assertions, and its PLY reader hands faces that disagree with the header to
  * TriangulateProcess, which aborts the process (`numOut != pMesh->mNumFaces`); so a PLY
  * reaches Assimp only once every face is known to be a polygon of valid indices. */
