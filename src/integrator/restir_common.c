@@ -9,7 +9,7 @@
  *   the previous frame) -> n rounds of spatial reuse (k neighbours) -> shading.
  * Reservoirs follow the digest: {y, w_sum, M} and W = w_sum / (M p^(y)) for the candidates
  * and the biased reuse; the unbiased reuse weights the merged reservoirs by pairwise MIS
- * (the digest's Z/M normalisation was built first; it had 1.1-1.9x the error).
+ * (the digest's Z/M normalisation measured 1.1-1.9x its error: docs/integrators.md).
  * DI samples are points on lights in the light's own measure (area for triangles, a
  * direction for the environment, the light itself for delta lights), so reuse needs no
  * Jacobian; GI samples are surface points x_s found from x_v in solid angle, so reuse

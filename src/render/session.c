@@ -218,8 +218,8 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
     }
     if (budget > 0 && el >= budget) break;
     /* Adaptive with a time budget: the uniform first pass gets ADAPT_UNIFORM of the time
-     * (at least 4 spp), as it gets that share of a sample budget; before, with --time it
-     * took the whole budget and adaptive sampling never ran. */
+     * (at least 4 spp), as it gets that share of a sample budget, so adaptive sampling
+     * has the rest. */
     if (ss->opt.adaptive && budget > 0 && el >= budget * ADAPT_UNIFORM && ss->spp_done >= 4) break;
     if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
     if (ss->opt.adaptive && budget > 0 && pass_spp * (pt / n) > budget * ADAPT_UNIFORM / 2) pass_spp = pass_spp > 1 ? pass_spp / 2 : 1;
