@@ -55,13 +55,13 @@ typedef struct render_ctx {
  * camera, whose frames are averaged. */
 typedef struct frame_ctx {
   int frame;            /* 0 for the first frame the integrator sees (no history yet) */
-  cam_view cam, prev;   /* this frame's camera and the previous frame's (equal for frame 0) */
+  cam_view prev;        /* the previous frame's camera (this frame's, lens->view, for frame 0) */
   float *rgb;           /* out: width*height*3 radiance estimates of this frame */
   thread_stats *ts;     /* one per thread */
   const _Atomic int *cancel; /* non-zero: stop between stages and return VALO_ERR_CANCELLED */
   int sequence;         /* 1: frames of a sequence (--frames), shown one by one; 0: the frames of a
                            still, averaged */
-  const cam_lens *lens; /* this frame's camera with its lens (camera_ray): cam is lens->view */
+  const cam_lens *lens; /* this frame's camera with its lens (camera_ray) */
 } frame_ctx;
 
 /* Per-ray integrators give li() and get the tile loop; image-wide ones give render_frame. */

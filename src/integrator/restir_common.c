@@ -48,7 +48,7 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
   if (delta_walk_next(&w, c, &smp, ts)) {
     g->it = w.it; g->fr = w.fr; g->b = w.b; g->wo = w.wo; g->beta = w.beta; g->valid = 1; g->chain = w.depth > 0;
   }
-  if (w.hit_any) g->depth = v3_len(v3_sub(w.first_p, f->cam.o));
+  if (w.hit_any) g->depth = v3_len(v3_sub(w.first_p, f->lens->view.o));
   g->Le = w.L;
 }
 

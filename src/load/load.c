@@ -3,14 +3,10 @@
 #include "load/load.h"
 #include "scene/envmap.h"
 #include "core/error.h"
+#include "core/strutil.h"
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-
-static int ends_with(const char *s, const char *suf) {
-  size_t n = strlen(s), m = strlen(suf);
-  return n >= m && !strcasecmp(s + n - m, suf);
-}
 
 /* Lights a scene could have before commit: emissive triangles, lights, an environment. */
 static int scene_has_any_light(const scene *s) {
@@ -30,7 +26,7 @@ valo_status scene_load(const char *path, const valo_load_options *lo, scene **ou
   if (strcmp(lo->up, "y") && strcmp(lo->up, "z") && lo->up[0]) return err_set(err, VALO_ERR_INVALID, "up axis \"%s\" (y or z)", lo->up);
   scene *s = scene_new(path);
   if (!s) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  int json = ends_with(path, ".json");
+  int json = str_ends_with(path, ".json");
   s->up_z = !strcmp(lo->up, "z");
   valo_status st = json ? load_json(s, path, file, err) : load_mesh(s, path, NULL, UINT32_MAX, 1, file, err);
   if (st == VALO_OK && lo->env_file[0]) {

@@ -4,15 +4,11 @@
 #include "image/image_io.h"
 #include "image/tonemap.h"
 #include "core/error.h"
+#include "core/strutil.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-
-static int ends_with(const char *s, const char *suf) {
-  size_t n = strlen(s), m = strlen(suf);
-  return n >= m && !strcasecmp(s + n - m, suf);
-}
 
 /* Data AOVs written as PNG: mapped into [0, 1] so that they are visible, then stored
  * linearly in the 8 bits (each value pre-decoded from sRGB, so the PNG writer's sRGB
@@ -73,7 +69,7 @@ valo_status output_write(const session *ss, const char *path, const valo_output_
   } else {
     aov_resolve(ss, k, px);
     int data = k == AOV_KIND_NORMAL || k == AOV_KIND_DEPTH || k == AOV_KIND_BENT || k == AOV_KIND_SPP;
-    if (ends_with(path, ".png") && data) {
+    if (str_ends_with(path, ".png") && data) {
       png_data_map(px, np, k == AOV_KIND_SPP ? 2 : k == AOV_KIND_DEPTH ? 1 : 0);
       use = &raw;
     }

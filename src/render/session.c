@@ -110,8 +110,8 @@ void session_destroy(session *ss) {
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
-  frame_ctx f = {ss->image_frames, ss->lens.view, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel,
-                 ss->opt.frames > 0, &ss->lens};
+  frame_ctx f = {ss->image_frames, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel, ss->opt.frames > 0,
+                 &ss->lens};
   valo_status st = ss->integ->render_frame(ss->istate, &ss->ctx, &f, err);
   if (st) return st;
   ss->image_frames++;
