@@ -21,6 +21,8 @@
 #    many-light scenes use nothing else; any other MTL key is refused);
 #  - camera: the JSON camera (position, look_at, up, vertical fov), pinhole; the film's
 #    box filter of one pixel ("box" rfilter); an independent sampler;
+#  - a shape's JSON "material" (diffuse reflectance/emission, smooth dielectric with
+#    interior ior, exterior 1) replaces its MTL; analytic spheres are Mitsuba spheres;
 #  - no environment (the scenes have none).
 import argparse, json, os, sys, tempfile
 
@@ -84,12 +86,36 @@ def read_obj(path):
     return groups, mats
 
 
+def json_bsdf(name):
+    """A JSON material (only those the reference scenes use): diffuse with optional
+    emission, or smooth dielectric."""
+    m = sc["materials"][name]
+    if m.get("type", "diffuse") == "dielectric":
+        if set(m) - {"type", "ior"}:
+            sys.exit("material %s: only ior is converted for dielectrics" % name)
+        return {"type": "dielectric", "int_ior": m.get("ior", 1.5), "ext_ior": 1.0}, None
+    if m.get("type", "diffuse") != "diffuse" or set(m) - {"type", "reflectance", "emission"}:
+        sys.exit("material %s: only diffuse (reflectance, emission) and dielectric are converted" % name)
+    rgb = lambda v: [float(v)] * 3 if not isinstance(v, list) else [float(x) for x in v]
+    b = {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb(m.get("reflectance", 0.8))}}
+    e = rgb(m.get("emission", 0))
+    return b, ({"type": "area", "radiance": {"type": "rgb", "value": e}} if any(c > 0 for c in e) else None)
+
+
 tmp = tempfile.mkdtemp(prefix="valo-mitsuba-")
 shapes = {}
 n = 0
 for shp in sc["shapes"]:
-    if "file" not in shp or not shp["file"].endswith(".obj") or len(shp) != 1:
-        sys.exit("only {\"file\": \"X.obj\"} shapes are converted")
+    if shp.get("type") == "sphere" and set(shp) <= {"type", "center", "radius", "material"}:
+        b, e = json_bsdf(shp["material"])
+        d = {"type": "sphere", "center": shp["center"], "radius": shp["radius"], "bsdf": b}
+        if e:
+            d["emitter"] = e
+        shapes["s%05d" % n] = d
+        n += 1
+        continue
+    if "file" not in shp or not shp["file"].endswith(".obj") or set(shp) - {"file", "material"}:
+        sys.exit("only {\"file\": \"X.obj\"[, \"material\": M]} and analytic sphere shapes are converted")
     groups, mats = read_obj(os.path.join(base, shp["file"]))
     for name, tris in groups.items():
         p = os.path.join(tmp, "m%05d.obj" % n)
@@ -99,11 +125,15 @@ for shp in sc["shapes"]:
                     f.write("v %.7g %.7g %.7g\n" % q)
             for i in range(len(tris)):
                 f.write("f %d %d %d\n" % (3 * i + 1, 3 * i + 2, 3 * i + 3))
-        m = mats[name]
-        d = {"type": "obj", "filename": p, "face_normals": True,
-             "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": m["Kd"]}}}
-        if any(c > 0 for c in m["Ke"]):
-            d["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": m["Ke"]}}
+        if "material" in shp:
+            b, e = json_bsdf(shp["material"])
+        else:
+            m = mats[name]
+            b = {"type": "diffuse", "reflectance": {"type": "rgb", "value": m["Kd"]}}
+            e = {"type": "area", "radiance": {"type": "rgb", "value": m["Ke"]}} if any(c > 0 for c in m["Ke"]) else None
+        d = {"type": "obj", "filename": p, "face_normals": True, "bsdf": b}
+        if e:
+            d["emitter"] = e
         shapes["s%05d" % n] = d
         n += 1
 

@@ -188,18 +188,20 @@ void compare_images(const float *img, const float *ref, int w, int h, int block,
     for (int c = 0; c < 3; c++) { s_img[c] += img[3 * i + c]; s_ref[c] += ref[3 * i + c]; }
   double mean_lum = (s_ref[0] + s_ref[1] + s_ref[2]) / (3.0 * w * h);
   for (int c = 0; c < 3; c++) r->mean_err[c] = fabs(s_img[c] - s_ref[c]) / s_ref[c];
-  r->worst_block = 0; r->lit_blocks = 0; r->worst_bx = r->worst_by = -1;
+  r->worst_block = 0; r->lit_blocks = 0; r->worst_bx = r->worst_by = r->worst_c = -1;
   for (int by = 0; by < h / block; by++)
     for (int bx = 0; bx < w / block; bx++) {
-      double a = 0, b = 0;
+      double a[3] = {0}, b[3] = {0};
       for (int y = by * block; y < (by + 1) * block; y++)
         for (int x = bx * block; x < (bx + 1) * block; x++)
-          for (int c = 0; c < 3; c++) { a += img[3 * (y * w + x) + c]; b += ref[3 * (y * w + x) + c]; }
-      double n = 3.0 * block * block;
-      if (b / n < 0.05 * mean_lum) continue;
-      r->lit_blocks++;
-      double e = fabs(a - b) / b;
-      if (e > r->worst_block) { r->worst_block = e; r->worst_bx = bx; r->worst_by = by; }
+          for (int c = 0; c < 3; c++) { a[c] += img[3 * (y * w + x) + c]; b[c] += ref[3 * (y * w + x) + c]; }
+      double n = (double)block * block;
+      for (int c = 0; c < 3; c++) {
+        if (b[c] / n < 0.05 * mean_lum) continue; /* this channel is dark here */
+        r->lit_blocks++;
+        double e = fabs(a[c] - b[c]) / b[c];
+        if (e > r->worst_block) { r->worst_block = e; r->worst_bx = bx; r->worst_by = by; r->worst_c = c; }
+      }
     }
 }
 

@@ -54,7 +54,10 @@ int read_aov(const valo_render *r, const char *name, image *out);
 /* An image against a reference: per-channel mean error and the worst relative error over
  * lit blocks (block x block pixels whose reference luminance is above 5 % of the image's
  * mean). */
-typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, lit_blocks; } cmp_result;
+/* Mean error per channel; blocks compared per channel, where the reference's channel mean
+ * in the block is at least 5 % of the image's mean luminance (lit_blocks counts those
+ * block-channels); the worst relative block-channel error and where it is. */
+typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, worst_c, lit_blocks; } cmp_result;
 void compare_images(const float *img, const float *ref, int w, int h, int block, cmp_result *r);
 /* Runs the valo binary with args (NULL-terminated): sends SIGINT (as Ctrl-C does) after
  * sigint_ms milliseconds when > 0, kills it after timeout_s seconds (a hang: returns 999).

@@ -17,10 +17,16 @@
  *    light by final gathering: `gather` BSDF-sampled rays whose hits take the global
  *    map's estimate of outgoing radiance (after up to 4 delta bounces; emission found by
  *    gather rays is left to NEE and the caustic map).
- *  - radiance estimate: L = sum f(wo, wp) Phi_p / (pi r^2) over the k nearest photons
- *    within the maximum radius, distance measured in a disc squeezed along the surface
- *    normal (|v|^2 + 16 (v.n)^2) against leaks at corners and through thin walls.
- * Biased (blur of the density estimate), consistent as the photon counts grow. */
+ *  - radiance estimate, progressive (Knaus & Zwicker 2011, probabilistic progressive
+ *    photon mapping): pass i (sample index i, 0-based) estimates L = sum f(wo, wp) Phi_p
+ *    / (pi r_i^2) over the photons of its own maps within r_i, distance measured in a
+ *    disc squeezed along the surface normal (|v|^2 + 16 (v.n)^2) against leaks at
+ *    corners and through thin walls; r_i^2 = r_0^2 prod_{j=1..i} (j + alpha) / (j + 1)
+ *    shrinks as i^(alpha-1), so the average over passes converges: both the blur (bias)
+ *    and the variance go to zero. r_0 per map: `radius` / `caustic_radius`, or the
+ *    median distance from a photon of the pass to its k-th nearest neighbour.
+ * Biased (blur of the density estimate) at any finite time, consistent: the bias shrinks
+ * with the passes. */
 #include "core/streams.h"
 #include "integrator/camera_path.h"
 #include "integrator/integrator.h"
@@ -33,22 +39,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { P_GLOBAL, P_CAUSTIC, P_K, P_RADIUS, P_GATHER, P_CAUSTIC_RADIUS };
+enum { P_GLOBAL, P_CAUSTIC, P_K, P_RADIUS, P_GATHER, P_CAUSTIC_RADIUS, P_ALPHA };
 static const integrator_param photon_params[] = {
     {"global", IPARAM_INT, 100000, 0, 1e8, "photons stored in the global map per pass (pbrt-v2's default count)"},
     {"caustic", IPARAM_INT, 20000, 0, 1e8, "photons stored in the caustic map per pass"},
-    {"k", IPARAM_INT, 50, 1, POINT_KNN_MAX, "nearest photons per radiance estimate"},
-    {"radius", IPARAM_FLOAT, 0, 0, 1e30, "largest search radius, global map; 0 = automatic, 1/10 of the scene's bounding-sphere radius"},
+    {"k", IPARAM_INT, 50, 1, POINT_KNN_MAX, "photons the automatic first-pass radius holds (the median over the map)"},
+    {"radius", IPARAM_FLOAT, 0, 0, 1e30, "first pass's search radius, global map; 0 = automatic (k photons, at most 1/10 of the bounding-sphere radius)"},
     {"gather", IPARAM_INT, 32, 0, 4096, "final-gathering rays per camera sample (0: use the global map at the first hit)"},
-    {"caustic_radius", IPARAM_FLOAT, 0, 0, 1e30, "largest search radius, caustic map; 0 = automatic, 1/40 of the bounding-sphere radius"},
+    {"caustic_radius", IPARAM_FLOAT, 0, 0, 1e30, "first pass's search radius, caustic map; 0 = automatic (k photons, at most 1/40 of the bounding-sphere radius)"},
+    {"alpha", IPARAM_FLOAT, 0.7, 0.05, 1, "radius reduction per pass (Knaus & Zwicker's alpha): r_i^2 = r_0^2 prod (j + alpha) / (j + 1); 1 keeps the radius"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 #define SQUEEZE 16.0f
 
-/* A stored photon: 28 bytes that every estimate reads, plus the surface normal and
- * diffuse reflectance where it landed, which only the radiance-photon precomputation
- * reads (kept beside it rather than in a second pass over the scene). */
-typedef struct photon { vec3 p; rgb power; uint32_t dir; uint32_t nrm; rgb rho; } photon; /* dir, nrm: octahedral 2x16 bits */
+/* A stored photon: 28 bytes. */
+typedef struct photon { vec3 p; rgb power; uint32_t dir; } photon; /* dir: octahedral 2x16 bits */
 
 static uint32_t oct_pack(vec3 d) {
   float s = fabsf(d.x) + fabsf(d.y) + fabsf(d.z);
@@ -71,18 +76,13 @@ static vec3 oct_unpack(uint32_t u) {
   return v3_norm(v3(x, y, z));
 }
 
-typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; } photon_map;
-/* Radiance photons (Christensen 1999): every RAD_STRIDE-th global photon with its
- * precomputed outgoing radiance rho E / pi, found by gather rays with one nearest lookup
- * instead of a k-nearest estimate. */
-#define RAD_STRIDE 4
-typedef struct rad_map { point_tree tree; vec3 *n; rgb *Lo; uint32_t n_pts; } rad_map;
+/* A map of one pass and the search radius its estimates use (r2: squared). */
+typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; float r2; } photon_map;
 
 typedef struct photon_state {
   photon_map global, caustic;
-  rad_map rad;
   int has_specular;        /* any delta lobe in the scene: else no caustic map */
-  float r2_global, r2_caustic;
+  float r2cap_global, r2cap_caustic; /* the automatic first radius's bound */
 } photon_state;
 
 static void map_free(photon_map *m) {
@@ -91,16 +91,9 @@ static void map_free(photon_map *m) {
   memset(m, 0, sizeof *m);
 }
 
-static void rad_free(rad_map *r) {
-  point_tree_free(&r->tree);
-  free(r->n); free(r->Lo);
-  memset(r, 0, sizeof *r);
-}
-
 static void photon_destroy(void *st) {
   photon_state *ps = st;
   if (!ps) return;
-  rad_free(&ps->rad);
   map_free(&ps->global);
   map_free(&ps->caustic);
   free(ps);
@@ -113,33 +106,17 @@ static valo_status photon_create(const render_ctx *c, void **out, valo_error *er
     bsdf b = bsdf_from_material(&c->s->mats[i]);
     ps->has_specular = b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR;
   }
-  float rg = c->param[P_RADIUS] > 0 ? (float)c->param[P_RADIUS] : 0.1f * c->s->radius;
-  float rc = c->param[P_CAUSTIC_RADIUS] > 0 ? (float)c->param[P_CAUSTIC_RADIUS] : 0.025f * c->s->radius;
-  ps->r2_global = rg * rg;
-  ps->r2_caustic = rc * rc;
+  float rg = 0.1f * c->s->radius, rc = 0.025f * c->s->radius;
+  ps->r2cap_global = rg * rg;
+  ps->r2cap_caustic = rc * rc;
   *out = ps;
   return VALO_OK;
-}
-
-/* What the surface reflects of uniform incident light, hemispherical-hemispherical, for
- * the radiance photons' Lo = rho E / pi (pbrt-v2's diffuse approximation): the
- * directional albedo at normal incidence, by the BSDF's own sampling (16 stratified
- * samples; deterministic). */
-static rgb diffuse_reflectance(const bsdf *b) {
-  rgb sum = c3(0, 0, 0);
-  vec3 wo = v3(0, 0, 1);
-  for (int i = 0; i < 16; i++) {
-    bsdf_sample bs;
-    float u1 = ((float)(i % 4) + 0.5f) / 4, u2 = ((float)(i / 4) + 0.5f) / 4;
-    if (bsdf_sample_dir(b, wo, ((float)i + 0.5f) / 16, u1, u2, &bs) && !bs.delta && bs.wi.z > 0) sum = c3_add(sum, bs.weight);
-  }
-  return c3_scale(sum, 1.0f / 16);
 }
 
 /* ---- shooting (lightpath.c) ---- */
 static int visit_global(void *user, const lp_vertex *v, void *rec) {
   (void)user;
-  photon ph = {v->it->p, v->power, oct_pack(v->d), oct_pack(v->fr->n), diffuse_reflectance(v->b)};
+  photon ph = {v->it->p, v->power, oct_pack(v->d)};
   memcpy(rec, &ph, sizeof ph);
   return 1;
 }
@@ -166,101 +143,80 @@ static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, ui
   return VALO_OK;
 }
 
-/* Irradiance at a radiance photon from its k nearest global photons on the same side. */
-typedef struct rad_job { const photon_state *ps; rad_map *rm; const uint32_t *src; int k; float r2max; } rad_job;
-static void rad_chunk(void *user, int64_t item, int thread) {
-  (void)thread;
-  rad_job *j = user;
-  const photon_map *m = &j->ps->global;
-  uint32_t lo = (uint32_t)item * 256, hi = lo + 256 < j->rm->n_pts ? lo + 256 : j->rm->n_pts;
-  point_near nb[POINT_KNN_MAX];
-  for (uint32_t i = lo; i < hi; i++) {
-    const photon *p = &m->ph[j->src[i]];
-    vec3 n = oct_unpack(p->nrm);
-    int cnt = point_tree_knn(&m->tree, p->p, j->k, j->r2max, n, SQUEEZE, nb);
-    float r2 = 0;
-    rgb E = c3(0, 0, 0);
-    for (int q = 0; q < cnt; q++) {
-      r2 = fmaxf(r2, nb[q].d2);
-      const photon *o = &m->ph[nb[q].i];
-      if (v3_dot(oct_unpack(o->dir), n) < 0) E = c3_add(E, o->power); /* arrived on the front side */
-    }
-    if (cnt < j->k) r2 = j->r2max;
-    j->rm->Lo[i] = r2 > 0 ? c3_scale(c3_mul(p->rho, E), 1 / (PI_F * PI_F * r2)) : c3(0, 0, 0);
+/* The radius of pass i: r_0^2 prod_{j=1..i} (j + alpha) / (j + 1) (Knaus & Zwicker),
+ * through lgamma: Gamma(i + 1 + alpha) / Gamma(1 + alpha) / (i + 1)!. */
+static double radius_shrink(int pass, double alpha) {
+  if (pass <= 0 || alpha >= 1) return 1;
+  return exp(lgamma(pass + 1 + alpha) - lgamma(1 + alpha) - lgamma(pass + 2.0));
+}
+
+/* The automatic first radius: the median over (up to) 511 photons spread through the map
+ * of the squared distance to their k-th nearest neighbour, at most r2cap. */
+#define RADIUS_PROBES 511
+static int cmp_float(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+static float auto_radius2(const photon_map *m, int k, float r2cap) {
+  if (m->n == 0) return r2cap;
+  static _Thread_local point_near nb[POINT_KNN_MAX];
+  float d2[RADIUS_PROBES];
+  int np = m->n < RADIUS_PROBES ? (int)m->n : RADIUS_PROBES;
+  for (int i = 0; i < np; i++) {
+    const photon *p = &m->ph[(uint64_t)i * m->n / (uint64_t)np];
+    int cnt = point_tree_knn(&m->tree, p->p, k, r2cap, v3(0, 0, 1), 0, nb);
+    float r2 = cnt < k ? r2cap : 0;
+    for (int q = 0; q < cnt && cnt >= k; q++) r2 = fmaxf(r2, nb[q].d2);
+    d2[i] = r2;
   }
-}
-
-static valo_status build_radiance_photons(photon_state *ps, const render_ctx *c, valo_error *err) {
-  rad_free(&ps->rad);
-  const photon_map *m = &ps->global;
-  uint32_t n = (m->n + RAD_STRIDE - 1) / RAD_STRIDE;
-  if (n == 0) return VALO_OK;
-  rad_map *rm = &ps->rad;
-  uint32_t *src = malloc(n * sizeof *src);
-  vec3 *pos = malloc(n * sizeof *pos);
-  rm->n = malloc(n * sizeof *rm->n);
-  rm->Lo = malloc(n * sizeof *rm->Lo);
-  if (!src || !pos || !rm->n || !rm->Lo) { free(src); free(pos); rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (uint32_t i = 0; i < n; i++) { src[i] = i * RAD_STRIDE; pos[i] = m->ph[src[i]].p; }
-  rm->n_pts = n;
-  rad_job j = {ps, rm, src, (int)c->param[P_K], ps->r2_global};
-  parallel_for(c->threads, (n + 255) / 256, rad_chunk, &j);
-  /* into tree order */
-  for (uint32_t i = 0; i < n; i++) rm->n[i] = oct_unpack(m->ph[src[i]].nrm);
-  vec3 *nn = NULL;
-  rgb *lo = NULL;
-  int rc = point_tree_build(&rm->tree, pos, n);
-  if (!rc) rc = point_tree_gather(&rm->tree, rm->n, sizeof *rm->n, (void **)&nn);
-  if (!rc) rc = point_tree_gather(&rm->tree, rm->Lo, sizeof *rm->Lo, (void **)&lo);
-  free(rm->n); free(rm->Lo);
-  rm->n = nn; rm->Lo = lo;
-  free(src); free(pos);
-  if (rc) { rad_free(rm); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  return VALO_OK;
-}
-
-/* The radiance photon nearest to p whose normal agrees with n. */
-static rgb radiance_lookup(const rad_map *rm, vec3 p, vec3 n, float r2max) {
-  if (rm->n_pts == 0) return c3(0, 0, 0);
-  point_near nb[8];
-  int cnt = point_tree_knn(&rm->tree, p, 8, r2max, n, SQUEEZE, nb);
-  int best = -1;
-  for (int i = 0; i < cnt; i++)
-    if (v3_dot(rm->n[nb[i].i], n) > 0.5f && (best < 0 || nb[i].d2 < nb[best].d2)) best = i;
-  return best < 0 ? c3(0, 0, 0) : rm->Lo[nb[best].i];
+  qsort(d2, (size_t)np, sizeof *d2, cmp_float);
+  return d2[np / 2];
 }
 
 static valo_status photon_prepare(void *state, const render_ctx *c, int sample_index, valo_error *err) {
   photon_state *ps = state;
-  uint64_t k = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + STREAM_PHOTON);
-  valo_status st = shoot_map(c, &ps->global, 0, (uint64_t)c->param[P_GLOBAL], k, err);
+  uint64_t key = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + STREAM_PHOTON);
+  float shrink = (float)radius_shrink(sample_index, c->param[P_ALPHA]);
+  int k = (int)c->param[P_K];
+  valo_status st = shoot_map(c, &ps->global, 0, (uint64_t)c->param[P_GLOBAL], key, err);
   if (st) return st;
-  st = build_radiance_photons(ps, c, err);
-  if (st) return st;
+  float r = (float)c->param[P_RADIUS];
+  ps->global.r2 = (r > 0 ? r * r : auto_radius2(&ps->global, k, ps->r2cap_global)) * shrink;
   if (!ps->has_specular) { map_free(&ps->caustic); return VALO_OK; }
-  return shoot_map(c, &ps->caustic, 1, (uint64_t)c->param[P_CAUSTIC], rng_mix64(k + 1), err);
+  st = shoot_map(c, &ps->caustic, 1, (uint64_t)c->param[P_CAUSTIC], rng_mix64(key + 1), err);
+  if (st) return st;
+  r = (float)c->param[P_CAUSTIC_RADIUS];
+  ps->caustic.r2 = (r > 0 ? r * r : auto_radius2(&ps->caustic, k, ps->r2cap_caustic)) * shrink;
+  return VALO_OK;
 }
 
 /* ---- radiance estimate ---- */
-static rgb estimate(const photon_map *m, float r2max, int k, const isect *it, const bsdf *b, const frame *fr, vec3 wo) {
-  if (m->n == 0) return c3(0, 0, 0);
-  point_near nb[POINT_KNN_MAX];
-  int cnt = point_tree_knn(&m->tree, it->p, k, r2max, fr->n, SQUEEZE, nb);
-  if (cnt == 0) return c3(0, 0, 0);
-  float r2 = 0;
-  for (int i = 0; i < cnt; i++) r2 = fmaxf(r2, nb[i].d2);
-  if (cnt < k) r2 = r2max; /* fewer than k in the largest disc: its area */
-  vec3 wo_l = frame_to_local(fr, wo);
-  rgb sum = c3(0, 0, 0);
-  for (int i = 0; i < cnt; i++) {
-    const photon *ph = &m->ph[nb[i].i];
-    vec3 wi = v3_neg(oct_unpack(ph->dir));
-    /* photons that arrived at the other side of the (geometric) surface are not ours */
-    if (!bsdf_transmits(b) && v3_dot(wi, it->ng) <= 0) continue;
-    rgb f = bsdf_eval(b, wo_l, frame_to_local(fr, wi));
-    sum = c3_add(sum, c3_mul(f, ph->power));
-  }
-  return c3_scale(sum, 1 / (PI_F * r2));
+typedef struct est_q {
+  const photon *ph;
+  const bsdf *b;
+  const frame *fr;
+  vec3 q, n, ng, wo_l;
+  float r2;
+  int transmits;
+  rgb sum;
+} est_q;
+static void est_visit(void *user, uint32_t i, float d2) {
+  est_q *e = user;
+  const photon *ph = &e->ph[i];
+  float dn = v3_dot(v3_sub(ph->p, e->q), e->n);
+  if (d2 + SQUEEZE * dn * dn >= e->r2) return; /* outside the squeezed disc */
+  vec3 wi = v3_neg(oct_unpack(ph->dir));
+  /* photons that arrived at the other side of the (geometric) surface are not ours */
+  if (!e->transmits && v3_dot(wi, e->ng) <= 0) return;
+  e->sum = c3_add(e->sum, c3_mul(bsdf_eval(e->b, e->wo_l, frame_to_local(e->fr, wi)), ph->power));
+}
+/* Map m's estimate of the radiance leaving it toward wo: its photons within the pass's
+ * radius, over the disc's area. */
+static rgb estimate(const photon_map *m, const isect *it, const bsdf *b, const frame *fr, vec3 wo) {
+  if (m->n == 0 || !(m->r2 > 0)) return c3(0, 0, 0);
+  est_q e = {m->ph, b, fr, it->p, fr->n, it->ng, frame_to_local(fr, wo), m->r2, bsdf_transmits(b), c3(0, 0, 0)};
+  point_tree_radius(&m->tree, it->p, m->r2, est_visit, &e);
+  return c3_scale(e.sum, 1 / (PI_F * m->r2));
 }
 
 /* Outgoing radiance at the first non-delta surface gather ray r reaches (the walk through
@@ -270,7 +226,7 @@ static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, i
   delta_walk w;
   delta_walk_start(&w, r, depth);
   if (!delta_walk_next(&w, c, smp, ts)) return c3(0, 0, 0);
-  return c3_mul(w.beta, radiance_lookup(&ps->rad, w.it.p, w.fr.n, ps->r2_global));
+  return c3_mul(w.beta, estimate(&ps->global, &w.it, &w.b, &w.fr, w.wo));
 }
 
 /* At a camera path's first non-delta surface: direct light by NEE, the caustic map, and
@@ -278,10 +234,10 @@ static rgb gather_radiance(const render_ctx *c, const photon_state *ps, ray r, i
 static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
                         thread_stats *ts) {
   const photon_state *ps = c->state;
-  int n = (int)c->param[P_GATHER], k = (int)c->param[P_K];
+  int n = (int)c->param[P_GATHER];
   /* no gathering (a quick preview): the global map's estimate of everything the surface
    * reflects here, direct light and caustics included */
-  if (n == 0) return estimate(&ps->global, ps->r2_global, k, it, b, fr, wo);
+  if (n == 0) return estimate(&ps->global, it, b, fr, wo);
   rgb G = c3(0, 0, 0);
   for (int g = 0; g < n; g++) {
     /* gather ray g of sample i is point i n + g of one stratified stream */
@@ -293,7 +249,7 @@ static rgb photon_shade(const render_ctx *c, const isect *it, const bsdf *b, con
   }
   sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
   rgb L = estimate_direct_nomis(c, it, b, fr, wo, smp, ts);
-  if (ps->caustic.n) L = c3_add(L, estimate(&ps->caustic, ps->r2_caustic, k, it, b, fr, wo));
+  if (ps->caustic.n) L = c3_add(L, estimate(&ps->caustic, it, b, fr, wo));
   return c3_add(L, c3_scale(G, 1.0f / (float)n));
 }
 
@@ -301,7 +257,7 @@ static rgb photon_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts)
 
 const integrator_ops integrator_photon = {
     .name = "photon",
-    .description = "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass",
+    .description = "photon mapping (Jensen): NEE for direct light, a caustic map, final gathering over a global map; a fresh photon set per pass, its radius shrinking (progressive, consistent)",
     .kind = INTEGRATOR_RAY,
     .params = photon_params,
     .li = photon_li,
