@@ -29,12 +29,12 @@ typedef struct vpl_state { vlight_set set; float c; } vpl_state;
 
 enum { P_COUNT, P_DIRECT, P_CLAMP, P_COMPENSATE, P_SHADOW };
 static const integrator_param vpl_params[] = {
-    {"count", IPARAM_INT, 1024, 1, 1e6, "virtual point lights per pass (each costs one shadow ray per camera sample)"},
+    {"count", IPARAM_INT, 512, 1, 1e6, "virtual point lights per pass"},
     {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample (cheap beside the lights' shadow rays)"},
-    {"clamp", IPARAM_FLOAT, 0.1, 0, 10,
+    {"clamp", IPARAM_FLOAT, 0.2, 0, 10,
      "clamping distance as a fraction of the scene's bounding-sphere radius R: G f_r is limited to 1 / (clamp R)^2; 0 = no clamping"},
     {"compensate", IPARAM_INT, 0, 0, 1, "1: add back what clamping removed by path tracing (Kollig & Keller 2004): unbiased"},
-    {"shadow_rays", IPARAM_INT, 0, 0, 1e6,
+    {"shadow_rays", IPARAM_INT, 32, 0, 1e6,
      "0: one shadow ray to every light; S > 0: S shadow rays to lights drawn in proportion to their unshadowed contribution"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 static void vpl_destroy(void *st) {

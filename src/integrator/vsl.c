@@ -19,10 +19,10 @@ typedef struct vsl_state { vlight_set set; } vsl_state;
 
 enum { S_COUNT, S_DIRECT, S_RADIUS, S_K, S_CONE };
 static const integrator_param vsl_params[] = {
-    {"count", IPARAM_INT, 1024, 1, 1e6, "virtual spherical lights per pass"},
+    {"count", IPARAM_INT, 2048, 1, 1e6, "virtual spherical lights per pass"},
     {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample"},
     {"radius", IPARAM_FLOAT, 0, 0, 1e30, "sphere radius in scene units; 0 = automatic, the distance to the k-th nearest light"},
-    {"k", IPARAM_INT, 10, 1, 256, "which nearest light sets the automatic radius"},
+    {"k", IPARAM_INT, 2, 1, 256, "which nearest light sets the automatic radius"},
     {"cone_samples", IPARAM_INT, 1, 1, 64, "directions sampled in the cone per light and camera sample"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
