@@ -7,7 +7,7 @@
  *  - scenes/caustic.json (a glass sphere's caustic) against Mitsuba 3
  *    (tests/data/caustic-mitsuba.exr): mean within 3 %, every lit 32x32 block-channel
  *    within 10 %; tests/data/caustic-far (a small lamp's sharp caustic, our held-out
- *    kind) the same, under the full label;
+ *    kind) the same (32 passes, label reference);
  *  - progressive radius reduction makes it consistent: with a deliberately wide first
  *    radius, the caustic's error falls with the passes at the default alpha and does not
  *    with alpha = 1 (a fixed radius);
@@ -153,7 +153,7 @@ static int photon_caustic(void) {
 static int photon_caustic_far(void) {
   valo_options o;
   valo_options_init(&o);
-  o.spp = 64;
+  o.spp = 32;
   return against(VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far.json", VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far-mitsuba.exr", &o,
                  0.03, 0.10, NULL);
 }

