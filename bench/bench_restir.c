@@ -13,7 +13,12 @@
  * a lamp (and their neighbours) left out: lamps smaller than a pixel are equally noisy
  * for every method.
  * References (bench/references, commands in docs/performance.md): path at high spp.
- * Usage: bench_restir [--quick] [--only room|sponza] [--seconds S] */
+ * Scenes: the room (scenes/manylight.json), Sponza with lamps, and the walls room
+ * (bench/manylight-walls.json: 1 536 lamps 1/1000 of the room's width off its walls and
+ * ceiling; reference bench/references/manylight-walls-direct.exr: valo `path
+ * --max-depth 1` at 8 192 spp with the light grid, see docs/performance.md for why not
+ * Mitsuba 3 here).
+ * Usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] */
 #include "valo/valo.h"
 #include "bench_util.h"
 #include "image/image_io.h"
@@ -238,15 +243,18 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
-    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza] [--seconds S]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S]\n"); return 2; }
   }
-  const scene_def scenes[2] = {
+  static const char *names[3] = {"room", "sponza", "walls"};
+  const scene_def scenes[3] = {
       {"room (scenes/manylight.json, 1 024 lamps)", VALO_SOURCE_DIR "/scenes/manylight.json", VALO_SOURCE_DIR "/bench/references/manylight-room-direct.exr",
        VALO_SOURCE_DIR "/bench/references/manylight-room-path.exr", 160, 120},
       {"Sponza with 1 200 lamps (bench/sponza-lamps.json)", VALO_SOURCE_DIR "/bench/sponza-lamps.json",
-       VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", VALO_SOURCE_DIR "/bench/references/sponza-lamps-path.exr", 320, 180}};
-  for (int s = 0; s < 2; s++) {
-    if (only && strcmp(only, s ? "sponza" : "room")) continue;
+       VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", VALO_SOURCE_DIR "/bench/references/sponza-lamps-path.exr", 320, 180},
+      {"walls room (bench/manylight-walls.json, 1 536 lamps 1/1000 of its width off the walls)", VALO_SOURCE_DIR "/bench/manylight-walls.json",
+       VALO_SOURCE_DIR "/bench/references/manylight-walls-direct.exr", NULL, 256, 192}};
+  for (int s = 0; s < 3; s++) {
+    if (only && strcmp(only, names[s])) continue;
     if (bench_scene(&scenes[s], quick, seconds)) return 1;
   }
   return 0;

@@ -8,7 +8,9 @@
 #       --out tests/data/manylight-direct-mitsuba.exr
 #
 # --integrator direct: Mitsuba's "direct" (emission seen by the camera plus direct light
-# at the first surface: what restir-di estimates); path: Mitsuba's "path" with unlimited
+# at the first surface: what restir-di estimates); direct-bsdf: the same by BSDF sampling
+# alone (bounded samples on diffuse surfaces: no heavy tail where lamps sit near surfaces,
+# slower); path: Mitsuba's "path" with unlimited
 # depth (what restir-gi and valo's path estimate). --variant defaults to llvm_ad_rgb
 # (needs an LLVM >= 16 shared library, see DRJIT_LIBLLVM_PATH above), scalar_rgb works
 # everywhere but slowly.
@@ -28,7 +30,7 @@ import argparse, json, os, sys, tempfile
 
 ap = argparse.ArgumentParser()
 ap.add_argument("scene")
-ap.add_argument("--integrator", default="direct", choices=["direct", "path"])
+ap.add_argument("--integrator", default="direct", choices=["direct", "direct-bsdf", "path"])
 ap.add_argument("--spp", type=int, default=4096)
 ap.add_argument("--res", default="")
 ap.add_argument("--out", required=True)
@@ -138,7 +140,9 @@ for shp in sc["shapes"]:
         n += 1
 
 scene = {"type": "scene",
-         "integrator": {"type": "direct"} if a.integrator == "direct" else {"type": "path", "max_depth": -1, "rr_depth": 5},
+         "integrator": {"type": "direct"} if a.integrator == "direct" else
+                       {"type": "direct", "emitter_samples": 0, "bsdf_samples": 1} if a.integrator == "direct-bsdf" else
+                       {"type": "path", "max_depth": -1, "rr_depth": 5},
          "sensor": {"type": "perspective", "fov_axis": "y", "fov": cam.get("fov", 40),
                     "to_world": mi.ScalarTransform4f().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"]),
                     "film": {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"}, "pixel_format": "rgb"},

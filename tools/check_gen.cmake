@@ -1,13 +1,13 @@
 # Runs tools/gen_manylight into OUT and checks its files equal the committed ones
 # (ctest: tools.gen_manylight_reproduces). -DGEN= -DSRC= -DOUT=
 file(MAKE_DIRECTORY ${OUT})
-foreach(kind room sponza)
+foreach(kind room sponza walls)
   execute_process(COMMAND ${GEN} ${kind} ${OUT} RESULT_VARIABLE rc OUTPUT_QUIET)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "gen_manylight ${kind} failed")
   endif()
 endforeach()
-foreach(pair "manylight-room.obj;scenes" "manylight-room.mtl;scenes" "sponza-lamps.obj;bench" "sponza-lamps.mtl;bench")
+foreach(pair "manylight-room.obj;scenes" "manylight-room.mtl;scenes" "sponza-lamps.obj;bench" "sponza-lamps.mtl;bench" "manylight-walls.obj;bench" "manylight-walls.mtl;bench")
   list(GET pair 0 f)
   list(GET pair 1 dir)
   execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT}/${f} ${SRC}/${dir}/${f} RESULT_VARIABLE rc)

@@ -4,6 +4,9 @@
  * (a fixed splitmix64 stream); run by hand, the outputs are committed:
  *   gen_manylight room   DIR   -> DIR/manylight-room.obj/.mtl   (room, boxes, 1024 lamps)
  *   gen_manylight sponza DIR   -> DIR/sponza-lamps.obj/.mtl     (1200 lamps for Sponza's atrium)
+ *   gen_manylight walls  DIR   -> DIR/manylight-walls.obj/.mtl  (1536 lamps 1/1000 of the room's
+ *                                 width off its walls and ceiling, facing in; three radiance
+ *                                 levels over 20x: light dominated by the nearest lamp)
  * Colours: hue uniform, saturation 0.1..0.5 (tinted whites, as real lamps; fully saturated
  * random hues put a floor under any one-sample estimator's per-channel error, see
  * docs/integrators.md); radiance log-uniform over a factor 30, so
@@ -91,20 +94,67 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
   }
 }
 
+/* n lamps lying flat `gap` in front of the room's ceiling (y = 2.5), back (z = -2), left
+ * (x = -2) and right (x = 2) faces, facing into the room: equilateral, of edge `edge`,
+ * radiance L0 times 1, 20^(1/2) or 20 (a third each), tinted. Lamps are spread over the
+ * faces in proportion to their areas. */
+static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, double L0) {
+  for (int i = 0; i < n; i++) {
+    double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd();
+    v3 c, nn;
+    double m = edge; /* keep whole triangles on their face */
+    if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); }
+    else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); }
+    else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); }
+    else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); }
+    v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), w = crs(nn, t);
+    double rot = 2 * PI * rnd(), r = edge / sqrt(3.0);
+    v3 p[3];
+    for (int k = 0; k < 3; k++) {
+      double ang = rot + 2 * PI * k / 3;
+      p[k] = add(c, add(scl(t, r * cos(ang)), scl(w, r * sin(ang))));
+    }
+    double R, G, B;
+    hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
+    int level = (int)(3 * rnd());
+    double L = L0 * pow(20.0, 0.5 * level);
+    fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R * L, G * L, B * L);
+    fprintf(obj, "usemtl lamp%04d\n", i);
+    v3 e1 = add(p[1], scl(p[0], -1)), e2 = add(p[2], scl(p[0], -1)), g = crs(e1, e2);
+    int flip = g.x * nn.x + g.y * nn.y + g.z * nn.z < 0;
+    vert(obj, p[0]); vert(obj, p[flip ? 2 : 1]); vert(obj, p[flip ? 1 : 2]);
+    fprintf(obj, "f %d %d %d\n", nv - 2, nv - 1, nv);
+  }
+}
+
 int main(int argc, char **argv) {
-  if (argc != 3 || (strcmp(argv[1], "room") && strcmp(argv[1], "sponza"))) {
-    fprintf(stderr, "usage: gen_manylight room|sponza DIR\n");
+  if (argc != 3 || (strcmp(argv[1], "room") && strcmp(argv[1], "sponza") && strcmp(argv[1], "walls"))) {
+    fprintf(stderr, "usage: gen_manylight room|sponza|walls DIR\n");
     return 2;
   }
-  int room = !strcmp(argv[1], "room");
+  int room = !strcmp(argv[1], "room"), walls = !strcmp(argv[1], "walls");
+  const char *name = room ? "manylight-room" : walls ? "manylight-walls" : "sponza-lamps";
   char po[4096], pm[4096];
-  snprintf(po, sizeof po, "%s/%s.obj", argv[2], room ? "manylight-room" : "sponza-lamps");
-  snprintf(pm, sizeof pm, "%s/%s.mtl", argv[2], room ? "manylight-room" : "sponza-lamps");
+  snprintf(po, sizeof po, "%s/%s.obj", argv[2], name);
+  snprintf(pm, sizeof pm, "%s/%s.mtl", argv[2], name);
   FILE *obj = fopen(po, "w"), *mtl = fopen(pm, "w");
   if (!obj || !mtl) { fprintf(stderr, "gen_manylight: cannot write %s\n", obj ? pm : po); return 1; }
   fprintf(obj, "# made by tools/gen_manylight.c (%s); do not edit\nmtllib %s\n", argv[1], strrchr(pm, '/') + 1);
   fprintf(mtl, "# made by tools/gen_manylight.c (%s); do not edit\n", argv[1]);
-  if (room) {
+  if (walls) {
+    fprintf(mtl, "newmtl white\nKd 0.7 0.7 0.7\n\nnewmtl red\nKd 0.6 0.1 0.08\n\nnewmtl green\nKd 0.12 0.5 0.15\n\nnewmtl grey\nKd 0.4 0.4 0.45\n\n");
+    /* the same room shell as `room`: x, z in [-2, 2], y in [0, 2.5], open towards +z */
+    quad(obj, mk(-2, 0, -2), mk(-2, 0, 2), mk(2, 0, 2), mk(2, 0, -2), "white");
+    quad(obj, mk(-2, 2.5, -2), mk(2, 2.5, -2), mk(2, 2.5, 2), mk(-2, 2.5, 2), "white");
+    quad(obj, mk(-2, 0, -2), mk(2, 0, -2), mk(2, 2.5, -2), mk(-2, 2.5, -2), "white");
+    quad(obj, mk(-2, 0, -2), mk(-2, 2.5, -2), mk(-2, 2.5, 2), mk(-2, 0, 2), "red");
+    quad(obj, mk(2, 0, -2), mk(2, 0, 2), mk(2, 2.5, 2), mk(2, 2.5, -2), "green");
+    box(obj, mk(-1.0, 0, -1.0), mk(-0.3, 0.9, -0.3), "grey");
+    box(obj, mk(0.3, 0, -0.4), mk(0.9, 0.5, 0.2), "white");
+    box(obj, mk(-0.2, 0, 0.6), mk(0.2, 0.3, 1.0), "grey");
+    /* edge 4/30 of the room's width, 1/1000 of it off the faces */
+    wall_lamps(obj, mtl, 1536, 4.0 / 30, 0.004, 0.25);
+  } else if (room) {
     fprintf(mtl, "newmtl white\nKd 0.7 0.7 0.7\n\nnewmtl red\nKd 0.6 0.1 0.08\n\nnewmtl green\nKd 0.12 0.5 0.15\n\nnewmtl grey\nKd 0.4 0.4 0.45\n\n");
     /* room: x, z in [-2, 2], y in [0, 2.5], open towards +z */
     quad(obj, mk(-2, 0, -2), mk(-2, 0, 2), mk(2, 0, 2), mk(2, 0, -2), "white");          /* floor, +y */
