@@ -18,7 +18,8 @@
  * ceiling; reference bench/references/manylight-walls-direct.exr: valo `path
  * --max-depth 1` at 8 192 spp with the light grid, see docs/performance.md for why not
  * Mitsuba 3 here).
- * Usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] */
+ * Usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params "K=V ..."]
+ * (--params: restir parameters for every restir run, before each run's own) */
 #include "valo/valo.h"
 #include "bench_util.h"
 #include "image/image_io.h"
@@ -60,6 +61,7 @@ static valo_status grab(void *user, const valo_render *r, int f, valo_error *err
 }
 
 /* Runs j; secs excludes scene loading and the acceleration-structure build. */
+static const char *g_params = ""; /* --params */
 static int run(job *j) {
   valo_error err;
   valo_scene *sc;
@@ -67,7 +69,8 @@ static int run(job *j) {
   valo_options o;
   valo_options_init(&o);
   snprintf(o.integrator, sizeof o.integrator, "%s", j->integ);
-  if (j->params) snprintf(o.params, sizeof o.params, "%s", j->params);
+  if (!strncmp(j->integ, "restir", 6)) snprintf(o.params, sizeof o.params, "%s %s", g_params, j->params ? j->params : "");
+  else if (j->params) snprintf(o.params, sizeof o.params, "%s", j->params);
   o.width = j->w; o.height = j->h; o.spp = j->spp; o.threads = 2; o.seed = (int64_t)(j->seed ? j->seed : 5);
   if (j->max_depth >= 0) o.max_depth = j->max_depth;
   if (j->budget > 0) o.time_budget = j->budget;
@@ -243,7 +246,8 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
-    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S]\n"); return 2; }
+    else if (!strcmp(argv[i], "--params") && i + 1 < argc) g_params = argv[++i];
+    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params \"K=V ...\"]\n"); return 2; }
   }
   static const char *names[3] = {"room", "sponza", "walls"};
   const scene_def scenes[3] = {
