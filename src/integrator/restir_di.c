@@ -11,7 +11,7 @@
 #include <string.h>
 
 #define DI_PARAMS_COMMON                                                                                                              \
-  {"candidates", IPARAM_INT, 32, 1, 1024, "M: light samples per pixel per frame (RIS candidates)"},                                   \
+  {"candidates", IPARAM_INT, 8, 1, 1024, "M: light samples per pixel per frame (RIS candidates)"},                                    \
   {"temporal", IPARAM_INT, -1, -1, 1, "1: reuse the previous frame's reservoir at the reprojected pixel; -1: in sequences only"},  \
   {"history", IPARAM_FLOAT, 2, 0, 1000, "the previous frame's M is capped at this many times the current one's (paper: 20)"},          \
   {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
