@@ -24,6 +24,9 @@ int test_main(int argc, char **argv, const test_case *cases);
 const char *shared_file(const char *rel);
 /* 1 when the full (heavy) statistical form is asked for: VALO_TEST_FULL=1. */
 int test_full(void);
+/* 1 when valo was built with Embree; else 0, and under CI=true the running case fails
+ * (Embree comparisons must run in CI, not skip). */
+int test_embree(void);
 /* Writes text to a file in the test's scratch folder; returns its path (static buffer
  * per call slot 0..7). */
 const char *scratch_file(const char *name, const char *text);
