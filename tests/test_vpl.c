@@ -278,6 +278,34 @@ static int vsl_cornell_bias(void) {
   return 0;
 }
 
+/* tests/data/thin-wall: a closed room cut in two by a wall of no thickness, the lamp on
+ * one side. Seen from the dark side, the image must stay black (path gives exactly 0):
+ * its mean under 1e-4 of the lit side's, for vpl and vsl (whose spheres reached through
+ * such walls: 1 % of the lit side before they were kept to their surface's side). */
+static int thin_wall_no_leak(void) {
+  const char *obj = VALO_SOURCE_DIR "/tests/data/thin-wall/thin-wall.obj";
+  char dark[1024], lit[1024];
+  snprintf(dark, sizeof dark,
+           "{ \"camera\": { \"position\": [3.8, 1.0, 0.0], \"look_at\": [2.0, 0.8, 0.0], \"up\": [0, 1, 0], \"fov\": 70 },\n"
+           "  \"shapes\": [ { \"file\": \"%s\" } ] }\n", obj);
+  snprintf(lit, sizeof lit,
+           "{ \"camera\": { \"position\": [0.2, 1.0, 0.0], \"look_at\": [2.0, 0.8, 0.0], \"up\": [0, 1, 0], \"fov\": 70 },\n"
+           "  \"shapes\": [ { \"file\": \"%s\" } ] }\n", obj);
+  const char *pd = scratch_file("thin-dark.json", dark), *pl = scratch_file("thin-lit.json", lit);
+  const char *integ[3] = {"path", "vpl", "vsl"};
+  for (int i = 0; i < 3; i++) {
+    float *a = render_res(pd, integ[i], "", 4, 0, 32), *b = render_res(pl, integ[i], "", 4, 0, 32);
+    CHECK(a && b, "render");
+    double sa = 0, sb = 0;
+    for (int k = 0; k < 32 * 32 * 3; k++) { sa += a[k]; sb += b[k]; }
+    fprintf(stderr, "%s: dark side mean %.3g, lit side %.3g\n", integ[i], sa / (32 * 32 * 3), sb / (32 * 32 * 3));
+    free(a); free(b);
+    CHECK(sb > 0, "%s: the lit side is black", integ[i]);
+    CHECK(sa < 1e-4 * sb, "%s: light leaks through the wall (%.3g of the lit side)", integ[i], sa / sb);
+  }
+  return 0;
+}
+
 static int vpl_threads(void) {
   const char *scene = VALO_SOURCE_DIR "/scenes/cornell-glossy.json";
   const char *integ[3] = {"vpl", "vpl", "vsl"}, *params[3] = {"count=64 compensate=1", "count=64 shadow_rays=8", "count=64"};
@@ -298,7 +326,7 @@ static int vpl_threads(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"vpl_unclamped_converges", vpl_unclamped_converges},
                                     {"vpl_clamping_and_compensation", vpl_clamping_and_compensation},
-                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
+                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"thin_wall_no_leak", thin_wall_no_leak}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
                                     {"vsl_glossy", vsl_glossy},
                                     {"vpl_threads", vpl_threads},
                                     {NULL, NULL}};

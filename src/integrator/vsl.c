@@ -74,6 +74,17 @@ static rgb vsl_contrib(const render_ctx *c, const vlight_set *s, uint32_t i, con
   vec3 d = v3_sub(l->p, it->p);
   float d2 = v3_len2(d);
   if (!(d2 > 0)) return c3(0, 0, 0);
+  /* Spheres do not reach through surfaces: a light on an opaque surface lights only its
+   * own side (x behind that surface, or on the opposite face of the same plane — a wall
+   * of no thickness — gets nothing), and an opaque x takes nothing from a light behind
+   * its own surface. The shadow ray to the sphere's centre cannot stop these: it starts
+   * on x's far side or ends on the shared plane. */
+  float eps = 1e-4f * c->s->radius;
+  if (!bsdf_transmits(&l->b)) {
+    float h = -v3_dot(d, l->ng);
+    if (h < -eps || (h < eps && v3_dot(fr->n, l->ng) < 0)) return c3(0, 0, 0);
+  }
+  if (!bsdf_transmits(b) && v3_dot(d, fr->n) < -eps) return c3(0, 0, 0);
   float dist = sqrtf(d2);
   vec3 w = v3_scale(d, 1 / dist); /* x -> light */
   int cone = (int)c->param[S_CONE];
