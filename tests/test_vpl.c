@@ -278,6 +278,37 @@ static int vsl_cornell_bias(void) {
   return 0;
 }
 
+/* Clamping in the furnace has a closed form. Inside a sphere of radius R every pair of
+ * points has G = 1 / (4 R^2), so G f_r = rho / (4 pi R^2) is the same for every light:
+ * clamped to c = 1 / (clamp R_s)^2 below it, each light's indirect term keeps the fraction
+ * c / (G f_r). With Le = 1 and rho = 1/2, L = Le + rho Le (next-event estimation) +
+ * w rho^2 Le / (1 - rho) = 1.5 + w / 2, so (L(clamp 10) - 1.5) / (L(clamp 5) - 1.5) =
+ * (5 / 10)^2 = 1/4 whatever R_s is; and compensation restores 2. */
+static int vpl_furnace_clamped(void) {
+  const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
+                     "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
+                     "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": 4,\n"
+                     "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }";
+  const char *path = scratch_file("furnace-clamped.json", json);
+  const char *params[3] = {"clamp=5 count=1024 shadow_rays=0", "clamp=10 count=1024 shadow_rays=0", "clamp=10 compensate=1 count=1024 shadow_rays=0"};
+  double m[3];
+  for (int i = 0; i < 3; i++) {
+    float *px = render_res(path, "vpl", params[i], 32, 0, 8);
+    CHECK(px, "render");
+    double s = 0;
+    for (int k = 0; k < 8 * 8 * 3; k++) s += px[k];
+    m[i] = s / (8 * 8 * 3);
+    free(px);
+  }
+  double ratio = (m[1] - 1.5) / (m[0] - 1.5);
+  fprintf(stderr, "furnace: clamp 5 %.4f, clamp 10 %.4f (indirect ratio %.4f, closed form 0.25), clamp 10 compensated %.4f (closed form 2)\n", m[0],
+          m[1], ratio, m[2]);
+  CHECK(m[0] < 1.95 && m[1] < m[0], "clamping does not darken: %g, %g", m[0], m[1]);
+  CHECK(fabs(ratio - 0.25) < 0.02, "clamped indirect ratio %.4f, closed form 0.25", ratio);
+  CHECK(fabs(m[2] - 2) < 0.02, "compensated %.4f, closed form 2", m[2]);
+  return 0;
+}
+
 /* tests/data/thin-wall: a closed room cut in two by a wall of no thickness, the lamp on
  * one side. Seen from the dark side, the image must stay black (path gives exactly 0):
  * its mean under 1e-4 of the lit side's, for vpl and vsl (whose spheres reached through
@@ -326,7 +357,7 @@ static int vpl_threads(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"vpl_unclamped_converges", vpl_unclamped_converges},
                                     {"vpl_clamping_and_compensation", vpl_clamping_and_compensation},
-                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"thin_wall_no_leak", thin_wall_no_leak}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
+                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"thin_wall_no_leak", thin_wall_no_leak}, {"vpl_furnace_clamped", vpl_furnace_clamped}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
                                     {"vsl_glossy", vsl_glossy},
                                     {"vpl_threads", vpl_threads},
                                     {NULL, NULL}};
