@@ -15,6 +15,7 @@
 #include "core/rng.h"
 #include "core/sampling.h"
 #include "geometry/triangle.h"
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -729,6 +730,22 @@ static int light_grid_selection(void) {
       }
     }
     CHECK(fabs(total - 1) < 1e-4, "pmfs sum to %g", total);
+    /* lamps whose back faces the whole cell around p (p behind their plane by more than
+     * the cell's diagonal) get the power share alone: the grid's own part is 0, up to the
+     * rounding of its float running sums (two ulps of 1) */
+    int behind = 0;
+    float diag = v3_len(v3(1 / ls.ginv.x, 1 / ls.ginv.y, 1 / ls.ginv.z));
+    for (uint32_t i = 0; i < n; i++) {
+      const light *l = &s->lights[i];
+      if (l->type != LIGHT_AREA || l->two_sided) continue;
+      const uint32_t *ix = &s->idx[3 * l->tri];
+      if (v3_dot(v3_norm(scene_tri_ng(s, l->tri)), v3_sub(p, s->pos[ix[0]])) > -diag) continue;
+      behind++;
+      float pg = light_select_pmf(&ls, s, i, p), pp = light_select_pmf(&lp, s, i, p);
+      CHECK(fabsf(pg - LIGHT_GRID_POWER * pp) <= (1 - LIGHT_GRID_POWER) * 2 * FLT_EPSILON, "light %u behind the cell: pmf %g, power share %g", i, pg,
+            LIGHT_GRID_POWER * pp);
+    }
+    CHECK(behind > 10, "only %d lamps behind the cell", behind);
     double gain = light_select_pmf(&ls, s, nearest, p) / light_select_pmf(&lp, s, nearest, p);
     CHECK(gain > 5, "the nearest lamp facing the point (%.2f m) is picked only %.2f times as often as by power", dmin, gain);
     memset(obs, 0, n * sizeof *obs);
