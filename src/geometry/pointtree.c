@@ -165,14 +165,17 @@ static void hs_rec(const point_tree *t, const hs_q *s, uint32_t lo, uint32_t hi,
     /* a small subtree is a contiguous run of points: testing them in a row costs less
      * than descending further (the caller's half-space test sees the same points) */
     for (uint32_t i = lo; i < hi; i++) {
-      float d2 = v3_len2(v3_sub(t->p[i], s->q));
+      vec3 v = v3_sub(t->p[i], s->q);
+      if (!(v3_dot(v, s->n) > s->eps)) continue;
+      float d2 = v3_len2(v);
       if (d2 < s->r2) s->fn(s->user, i, d2);
     }
     return;
   }
   uint32_t m = lo + (hi - lo) / 2;
-  float d2 = v3_len2(v3_sub(t->p[m], s->q));
-  if (d2 < s->r2) s->fn(s->user, m, d2);
+  vec3 vm = v3_sub(t->p[m], s->q);
+  float d2 = v3_len2(vm);
+  if (d2 < s->r2 && v3_dot(vm, s->n) > s->eps) s->fn(s->user, m, d2);
   int a = t->axis[m];
   float split = coord(t->p[m], a);
   float lmax[3] = {bmax[0], bmax[1], bmax[2]}, rmin[3] = {bmin[0], bmin[1], bmin[2]};
