@@ -432,12 +432,8 @@ static int still_last_frame(const char *scene_path, const char *integ, const cha
   if (max_depth >= 0) o.max_depth = max_depth;
   o.width = W; o.height = H; o.spp = spp; o.threads = 2; o.frames = n; o.seed = (int64_t)seed;
   valo_scene *sc;
-  valo_error err;
-  CHECK(valo_scene_load(scene_path, &sc, &err) == VALO_OK, "%s", err.message);
-  valo_render *r;
-  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
-  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
-  CHECK(!check_losses(r), "samples lost");
+  valo_render *r = render_file(scene_path, &o, &sc);
+  CHECK(r, "render (or samples lost)");
   valo_stats st;
   valo_render_stats(r, &st);
   CHECK(st.width == W && st.height == H, "film %dx%d", st.width, st.height);
@@ -466,8 +462,8 @@ static double masked_relmse(const float *a, const float *ref, const float *em) {
 /* Each reuse must lower a frame's error, DI and GI separately, on the still room: the
  * last of 8 frames (1 sample per pixel per frame), mean over 3 seeds, against path
  * (DI: max depth 1, 1 024 spp; GI: 512 spp). Spatial reuse (no temporal) against RIS
- * alone: at most 0.7x (measured 0.47x DI, 0.55x GI); temporal + spatial against spatial
- * alone: at most 0.95x DI (measured 0.90x: the history cap of 2 keeps DI's gain small),
+ * alone: at most 0.7x (measured 0.41x DI, 0.55x GI); temporal + spatial against spatial
+ * alone: at most 0.95x DI (measured 0.93x: the history cap of 2 keeps DI's gain small),
  * 0.8x GI (measured 0.66x). Reuse that merged nothing would give about 1x. */
 static int reuse_lowers_error(int gi) {
   const char *room = still_room();

@@ -171,20 +171,33 @@ static int vpl_clamping_and_compensation(void) {
   return 0;
 }
 
+/* The white furnace: a closed diffuse sphere of radius 1 (albedo 1/2, Le = 1 inside, flat
+ * facets), seen from its centre; L = Le / (1 - rho) = 2 everywhere. The mean of a
+ * res x res render of it with integrator integ in *mean: 0, or -1 when the render failed. */
+static int furnace_mean(int subdivisions, const char *integ, const char *params, int res, double *mean) {
+  char json[1024], name[64];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
+           "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
+           "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": %d,\n"
+           "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }", subdivisions);
+  snprintf(name, sizeof name, "furnace-%d.json", subdivisions);
+  float *px = render_res(scratch_file(name, json), integ, params, 32, 0, res);
+  if (!px) return -1;
+  double s = 0;
+  for (int k = 0; k < res * res * 3; k++) s += px[k];
+  *mean = s / (res * res * 3);
+  free(px);
+  return 0;
+}
+
 /* shadow_rays = S: S lights drawn per camera sample in proportion to their unshadowed
  * contribution, weighted 1 / (S p), stand for all of them: the same expectation. The
  * furnace (every light visible) gives the analytic 2, and unclamped vpl on
  * CornellBox-Original meets the reference as vpl with a ray to every light does. */
 static int vpl_sampled_shadow_rays(void) {
-  const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
-                     "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
-                     "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": 3,\n"
-                     "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }";
-  float *px = render_res(scratch_file("furnace.json", json), "vpl", "clamp=0 count=1024 shadow_rays=16", 32, 0, 16);
-  CHECK(px, "render");
-  double m = 0;
-  for (int k = 0; k < 16 * 16 * 3; k++) m += px[k] / (16 * 16 * 3);
-  free(px);
+  double m;
+  CHECK(furnace_mean(3, "vpl", "clamp=0 count=1024 shadow_rays=16", 16, &m) == 0, "render");
   fprintf(stderr, "vpl shadow_rays=16, furnace (rho 0.5, Le 1): mean %.4f, analytic 2\n", m);
   CHECK(fabs(m - 2) < 0.01, "furnace: %g", m);
   const char *scene;
@@ -198,23 +211,13 @@ static int vpl_sampled_shadow_rays(void) {
 }
 
 static int vpl_furnace(void) {
-  const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
-                     "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
-                     "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": 3,\n"
-                     "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }";
-  const char *path = scratch_file("furnace.json", json);
   /* 16x16 pixels: the image is uniform; what matters is the number of light paths (the
    * image's mean varies with each pass's total flux) */
   const struct { const char *integ, *params; } runs[3] = {{"vpl", "clamp=0 count=1024"}, {"vsl", "count=128"}, {"vsl", "count=1024"}};
   double m[3];
   for (int i = 0; i < 3; i++) {
-    float *px = render_res(path, runs[i].integ, runs[i].params, 32, 0, 16);
-    CHECK(px, "render");
-    double s = 0;
-    for (int k = 0; k < 16 * 16 * 3; k++) s += px[k];
-    m[i] = s / (16 * 16 * 3);
+    CHECK(furnace_mean(3, runs[i].integ, runs[i].params, 16, &m[i]) == 0, "render");
     fprintf(stderr, "%s %s, furnace (rho 0.5, Le 1): mean %.4f, analytic 2\n", runs[i].integ, runs[i].params, m[i]);
-    free(px);
   }
   CHECK(fabs(m[0] - 2) < 0.01, "vpl: %g", m[0]);
   /* vsl spreads flux over spheres that surfaces clip: biased, but consistent */
@@ -285,21 +288,9 @@ static int vsl_cornell_bias(void) {
  * w rho^2 Le / (1 - rho) = 1.5 + w / 2, so (L(clamp 10) - 1.5) / (L(clamp 5) - 1.5) =
  * (5 / 10)^2 = 1/4 whatever R_s is; and compensation restores 2. */
 static int vpl_furnace_clamped(void) {
-  const char *json = "{ \"camera\": {\"position\": [0, 0, 0], \"look_at\": [0, 0, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
-                     "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 1}},\n"
-                     "  \"shapes\": [ {\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"subdivisions\": 4,\n"
-                     "    \"flip_normals\": true, \"smooth\": false, \"material\": \"glow\"} ] }";
-  const char *path = scratch_file("furnace-clamped.json", json);
   const char *params[3] = {"clamp=5 count=1024 shadow_rays=0", "clamp=10 count=1024 shadow_rays=0", "clamp=10 compensate=1 count=1024 shadow_rays=0"};
   double m[3];
-  for (int i = 0; i < 3; i++) {
-    float *px = render_res(path, "vpl", params[i], 32, 0, 8);
-    CHECK(px, "render");
-    double s = 0;
-    for (int k = 0; k < 8 * 8 * 3; k++) s += px[k];
-    m[i] = s / (8 * 8 * 3);
-    free(px);
-  }
+  for (int i = 0; i < 3; i++) CHECK(furnace_mean(4, "vpl", params[i], 8, &m[i]) == 0, "render");
   double ratio = (m[1] - 1.5) / (m[0] - 1.5);
   fprintf(stderr, "furnace: clamp 5 %.4f, clamp 10 %.4f (indirect ratio %.4f, closed form 0.25), clamp 10 compensated %.4f (closed form 2)\n", m[0],
           m[1], ratio, m[2]);

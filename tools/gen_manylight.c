@@ -59,6 +59,25 @@ static void hsv(double h, double s, double v, double *r, double *g, double *b) {
   *r = rr + m; *g = gg + m; *b = bb + m;
 }
 
+/* Lamp i: an equilateral triangle of edge `edge` centred at c, turned by rot about its
+ * normal nn, emitting (R, G, B) on the side nn points to. */
+static void lamp(FILE *obj, FILE *mtl, int i, v3 c, v3 nn, double edge, double rot, double R, double G, double B) {
+  v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), u = crs(nn, t);
+  double r = edge / sqrt(3.0);
+  v3 p[3];
+  for (int k = 0; k < 3; k++) {
+    double a = rot + 2 * PI * k / 3;
+    p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
+  }
+  fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R, G, B);
+  fprintf(obj, "usemtl lamp%04d\n", i);
+  /* winding so that the emitting side (counter-clockwise) faces along nn */
+  v3 e1 = add(p[1], scl(p[0], -1)), e2 = add(p[2], scl(p[0], -1)), g = crs(e1, e2);
+  int flip = g.x * nn.x + g.y * nn.y + g.z * nn.z < 0;
+  vert(obj, p[0]); vert(obj, p[flip ? 2 : 1]); vert(obj, p[flip ? 1 : 2]);
+  fprintf(obj, "f %d %d %d\n", nv - 2, nv - 1, nv);
+}
+
 /* n lamps with centres drawn in [lo, hi] (rejecting those inside any of the nb boxes,
  * grown by a margin), equilateral, of edge `edge`, normal within `tilt` radians of -y. */
 static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double tilt, double L0, const v3 *blo, const v3 *bhi, int nb) {
@@ -74,23 +93,10 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
     }
     double th = tilt * sqrt(rnd()), ph = 2 * PI * rnd();
     v3 nn = nrm(mk(sin(th) * cos(ph), -cos(th), sin(th) * sin(ph)));
-    v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), u = crs(nn, t);
-    double rot = 2 * PI * rnd(), r = edge / sqrt(3.0);
-    v3 p[3];
-    for (int k = 0; k < 3; k++) {
-      double a = rot + 2 * PI * k / 3;
-      p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
-    }
-    double R, G, B;
+    double rot = 2 * PI * rnd(), R, G, B;
     hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
     double L = L0 * exp(log(30.0) * rnd());
-    fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R * L, G * L, B * L);
-    fprintf(obj, "usemtl lamp%04d\n", i);
-    /* winding so that the emitting side (counter-clockwise) faces along nn */
-    v3 e1 = add(p[1], scl(p[0], -1)), e2 = add(p[2], scl(p[0], -1)), g = crs(e1, e2);
-    int flip = g.x * nn.x + g.y * nn.y + g.z * nn.z < 0;
-    vert(obj, p[0]); vert(obj, p[flip ? 2 : 1]); vert(obj, p[flip ? 1 : 2]);
-    fprintf(obj, "f %d %d %d\n", nv - 2, nv - 1, nv);
+    lamp(obj, mtl, i, c, nn, edge, rot, R * L, G * L, B * L);
   }
 }
 
@@ -107,23 +113,11 @@ static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, dou
     else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); }
     else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); }
     else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); }
-    v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), w = crs(nn, t);
-    double rot = 2 * PI * rnd(), r = edge / sqrt(3.0);
-    v3 p[3];
-    for (int k = 0; k < 3; k++) {
-      double ang = rot + 2 * PI * k / 3;
-      p[k] = add(c, add(scl(t, r * cos(ang)), scl(w, r * sin(ang))));
-    }
-    double R, G, B;
+    double rot = 2 * PI * rnd(), R, G, B;
     hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
     int level = (int)(3 * rnd());
     double L = L0 * pow(20.0, 0.5 * level);
-    fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R * L, G * L, B * L);
-    fprintf(obj, "usemtl lamp%04d\n", i);
-    v3 e1 = add(p[1], scl(p[0], -1)), e2 = add(p[2], scl(p[0], -1)), g = crs(e1, e2);
-    int flip = g.x * nn.x + g.y * nn.y + g.z * nn.z < 0;
-    vert(obj, p[0]); vert(obj, p[flip ? 2 : 1]); vert(obj, p[flip ? 1 : 2]);
-    fprintf(obj, "f %d %d %d\n", nv - 2, nv - 1, nv);
+    lamp(obj, mtl, i, c, nn, edge, rot, R * L, G * L, B * L);
   }
 }
 

@@ -159,15 +159,15 @@ static int cmp_float(const void *a, const void *b) {
 }
 static float auto_radius2(const photon_map *m, int k, float r2cap) {
   if (m->n == 0) return r2cap;
-  static _Thread_local point_near nb[POINT_KNN_MAX];
+  point_near nb[POINT_KNN_MAX];
   float d2[RADIUS_PROBES];
   int np = m->n < RADIUS_PROBES ? (int)m->n : RADIUS_PROBES;
   for (int i = 0; i < np; i++) {
     const photon *p = &m->ph[(uint64_t)i * m->n / (uint64_t)np];
     int cnt = point_tree_knn(&m->tree, p->p, k, r2cap, v3(0, 0, 1), 0, nb);
-    float r2 = cnt < k ? r2cap : 0;
-    for (int q = 0; q < cnt && cnt >= k; q++) r2 = fmaxf(r2, nb[q].d2);
-    d2[i] = r2;
+    float r2 = 0;
+    for (int q = 0; q < cnt; q++) r2 = fmaxf(r2, nb[q].d2);
+    d2[i] = cnt < k ? r2cap : r2; /* fewer than k within the bound: the bound */
   }
   qsort(d2, (size_t)np, sizeof *d2, cmp_float);
   return d2[np / 2];
