@@ -52,7 +52,7 @@ static int queries_match_brute_force(void) {
     if (i % 97 == 0 && i > 0) pts[i] = pts[i - 1];  /* duplicates */
   }
   point_tree t;
-  CHECK(point_tree_build(&t, pts, NP) == 0, "build");
+  CHECK(point_tree_build(&t, pts, NP) == 0 && point_tree_build_boxes(&t) == 0, "build");
   CHECK(t.n == NP, "n");
   /* the tree holds a permutation of the points */
   char *seen = calloc(NP, 1);
@@ -116,7 +116,7 @@ static int queries_match_brute_force(void) {
   CHECK(bad_knn == 0 && bad_rad == 0 && bad_hs == 0, "mismatches");
   point_tree_free(&t);
   /* an empty tree answers nothing */
-  CHECK(point_tree_build(&t, pts, 0) == 0, "empty build");
+  CHECK(point_tree_build(&t, pts, 0) == 0 && point_tree_build_boxes(&t) == 0, "empty build");
   CHECK(point_tree_knn(&t, v3(0, 0, 0), 5, INFINITY, v3(0, 0, 1), 0, out) == 0, "empty knn");
   point_tree_free(&t);
   free(pts);

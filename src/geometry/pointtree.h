@@ -3,13 +3,19 @@
  * (Jensen's photon-map tree: the median of each range is its node, split on the range's
  * widest axis; no child pointers), with k-nearest and fixed-radius queries. The k-nearest
  * query can measure distance squeezed along a normal (d^2 + f (d.n)^2), the disc variant
- * against leaks through corners and thin walls. Built once, then read by any number of
- * threads. */
+ * against leaks through corners and thin walls. An optional hierarchy of tight boxes
+ * over runs of the tree order serves the half-space radius query (proximity-AO). Built
+ * once, then read by any number of threads. */
 #ifndef VALO_POINTTREE_H
 #define VALO_POINTTREE_H
 #include "core/vec.h"
 #include <stddef.h>
 #include <stdint.h>
+
+/* A node of the optional box hierarchy (point_tree_build_boxes), 32 bytes: the tight box
+ * of its tree-order points; a leaf holds the points [a, b) (b > 0), an inner node its
+ * right child's index in a and 0 in b (the left child is the next node). */
+typedef struct point_box { float lo[3]; uint32_t a; float hi[3]; uint32_t b; } point_box;
 
 typedef struct point_tree {
   vec3 *p;          /* the points in tree order */
@@ -17,6 +23,8 @@ typedef struct point_tree {
   uint8_t *axis;    /* split axis of the node at i */
   uint32_t n;
   bbox bounds;      /* of all points */
+  point_box *box;   /* the box hierarchy, or NULL (point_tree_build_boxes) */
+  uint32_t n_box;
 } point_tree;
 
 /* Builds the tree over pts[0..n) (copied). Returns 0, or -1 when out of memory. */
@@ -39,7 +47,16 @@ int point_tree_knn(const point_tree *t, vec3 q, int k, float r2max, vec3 n_squee
 /* Calls fn for every point with |p - q|^2 < r2 (i in tree order). */
 typedef void (*point_visit_fn)(void *user, uint32_t i, float d2);
 void point_tree_radius(const point_tree *t, vec3 q, float r2, point_visit_fn fn, void *user);
+/* Builds the box hierarchy the half-space queries below need: tight boxes over runs of
+ * the tree order. 0, or -1 out of memory. */
+int point_tree_build_boxes(point_tree *t);
 /* Calls fn for every point with |p - q|^2 < r2 and (p - q).n > eps (n unit), skipping
- * whole subtrees outside the sphere or behind the plane. */
+ * whole boxes outside the sphere or behind the plane (needs point_tree_build_boxes). */
 void point_tree_radius_halfspace(const point_tree *t, vec3 q, float r2, vec3 n, float eps, point_visit_fn fn, void *user);
+/* The same search, handing the caller runs [lo, hi) of tree-order points that may
+ * qualify (every qualifying point is in exactly one run; the caller tests each point),
+ * so that a caller can keep its per-point data in tree-order arrays and test a run in a
+ * branch-free loop. */
+typedef void (*point_run_fn)(void *user, uint32_t lo, uint32_t hi);
+void point_tree_halfspace_runs(const point_tree *t, vec3 q, float r2, vec3 n, float eps, point_run_fn fn, void *user);
 #endif
