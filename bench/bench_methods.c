@@ -9,8 +9,12 @@
  *     time budgets on CornellBox-Original, scenes/cornell-glossy.json
  *     (tests/data/cornell-glossy-path.exr, 64x64) and Sponza under a sun
  *     (bench/sponza-sun.json, bench/references/sponza-sun-path.exr: path, 2048 spp),
- *     relMSE at each budget.
- * Usage: bench_methods [--quick] [--only ao|photon|manylight] */
+ *     relMSE at each budget;
+ *  4. the "when to use each method" table: photon, vpl, vsl and restir-gi at their
+ *     defaults against path at equal time (10 s; 3 with --quick; --seconds S) on
+ *     CornellBox-Original and -Mirror, caustic-far and scenes/manylight.json, and
+ *     restir-di against path with one bounce on manylight.json's direct light.
+ * Usage: bench_methods [--quick] [--only ao|photon|manylight|table] [--seconds S] */
 #include "valo/valo.h"
 #include "bench_util.h"
 #include "scene/scene.h"
@@ -34,11 +38,15 @@
 #endif
 
 
+static int g_last_spp; /* spp of the last render */
+
 static const char *shared(void) { const char *r = getenv("VALO_SHARED"); return r && *r ? r : VALO_SHARED_DIR; }
 
-/* Renders scene file `path` with the integrator and spp; returns pixels and the
- * wall-clock seconds of create + run, less the kd-tree build every method needs. */
-static float *render_budget(const char *path, const char *integ, int spp, double budget, const char *params, int w, int h, double *secs) {
+/* Renders scene file `path` with the integrator and spp (path length at most max_depth,
+ * -1: unlimited); returns pixels and the wall-clock seconds of create + run, less the
+ * kd-tree build every method needs. */
+static float *render_depth(const char *path, const char *integ, int spp, double budget, const char *params, int max_depth, int w, int h,
+                           double *secs) {
   valo_error err;
   valo_scene *sc;
   if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
@@ -51,17 +59,23 @@ static float *render_budget(const char *path, const char *integ, int spp, double
   o.width = w; o.height = h;
   o.threads = 2;
   o.seed = 5;
+  o.max_depth = max_depth;
   valo_render *r;
   double t0 = bench_now();
   if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return NULL; }
   valo_stats st;
   valo_render_stats(r, &st);
+  g_last_spp = st.spp_done;
   *secs = bench_now() - t0 - st.build_seconds; /* the ray-tracing structure is common to all */
   float *px = malloc((size_t)w * h * 3 * sizeof *px);
   valo_render_pixels(r, px);
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   return px;
+}
+
+static float *render_budget(const char *path, const char *integ, int spp, double budget, const char *params, int w, int h, double *secs) {
+  return render_depth(path, integ, spp, budget, params, -1, w, h, secs);
 }
 
 static float *render(const char *path, const char *integ, int spp, const char *params, int w, int h, double *secs) {
@@ -307,16 +321,77 @@ static int bench_manylight(int quick) {
   return 0;
 }
 
+/* The "when to use each method" table (docs/integrators.md): every method at its
+ * defaults against path, equal time, on scenes with independent references: where a
+ * method should win and where it should not. restir-di is measured against path with
+ * one bounce (direct light) on the many-light scene here and in bench_restir. */
+static int bench_table(int quick, double seconds) {
+  char cpath[64], mpath[64], refp[2048], mref[2048], obj[2048];
+  snprintf(cpath, sizeof cpath, "bench-cornell-%ld.json", (long)getpid());
+  snprintf(mpath, sizeof mpath, "bench-mirror-%ld.json", (long)getpid());
+  snprintf(obj, sizeof obj, "%s/scenes/cornell/CornellBox-Original.obj", shared());
+  if (bench_cornell_scene(cpath, obj, 256, 256)) return 1;
+  snprintf(obj, sizeof obj, "%s/scenes/cornell/CornellBox-Mirror.obj", shared());
+  if (bench_cornell_scene(mpath, obj, 256, 256)) return 1;
+  snprintf(refp, sizeof refp, "%s/references/cornell-original.exr", shared());
+  snprintf(mref, sizeof mref, "%s/references/cornell-mirror.exr", shared());
+  const struct { const char *name, *scene, *ref; } sc[5] = {
+      {"CornellBox-Original (diffuse; Cycles)", cpath, refp},
+      {"CornellBox-Mirror (the tall box a mirror; Cycles)", mpath, mref},
+      {"caustic-far (a small lamp's caustic through a glass ball; Mitsuba 3)", VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far.json",
+       VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far-mitsuba.exr"},
+      {"scenes/manylight.json (many small lamps; Mitsuba 3)", VALO_SOURCE_DIR "/scenes/manylight.json",
+       VALO_SOURCE_DIR "/tests/data/manylight-path-mitsuba.exr"},
+      {"scenes/manylight.json, direct light only (Mitsuba 3)", VALO_SOURCE_DIR "/scenes/manylight.json",
+       VALO_SOURCE_DIR "/tests/data/manylight-direct-mitsuba.exr"}};
+  const char *methods[4] = {"photon", "vpl", "vsl", "restir-gi"};
+  double t = seconds > 0 ? seconds : quick ? 3 : 10;
+  printf("## Each method at its defaults against path, %.0f s each (2 threads; relMSE against the reference)\n\n", t);
+  printf("| scene | method | spp | relMSE | path relMSE | method / path | mean vs reference |\n|---|---|---|---|---|---|---|\n");
+  for (int k = 0; k < 5; k++) {
+    image ref;
+    valo_error err;
+    if (image_read(sc[k].ref, &ref, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
+    int n = ref.w * ref.h, direct = k == 4;
+    double ref_mean = 0;
+    for (int i = 0; i < 3 * n; i++) ref_mean += ref.rgb[i];
+    double secs;
+    float *pp = render_depth(sc[k].scene, "path", 1000000, t, NULL, direct ? 1 : -1, ref.w, ref.h, &secs);
+    if (!pp) return 1;
+    double pe = bench_relmse(pp, ref.rgb, n, NULL);
+    free(pp);
+    for (int m = 0; m < (direct ? 1 : 4); m++) {
+      const char *integ = direct ? "restir-di" : methods[m];
+      g_last_spp = 0;
+      float *px = render_depth(sc[k].scene, integ, 1000000, t, NULL, -1, ref.w, ref.h, &secs);
+      if (!px) return 1;
+      double e = bench_relmse(px, ref.rgb, n, NULL), mean = 0;
+      for (int i = 0; i < 3 * n; i++) mean += px[i];
+      printf("| %s | %s | %d | %.5f | %.5f | %.2f | %+.1f %% |\n", sc[k].name, integ, g_last_spp, e, pe, e / pe,
+             100 * (mean / ref_mean - 1));
+      fflush(stdout);
+      free(px);
+    }
+    image_free(&ref);
+  }
+  remove(cpath);
+  remove(mpath);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   int quick = 0;
+  double seconds = 0;
   const char *only = NULL;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else { fprintf(stderr, "usage: bench_methods [--quick] [--only ao|photon|manylight]\n"); return 2; }
+    else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
+    else { fprintf(stderr, "usage: bench_methods [--quick] [--only ao|photon|manylight|table] [--seconds S]\n"); return 2; }
   }
   if ((!only || !strcmp(only, "ao")) && bench_ao(quick)) return 1;
   if ((!only || !strcmp(only, "photon")) && bench_photon(quick)) return 1;
   if ((!only || !strcmp(only, "manylight")) && bench_manylight(quick)) return 1;
+  if ((!only || !strcmp(only, "table")) && bench_table(quick, seconds)) return 1;
   return 0;
 }
