@@ -4,6 +4,8 @@
  * command line's own behaviour: --help, --version, usage errors. */
 #include "harness.h"
 #include "image/image_io.h"
+#include <cjson/cJSON.h>
+#include <math.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <signal.h>
@@ -208,6 +210,117 @@ static int cli_behaviour(void) {
   SAID("/no/such/dir/x.exr"); SAID("does not exist"); NOT_SAID("summary");
   EXPECT_FAIL(1, "render", obj, "-o", "depth:/no/such/dir/d.png", "--res", "8x8");
   SAID("/no/such/dir"); NOT_SAID("summary");
+  return 0;
+}
+
+/* The summary names the peak memory; --stats-json writes the run's figures, and they
+ * agree with the summary and the options: spp as asked, rays/s = rays / render seconds,
+ * every loss cause present, a peak memory above what the film alone needs. An
+ * unwritable stats file is refused before rendering. */
+static double json_num(const cJSON *o, const char *key) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+  return cJSON_IsNumber(v) ? v->valuedouble : -1;
+}
+static int stats_json(void) {
+  const char *obj = write_file("ok.obj", CUBE_OBJ);
+  char out[1200], js[1200];
+  snprintf(out, sizeof out, "%s/s.exr", scratch_dir());
+  snprintf(js, sizeof js, "%s/stats.json", scratch_dir());
+  remove(js);
+  EXPECT_FAIL(0, "render", obj, "-o", out, "--res", "64x48", "--spp", "6", "--threads", "2", "--stats-json", js);
+  SAID("peak memory"); SAID(" MB; lost:"); NO_SANITIZER();
+  FILE *f = fopen(js, "rb");
+  CHECK(f != NULL, "no %s", js);
+  char buf[8192];
+  size_t n = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[n] = 0;
+  cJSON *o = cJSON_Parse(buf);
+  CHECK(o != NULL, "%s is not JSON:\n%s", js, buf);
+  double spp = json_num(o, "spp"), rays = json_num(o, "rays"), rps = json_num(o, "rays_per_second"), rs = json_num(o, "render_seconds");
+  double peak = json_num(o, "peak_memory_bytes"), samples = json_num(o, "samples");
+  const cJSON *status = cJSON_GetObjectItemCaseSensitive(o, "status"), *lost = cJSON_GetObjectItemCaseSensitive(o, "lost");
+  int ok = spp == 6 && samples == 6 * 64 * 48 && rays >= samples && rs > 0 && fabs(rps - rays / rs) <= 1e-4 * rps &&
+           json_num(o, "load_seconds") >= 0 && json_num(o, "build_seconds") >= 0 && peak > 64 * 48 * 12 && json_num(o, "width") == 64 &&
+           json_num(o, "threads") == 2 && cJSON_IsString(status) && !strcmp(status->valuestring, "ok") && json_num(o, "exit_code") == 0 &&
+           cJSON_IsObject(lost) && cJSON_GetArraySize(lost) == VALO_LOSS_COUNT;
+  for (int k = 0; ok && k < VALO_LOSS_COUNT; k++) ok = json_num(lost, valo_loss_name(k)) == 0;
+  cJSON_Delete(o);
+  CHECK(ok, "stats disagree with the run:\n%s", buf);
+  /* nothing but the file is left beside it */
+  char tmp[1300];
+  snprintf(tmp, sizeof tmp, "ls %s | grep -c stats.json.tmp > /dev/null", scratch_dir());
+  CHECK(system(tmp) != 0, "a temporary stats file was left");
+  EXPECT_FAIL(1, "render", obj, "-o", out, "--res", "8x8", "--stats-json", "/no/such/dir/s.json");
+  SAID("/no/such/dir/s.json"); SAID("does not exist"); NOT_SAID("summary");
+  EXPECT_FAIL(2, "render", obj, "--stats-json");
+  SAID("needs a value");
+  return 0;
+}
+
+/* Writes a PNG that is only a signature and a header (IHDR) claiming w x h RGBA pixels:
+ * what a decoder reads before it allocates. */
+static const char *png_header_only(const char *name, uint32_t w, uint32_t h) {
+  unsigned char b[33] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+  for (int k = 0; k < 4; k++) { b[16 + k] = (unsigned char)(w >> (24 - 8 * k)); b[20 + k] = (unsigned char)(h >> (24 - 8 * k)); }
+  b[24] = 8; b[25] = 6; /* 8-bit RGBA; the CRC is left 0 */
+  static char path[2][1200];
+  static int slot;
+  char *p = path[slot++ & 1];
+  snprintf(p, sizeof path[0], "%s/%s", scratch_dir(), name);
+  FILE *f = fopen(p, "wb");
+  if (!f) return NULL;
+  fwrite(b, 1, sizeof b, f);
+  fclose(f);
+  return p;
+}
+
+static double wall_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Memory limits: what would need more memory than the machine has (or than
+ * VALO_MEMORY_LIMIT allows) fails at once, exit 1, naming the file and the size: a PNG
+ * whose header claims 100 000 x 100 000 pixels, a texture and an environment map that
+ * would not fit the limit, a film of absurd size, a mesh file too large for the limit. */
+static int memory_limits(void) {
+  CHECK(png_header_only("huge.png", 100000, 100000) && png_header_only("big.png", 12000, 12000), "cannot write PNGs");
+  write_file("tex.mtl", "newmtl t\nKd 1 1 1\nmap_Kd huge.png\n");
+  write_file("tex2.mtl", "newmtl b\nKd 1 1 1\nmap_Kd big.png\n");
+  const char *obj = write_file("tex.obj", "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n");
+  double t0 = wall_seconds();
+  EXPECT_FAIL(1, "render", obj, "--res", "8x8", "-o", "x.png");
+  SAID("huge.png"); SAID("100000 x 100000"); NO_SANITIZER();
+  /* 12 000 x 12 000 is within the fixed texture limit, but 2.7 GiB as float RGBA */
+  obj = write_file("tex2.obj", "mtllib tex2.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl b\nf 1/1 2/2 3/3\n");
+  setenv("VALO_MEMORY_LIMIT", "1G", 1);
+  EXPECT_FAIL(1, "render", obj, "--res", "8x8", "-o", "x.png");
+  SAID("big.png"); SAID("12000 x 12000 pixels"); SAID("GiB needed, more than the 1.0 GiB of VALO_MEMORY_LIMIT"); NO_SANITIZER();
+  /* an environment map whose header claims 30 000 x 15 000 pixels (5 GiB as float RGB) */
+  write_file("env.pfm", "PF\n30000 15000\n-1\n");
+  const char *js = write_file("env.json", "{ \"shapes\": [{\"type\": \"sphere\"}], \"environment\": {\"type\": \"map\", \"file\": \"env.pfm\"} }\n");
+  EXPECT_FAIL(1, "render", js, "--res", "8x8", "-o", "x.png");
+  SAID("env.pfm"); SAID("30000 x 15000 pixels"); SAID("VALO_MEMORY_LIMIT"); NO_SANITIZER();
+  /* a film of 16 384 x 16 384 pixels under a 256 MiB limit */
+  setenv("VALO_MEMORY_LIMIT", "256M", 1);
+  const char *cube = write_file("ok.obj", CUBE_OBJ);
+  EXPECT_FAIL(1, "render", cube, "--res", "16384x16384", "--spp", "1", "-o", "x.png");
+  SAID("film: 16384 x 16384 pixels"); SAID("more than the 256.0 MiB of VALO_MEMORY_LIMIT"); NOT_SAID("summary"); NO_SANITIZER();
+  /* a mesh file (a 20 x 20 grid, 6 KB) the importer could not hold within 16 KiB */
+  static char grid[16384];
+  size_t n = 0;
+  for (int i = 0; i < 400; i++) n += (size_t)snprintf(grid + n, sizeof grid - n, "v %d %d 0\n", i % 20, i / 20);
+  for (int i = 0; i < 19; i++) n += (size_t)snprintf(grid + n, sizeof grid - n, "f %d %d %d\n", i + 1, i + 2, i + 22);
+  const char *big = write_file("grid.obj", grid);
+  setenv("VALO_MEMORY_LIMIT", "16K", 1);
+  EXPECT_FAIL(1, "render", big, "--res", "8x8", "-o", "x.png");
+  SAID("grid.obj"); SAID("reading a mesh file of"); SAID("more than the 16.0 KiB of VALO_MEMORY_LIMIT"); NO_SANITIZER();
+  unsetenv("VALO_MEMORY_LIMIT");
+  /* each at once, not after allocating or rendering (the film alone would take minutes) */
+  CHECK(wall_seconds() - t0 < 30, "the five refusals took %.1f s", wall_seconds() - t0);
+  EXPECT_FAIL(0, "render", cube, "--res", "8x8", "-o", "x.png");
   return 0;
 }
 
@@ -499,7 +612,7 @@ static int options_docs(void) {
   /* and the other way: every --flag named in README.md and the docs exists */
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
   const char *docs[] = {"README.md", "docs/scene-format.md", "docs/integrators.md"};
-  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", NULL};
+  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", NULL};
   int named = 0;
   for (int k = 0; k < 3; k++) {
     char path[600];
@@ -547,6 +660,8 @@ int main(int argc, char **argv) {
                                     {"no_light", no_light},
                                     {"cli_behaviour", cli_behaviour},
                                     {"frames_cli", frames_cli},
+                                    {"stats_json", stats_json},
+                                    {"memory_limits", memory_limits},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

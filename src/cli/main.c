@@ -3,6 +3,7 @@
  * Ctrl-C handling and exit codes (0 success, 1 error, 2 usage, 130 interrupted).
  * Uses only the public API in valo/valo.h. */
 #include "valo/valo.h"
+#include "cli/run_stats.h"
 #include <errno.h>
 #include <limits.h>
 #include <signal.h>
@@ -73,6 +74,8 @@ static void usage_render(FILE *f) {
     }
   }
   fprintf(f,
+          "  --stats-json FILE      write the run's figures as JSON: load, build and render\n"
+          "                         seconds, spp, rays, rays/s, peak memory, lost samples\n"
           "  --help-integrators     the integrators' parameters, with defaults and ranges\n"
           "  -q, --quiet            no progress or summary\n"
           "  -h, --help             this text\n");
@@ -172,7 +175,7 @@ static int cmd_render(int argc, char **argv) {
   valo_output_options_init(&oo);
   valo_load_options lo;
   valo_load_options_init(&lo);
-  const char *scene_path = NULL, *outputs[MAX_OUTPUTS];
+  const char *scene_path = NULL, *outputs[MAX_OUTPUTS], *stats_json = NULL;
   int nout = 0, quiet = 0;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
@@ -190,6 +193,12 @@ static int cmd_render(int argc, char **argv) {
       i++;
       if (nout == MAX_OUTPUTS) { fprintf(stderr, "valo: at most %d outputs\n", MAX_OUTPUTS); return EXIT_USAGE; }
       outputs[nout++] = val;
+      continue;
+    }
+    if (!strcmp(a, "--stats-json")) {
+      if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
+      stats_json = val;
+      i++;
       continue;
     }
     if (a[0] == '-' && a[1]) {
@@ -240,14 +249,15 @@ static int cmd_render(int argc, char **argv) {
   if (aovs) opt.aovs = aovs;
 
   /* Every output's folder must exist and be writable before hours of rendering. */
-  for (int i = 0; i < nout; i++) {
-    const char *file = outputs[i] + aov_prefix(outputs[i]);
+  for (int i = 0; i <= nout; i++) {
+    if (i == nout && !stats_json) break;
+    const char *file = i == nout ? stats_json : outputs[i] + aov_prefix(outputs[i]);
     char dir[4096];
     const char *slash = strrchr(file, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);
     else snprintf(dir, sizeof dir, ".");
     if (access(dir, W_OK) != 0) {
-      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", outputs[i], dir,
+      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", i == nout ? stats_json : outputs[i], dir,
               errno == ENOENT ? "does not exist" : strerror(errno));
       return 1;
     }
@@ -346,6 +356,11 @@ static int cmd_render(int argc, char **argv) {
       else if (!quiet) fprintf(stderr, "valo: wrote %s (%d spp)\n", outputs[i], st.spp_done);
     }
   }
+  uint64_t peak = run_peak_memory();
+  if (stats_json) {
+    run_report rep = {scene_path, rc == 0 ? "ok" : rc == EXIT_INTERRUPTED ? "interrupted" : "error", rc, load_s, &st, peak};
+    if (run_stats_write_json(stats_json, &rep) && rc == 0) rc = 1;
+  }
   if (!quiet) {
     char lost[256] = "none";
     size_t n = 0;
@@ -356,9 +371,10 @@ static int cmd_render(int argc, char **argv) {
         n += (size_t)snprintf(lost + n, sizeof lost - n, " (%.3g%% of surface samples)", 100.0 * (double)st.lost[k] / (double)st.surface_samples);
     }
     fprintf(stderr,
-            "valo: summary: %llu triangles; load %.2f s, build %.2f s, render %.2f s; %d spp; %.3g rays, %.2f Mrays/s; lost: %s\n",
+            "valo: summary: %llu triangles; load %.2f s, build %.2f s, render %.2f s; %d spp; %.3g rays, %.2f Mrays/s; "
+            "peak memory %.0f MB; lost: %s\n",
             (unsigned long long)st.triangles, load_s, st.build_seconds, st.render_seconds, st.spp_done, (double)st.rays,
-            st.render_seconds > 0 ? st.rays / st.render_seconds * 1e-6 : 0.0, lost);
+            st.render_seconds > 0 ? st.rays / st.render_seconds * 1e-6 : 0.0, (double)peak / 1048576.0, lost);
   }
   valo_render_destroy(r);
   valo_scene_destroy(sc);

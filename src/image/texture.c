@@ -3,6 +3,8 @@
 #include "image/image_io.h"
 #include "image/tonemap.h"
 #include "core/error.h"
+#include "core/memlimit.h"
+#include <stdio.h>
 #include <stb_image.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,12 +15,36 @@
 #define TEXTURE_MAX_PIXELS (1ull << 28)
 
 /* ok: stb read the header (when it did not, decoding fails below with stb's reason). */
+/* The size a PNG's header (IHDR) claims: 1 and *w, *h, or 0 when path is not a PNG. stb
+ * refuses to report sizes above 2^30 bytes of 8-bit texels, without saying them. */
+static int png_header_size(const char *path, int *w, int *h) {
+  unsigned char b[24];
+  FILE *f = fopen(path, "rb");
+  if (!f) return 0;
+  size_t got = fread(b, 1, sizeof b, f);
+  fclose(f);
+  static const unsigned char sig[16] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
+  if (got < sizeof b || memcmp(b, sig, sizeof sig)) return 0;
+  uint32_t pw = (uint32_t)b[16] << 24 | (uint32_t)b[17] << 16 | (uint32_t)b[18] << 8 | b[19];
+  uint32_t ph = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
+  if (pw == 0 || ph == 0 || pw > INT32_MAX || ph > INT32_MAX) return 0;
+  *w = (int)pw;
+  *h = (int)ph;
+  return 1;
+}
+
 static valo_status check_size(int ok, int w, int h, const char *name, valo_error *err) {
   if (ok && (w < 1 || h < 1))
     return err_set(err, VALO_ERR_PARSE, "%s: the image header gives a size of %d x %d pixels", name, w, h);
   if (ok && (unsigned long long)w * (unsigned long long)h > TEXTURE_MAX_PIXELS)
-    return err_set(err, VALO_ERR_INVALID, "%s: image of %d x %d pixels is larger than valo's texture limit (%llu pixels, %llu MiB as float RGBA)",
+    return err_set(err, VALO_ERR_NOMEM, "%s: image of %d x %d pixels is larger than valo's texture limit (%llu pixels, %llu MiB as float RGBA)",
                    name, w, h, TEXTURE_MAX_PIXELS, TEXTURE_MAX_PIXELS * 16 >> 20);
+  if (ok) {
+    /* float RGBA, and the decoder's 8-bit copy (at most 4 channels) while converting */
+    char what[96];
+    snprintf(what, sizeof what, "%d x %d pixels", w, h);
+    return mem_check((uint64_t)w * (uint64_t)h * 20, name, what, err);
+  }
   return VALO_OK;
 }
 
@@ -60,6 +86,9 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
     image im;
     valo_status st = image_read(path, &im, err);
     if (st) return st;
+    char what[96];
+    snprintf(what, sizeof what, "%d x %d pixels", im.w, im.h);
+    if ((st = mem_check((uint64_t)im.w * (uint64_t)im.h * 28, path, what, err))) { image_free(&im); return st; }
     t->px = malloc((size_t)im.w * im.h * 4 * sizeof(float));
     if (!t->px) { image_free(&im); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); }
     for (size_t i = 0; i < (size_t)im.w * im.h; i++) {
@@ -72,6 +101,7 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
   }
   int w = 0, h = 0, n = 0;
   int ok = stbi_info(path, &w, &h, &n);
+  if (!ok) ok = png_header_size(path, &w, &h); /* a size stb refuses to report */
   valo_status st = check_size(ok, w, h, path, err);
   if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);

@@ -107,6 +107,7 @@ int scene_texture_file(scene *s, const char *path, int srgb, valo_error *to) {
   valo_error err;
   if (texture_load_file(&t, path, srgb, to ? to : &err)) {
     if (to) return -1;
+    if (err.status == VALO_ERR_NOMEM && !s->tex_fatal.status) { s->tex_fatal = err; return -1; }
     log_warning("%s%s%s (the map is ignored)", s->tex_user, s->tex_user[0] ? ": " : "", err.message);
     return -1;
   }
@@ -121,6 +122,7 @@ int scene_texture_memory(scene *s, const char *name, const unsigned char *data, 
   texture t;
   valo_error err;
   if (texture_load_memory(&t, data, len, name, srgb, &err)) {
+    if (err.status == VALO_ERR_NOMEM && !s->tex_fatal.status) { s->tex_fatal = err; return -1; }
     log_warning("%s%s%s (the map is ignored)", s->tex_user, s->tex_user[0] ? ": " : "", err.message);
     return -1;
   }

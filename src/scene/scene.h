@@ -88,6 +88,9 @@ typedef struct scene {
   float *tan;              /* 4 per vertex (tangent xyz, bitangent sign), after commit when
                               a material has a normal map; else NULL */
   float *uv;               /* 2 per vertex */
+  valo_error tex_fatal;     /* a map that would not fit in memory (status VALO_ERR_NOMEM):
+                               the loader refuses the scene with it rather than ignoring
+                               the map (VALO_OK when none) */
   char tex_user[1200];      /* while a loader reads a material's maps: "file: material 'x'",
                               named in the warning when one cannot be read */
   float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and

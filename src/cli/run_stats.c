@@ -1,0 +1,74 @@
+/* run_stats.c — owns the peak-memory figure (getrusage) and the `--stats-json` file:
+ * load, build and render seconds, spp, samples, rays, rays/s, peak memory and the lost
+ * samples by cause, written atomically. */
+#include "cli/run_stats.h"
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+uint64_t run_peak_memory(void) {
+  struct rusage ru;
+  if (getrusage(RUSAGE_SELF, &ru)) return 0;
+  return (uint64_t)ru.ru_maxrss * 1024; /* Linux: kilobytes */
+}
+
+/* s as a JSON string (quotes, backslashes and control characters escaped). */
+static void put_string(FILE *f, const char *s) {
+  fputc('"', f);
+  for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+    if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
+    else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
+    else fputc(*p, f);
+  }
+  fputc('"', f);
+}
+
+static void put_report(FILE *f, const run_report *r) {
+  const valo_stats *st = r->st;
+  fprintf(f, "{\n  \"valo_version\": ");
+  put_string(f, valo_version());
+  fprintf(f, ",\n  \"scene\": ");
+  put_string(f, r->scene);
+  fprintf(f, ",\n  \"status\": ");
+  put_string(f, r->status);
+  fprintf(f, ",\n  \"exit_code\": %d,\n  \"integrator\": ", r->exit_code);
+  put_string(f, st->integrator);
+  fprintf(f, ",\n  \"accel\": ");
+  put_string(f, st->accel);
+  fprintf(f, ",\n  \"threads\": %d,\n  \"width\": %d,\n  \"height\": %d,\n  \"triangles\": %llu,\n", st->threads, st->width, st->height,
+          (unsigned long long)st->triangles);
+  fprintf(f, "  \"load_seconds\": %.9f,\n  \"build_seconds\": %.9f,\n  \"render_seconds\": %.9f,\n", r->load_seconds, st->build_seconds,
+          st->render_seconds);
+  fprintf(f, "  \"spp\": %d,\n  \"frames\": %d,\n  \"samples\": %llu,\n  \"rays\": %llu,\n  \"rays_per_second\": %.9g,\n", st->spp_done,
+          st->frames_done, (unsigned long long)st->samples, (unsigned long long)st->rays,
+          st->render_seconds > 0 ? (double)st->rays / st->render_seconds : 0.0);
+  fprintf(f, "  \"peak_memory_bytes\": %llu,\n  \"surface_samples\": %llu,\n  \"lost\": {", (unsigned long long)r->peak_memory,
+          (unsigned long long)st->surface_samples);
+  for (int k = 0; k < VALO_LOSS_COUNT; k++) {
+    fprintf(f, "%s\n    ", k ? "," : "");
+    put_string(f, valo_loss_name(k));
+    fprintf(f, ": %llu", (unsigned long long)st->lost[k]);
+  }
+  fprintf(f, "\n  }\n}\n");
+}
+
+int run_stats_write_json(const char *path, const run_report *r) {
+  char tmp[4200];
+  if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp) {
+    fprintf(stderr, "valo: error: %s: --stats-json name too long\n", path);
+    return -1;
+  }
+  FILE *f = fopen(tmp, "w");
+  if (!f) { fprintf(stderr, "valo: error: %s: cannot write: %s\n", path, strerror(errno)); return -1; }
+  put_report(f, r);
+  int bad = fflush(f) != 0 || fsync(fileno(f)) != 0;
+  bad |= fclose(f) != 0;
+  if (bad || rename(tmp, path) != 0) {
+    fprintf(stderr, "valo: error: %s: cannot write: %s\n", path, strerror(errno));
+    remove(tmp);
+    return -1;
+  }
+  return 0;
+}

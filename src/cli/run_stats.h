@@ -1,0 +1,24 @@
+/* run_stats.h — owns what the command line reports about a finished run beside the
+ * image: the peak memory of the process and the machine-readable `--stats-json` file. */
+#ifndef VALO_CLI_RUN_STATS_H
+#define VALO_CLI_RUN_STATS_H
+#include "valo/valo.h"
+#include <stdint.h>
+
+/* The process's peak resident memory so far, bytes (0 when the system does not say). */
+uint64_t run_peak_memory(void);
+
+/* One run as --stats-json writes it. */
+typedef struct run_report {
+  const char *scene;
+  const char *status;       /* "ok", "interrupted" or "error" */
+  int exit_code;
+  double load_seconds;
+  const valo_stats *st;
+  uint64_t peak_memory;     /* bytes */
+} run_report;
+
+/* Writes the report as JSON to path, atomically (a temporary file beside it, flushed to
+ * disk, then renamed). 0, or -1 with a message on stderr naming the file. */
+int run_stats_write_json(const char *path, const run_report *r);
+#endif
