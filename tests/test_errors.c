@@ -612,7 +612,7 @@ static int options_docs(void) {
   /* and the other way: every --flag named in README.md and the docs exists */
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
   const char *docs[] = {"README.md", "docs/scene-format.md", "docs/integrators.md"};
-  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", NULL};
+  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume", NULL};
   int named = 0;
   for (int k = 0; k < 3; k++) {
     char path[600];

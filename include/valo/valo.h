@@ -156,6 +156,19 @@ VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, 
  * it). Returning non-zero stops the sequence with that status (err filled). */
 typedef valo_status (*valo_frame_fn)(void *user, const valo_render *r, int frame, valo_error *err);
 VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user);
+/* Checkpoints: valo_render_run writes the render's state to path at pass boundaries, at
+ * most every `every_seconds` (0: at every boundary), atomically (a temporary file, fsync,
+ * rename). A still image only (not --frames), from per-ray integrators (not restir-di or
+ * restir-gi); with adaptive sampling and a time budget only the uniform passes are
+ * checkpointed. VALO_ERR_INVALID when the render cannot be checkpointed. */
+VALO_API valo_status valo_render_checkpoint_to(valo_render *r, const char *path, double every_seconds, valo_error *err);
+/* Goes on from the checkpoint at path: call after valo_render_create, before
+ * valo_render_run. The render ends as an uninterrupted one with the same scene, seed and
+ * options would, byte for byte. A checkpoint that is truncated or corrupted, made by
+ * another valo version, for another scene or with other options (all but the thread
+ * count and the time budget) is refused, the message saying which. A time budget is that
+ * of the resumed run; valo_stats counts the samples, rays and seconds of every run. */
+VALO_API valo_status valo_render_resume(valo_render *r, const char *path, valo_error *err);
 /* Asks a running render to stop: tiles already started finish, no new tile starts.
  * Thread-safe and async-signal-safe (one atomic store). */
 VALO_API void valo_render_cancel(valo_render *r);

@@ -8,6 +8,7 @@
 #include "api/options.h"
 #include "render/session.h"
 #include "render/output.h"
+#include "render/checkpoint.h"
 #include "core/error.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -66,6 +67,37 @@ VALO_API void valo_render_on_frame(valo_render *r, valo_frame_fn fn, void *user)
 }
 
 VALO_API const char *valo_loss_name(int cause) { return stats_loss_name(cause); }
+
+static valo_status checkpointable(const valo_render *r, valo_error *err) {
+  if (!r) return err_set(err, VALO_ERR_INVALID, "no render");
+  if (r->ss->opt.frames > 0) return err_set(err, VALO_ERR_INVALID, "checkpoints are for still images, not sequences (--frames)");
+  if (r->ss->integ->kind == INTEGRATOR_IMAGE)
+    return err_set(err, VALO_ERR_INVALID, "checkpoints are not supported for image-wide integrators (%s)", r->ss->integ->name);
+  return VALO_OK;
+}
+
+VALO_API valo_status valo_render_checkpoint_to(valo_render *r, const char *path, double every_seconds, valo_error *err) {
+  clear_err(err);
+  valo_status st = checkpointable(r, err);
+  if (st) return st;
+  if (!path || !*path || strlen(path) >= sizeof r->ss->ckpt_path) return err_set(err, VALO_ERR_INVALID, "no checkpoint file, or its name is too long");
+  if (!(every_seconds >= 0)) return err_set(err, VALO_ERR_INVALID, "checkpoint interval %g: must be 0 or more seconds", every_seconds);
+  snprintf(r->ss->ckpt_path, sizeof r->ss->ckpt_path, "%s", path);
+  r->ss->ckpt_every = every_seconds;
+  return VALO_OK;
+}
+
+VALO_API valo_status valo_render_resume(valo_render *r, const char *path, valo_error *err) {
+  clear_err(err);
+  valo_status st = checkpointable(r, err);
+  if (st) return st;
+  if (r->ss->resumed || r->ss->spp_done > 0) return err_set(err, VALO_ERR_INVALID, "resume before the render runs");
+  log_scope scope;
+  log_scope_enter(&scope, r->warn_fn, r->warn_user);
+  st = checkpoint_read(r->ss, path, err);
+  log_scope_leave(&scope);
+  return st;
+}
 
 VALO_API valo_status valo_render_run(valo_render *r, valo_progress_fn progress, void *user, valo_error *err) {
   clear_err(err);

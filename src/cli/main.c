@@ -74,6 +74,10 @@ static void usage_render(FILE *f) {
     }
   }
   fprintf(f,
+          "  --checkpoint FILE      save the render's state to FILE at pass boundaries (atomically)\n"
+          "  --checkpoint-every S   at most every S seconds (default 60; 0: every pass)\n"
+          "  --resume FILE          go on from a checkpoint (and keep checkpointing to it);\n"
+          "                         the same scene and options; --time is this run's budget\n"
           "  --stats-json FILE      write the run's figures as JSON: load, build and render\n"
           "                         seconds, spp, rays, rays/s, peak memory, lost samples\n"
           "  --help-integrators     the integrators' parameters, with defaults and ranges\n"
@@ -175,7 +179,8 @@ static int cmd_render(int argc, char **argv) {
   valo_output_options_init(&oo);
   valo_load_options lo;
   valo_load_options_init(&lo);
-  const char *scene_path = NULL, *outputs[MAX_OUTPUTS], *stats_json = NULL;
+  const char *scene_path = NULL, *outputs[MAX_OUTPUTS], *stats_json = NULL, *ckpt = NULL, *resume = NULL;
+  double ckpt_every = 60;
   int nout = 0, quiet = 0;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i];
@@ -195,10 +200,20 @@ static int cmd_render(int argc, char **argv) {
       outputs[nout++] = val;
       continue;
     }
-    if (!strcmp(a, "--stats-json")) {
+    if (!strcmp(a, "--stats-json") || !strcmp(a, "--checkpoint") || !strcmp(a, "--resume") || !strcmp(a, "--checkpoint-every")) {
       if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
-      stats_json = val;
       i++;
+      if (a[2] == 's') stats_json = val;
+      else if (a[2] == 'r') resume = val;
+      else if (!strcmp(a, "--checkpoint")) ckpt = val;
+      else {
+        char *end;
+        ckpt_every = strtod(val, &end);
+        if (end == val || *end || !(ckpt_every >= 0 && ckpt_every <= 1e9)) {
+          fprintf(stderr, "valo: --checkpoint-every: \"%s\" is not a number of seconds from 0 to 1e9\n", val);
+          return EXIT_USAGE;
+        }
+      }
       continue;
     }
     if (a[0] == '-' && a[1]) {
@@ -248,16 +263,18 @@ static int cmd_render(int argc, char **argv) {
   }
   if (aovs) opt.aovs = aovs;
 
+  if (resume && !ckpt) ckpt = resume; /* a resumed render keeps checkpointing to its file */
   /* Every output's folder must exist and be writable before hours of rendering. */
-  for (int i = 0; i <= nout; i++) {
-    if (i == nout && !stats_json) break;
-    const char *file = i == nout ? stats_json : outputs[i] + aov_prefix(outputs[i]);
+  const char *extra[2] = {stats_json, ckpt};
+  for (int i = 0; i < nout + 2; i++) {
+    if (i >= nout && !extra[i - nout]) continue;
+    const char *file = i >= nout ? extra[i - nout] : outputs[i] + aov_prefix(outputs[i]);
     char dir[4096];
     const char *slash = strrchr(file, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);
     else snprintf(dir, sizeof dir, ".");
     if (access(dir, W_OK) != 0) {
-      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", i == nout ? stats_json : outputs[i], dir,
+      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", i >= nout ? extra[i - nout] : outputs[i], dir,
               errno == ENOENT ? "does not exist" : strerror(errno));
       return 1;
     }
@@ -290,6 +307,12 @@ static int cmd_render(int argc, char **argv) {
     valo_scene_destroy(sc);
     return 1;
   }
+  if ((resume && valo_render_resume(r, resume, &err)) || (ckpt && valo_render_checkpoint_to(r, ckpt, ckpt_every, &err))) {
+    fprintf(stderr, "valo: error: %s\n", err.message);
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+    return 1;
+  }
   valo_stats st;
   valo_render_stats(r, &st);
   valo_options eff;
@@ -308,6 +331,7 @@ static int cmd_render(int argc, char **argv) {
     else snprintf(budget, sizeof budget, "%d spp", spp_total);
     fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %s, %s integrator, %s, %d threads\n", scene_path,
             (unsigned long long)st.triangles, st.width, st.height, budget, st.integrator, st.accel, st.threads);
+    if (resume) fprintf(stderr, "valo: resuming from %s at %d spp\n", resume, st.spp_done);
     if (!valo_scene_has_light(sc))
       fprintf(stderr, "valo: warning: the scene has no light: the image will be black\n");
   }

@@ -93,7 +93,7 @@ static void adapt_chunk(void *user, int64_t item, int thread) {
 valo_status adapt_digest(session *ss, int uniform_spp, double total, double budget, double t0, valo_progress_fn progress, void *user,
                                 thread_stats *ts, valo_error *err) {
   size_t np = (size_t)ss->opt.width * ss->opt.height;
-  double taken = (double)uniform_spp * (double)np;
+  double taken = ss->resumed && ss->resume.phase == CKPT_ADAPT_DIGEST ? ss->resume.taken : (double)uniform_spp * (double)np;
   prio *pr = malloc(np * sizeof *pr);
   if (!pr) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
@@ -121,6 +121,9 @@ valo_status adapt_digest(session *ss, int uniform_spp, double total, double budg
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
       break;
     }
+    ss->spp_done = (int)(taken / (double)np);
+    ss->ckpt_state = (ckpt_state){CKPT_ADAPT_DIGEST, 0, 0, taken, NULL, NULL};
+    session_checkpoint_tick(ss, ts, t0);
     if (budget > 0 && el >= budget) break;
   }
   ss->spp_done = (int)(taken / (double)np);
@@ -224,14 +227,20 @@ valo_status adapt_error(session *ss, double total, double budget, double t0, val
   /* A sample budget: the final counts at once, taken in equal stages of about 2 samples
    * per pixel (8 to 64 of them) so that progress moves; they depend on the budget alone,
    * so the image does not depend on timing. */
-  int stages = 0;
-  if (!(budget > 0)) {
+  int stages = 0, stage0 = 1;
+  if (!(budget > 0) && ss->resumed && ss->resume.phase == CKPT_ADAPT_ERROR) {
+    /* resumed: the plan made after the uniform passes, from the stage after the saved one */
+    memcpy(first, ss->resume.first, np * sizeof *first);
+    memcpy(fin, ss->resume.fin, np * sizeof *fin);
+    stages = ss->resume.stages;
+    stage0 = ss->resume.stage + 1;
+  } else if (!(budget > 0)) {
     if (waterfill(ss, a, cap, np, total, fin, tmp) <= taken) goto finish; /* all at their noise threshold */
     for (size_t i = 0; i < np; i++) first[i] = ss->film.count[i];
     double per_pixel = (total - taken) / (double)np;
     stages = per_pixel / 2 < 8 ? 8 : per_pixel / 2 > 64 ? 64 : (int)(per_pixel / 2);
   }
-  for (int stage = 1;; stage++) {
+  for (int stage = stage0;; stage++) {
     double sum = 0;
     if (budget > 0) {
       double rem = budget - (now_seconds() - t0);
@@ -260,6 +269,13 @@ valo_status adapt_error(session *ss, double total, double budget, double t0, val
     if (session_report_progress(progress, user, taken / total, (int)(taken / (double)np), el, budget)) {
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
       break;
+    }
+    if (!(budget > 0)) {
+      /* a sample budget's plan is fixed, so a stage boundary can be resumed from; a time
+       * budget's stages depend on timing, and are not checkpointed */
+      ss->spp_done = (int)(taken / (double)np);
+      ss->ckpt_state = (ckpt_state){CKPT_ADAPT_ERROR, stage, stages, taken, first, fin};
+      session_checkpoint_tick(ss, ts, t0);
     }
     if (taken >= total || (budget > 0 && el >= budget)) break;
   }

@@ -2,6 +2,7 @@
 #include "render/session.h"
 #include "render/adaptive.h"
 #include "render/tiles.h"
+#include "render/checkpoint.h"
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/memlimit.h"
@@ -107,12 +108,24 @@ fail:
 
 void session_destroy(session *ss) {
   if (!ss) return;
+  free(ss->resume.first);
+  free(ss->resume.fin);
   accel_destroy(ss->acc);
   light_sampler_free(&ss->ctx.ls);
   if (ss->integ && ss->integ->destroy && ss->istate) ss->integ->destroy(ss->istate);
   film_free(&ss->film);
   free(ss->frame_rgb);
   free(ss);
+}
+
+void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0) {
+  if (!ss->ckpt_path[0]) return;
+  double now = now_seconds();
+  if (ss->ckpt_every > 0 && now - ss->ckpt_last < ss->ckpt_every) return;
+  ss->ckpt_run_seconds = now - run_t0;
+  valo_error e;
+  if (checkpoint_write(ss, ts, ss->ckpt_path, &e)) log_warning("%s (the render goes on)", e.message);
+  ss->ckpt_last = now_seconds();
 }
 
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
@@ -200,7 +213,10 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
     if (uniform_spp < 4) uniform_spp = ss->opt.spp < 4 ? ss->opt.spp : 4;
   }
   /* Passes grow until one takes about a second, so progress stays lively. */
-  while (ss->spp_done < uniform_spp) {
+  /* a render resumed in its adaptive phase goes straight on with it */
+  int adaptive_resumed = ss->resumed && ss->resume.phase != CKPT_UNIFORM;
+  ss->ckpt_last = t0;
+  while (ss->spp_done < uniform_spp && !adaptive_resumed) {
     int n = pass_spp;
     if (ss->spp_done + n > uniform_spp) n = uniform_spp - ss->spp_done;
     /* One sample index per pass for integrators with prepare (its light paths are shot
@@ -224,6 +240,8 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", ss->spp_done);
       break;
     }
+    ss->ckpt_state = (ckpt_state){CKPT_UNIFORM, 0, 0, 0, NULL, NULL};
+    session_checkpoint_tick(ss, ts, t0);
     if (budget > 0 && el >= budget) break;
     /* Adaptive with a time budget: the uniform first pass gets ADAPT_UNIFORM of the time
      * (at least 4 spp), as it gets that share of a sample budget, so adaptive sampling
@@ -232,7 +250,7 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
     if (pt < 0.5 && pass_spp < 64) pass_spp *= 2;
     if (ss->opt.adaptive && budget > 0 && pass_spp * (pt / n) > budget * ADAPT_UNIFORM / 2) pass_spp = pass_spp > 1 ? pass_spp / 2 : 1;
   }
-  if (ss->opt.adaptive) uniform_spp = ss->spp_done;
+  if (ss->opt.adaptive && !adaptive_resumed) uniform_spp = ss->spp_done;
   if (ss->opt.adaptive && st == VALO_OK && !(budget > 0 && now_seconds() - t0 >= budget)) {
     size_t np = (size_t)ss->opt.width * ss->opt.height;
     double total = (double)ss->opt.spp * (double)np;

@@ -13,6 +13,11 @@
 #define TILE 16 /* tiles of TILE x TILE pixels: the unit of work and of cancellation */
 
 typedef struct session session;
+/* Where a checkpoint stands (render/checkpoint.h): the uniform passes, a stage of the
+ * error rule's plan (the counts it started from, first, and ends at, fin), or a round
+ * of the digest rule; taken: samples over the whole film. */
+enum { CKPT_UNIFORM = 0, CKPT_ADAPT_ERROR = 1, CKPT_ADAPT_DIGEST = 2 };
+typedef struct ckpt_state { int phase, stage, stages; double taken; uint32_t *first, *fin; } ckpt_state;
 /* Called after each frame of a sequence (opt.frames > 0), from the thread that runs it. */
 typedef valo_status (*session_frame_fn)(void *user, int frame, valo_error *err);
 
@@ -41,6 +46,13 @@ struct session {
   float *frame_rgb;        /* render_frame output, width*height*3 */
   session_frame_fn on_frame;
   void *on_frame_user;
+  char ckpt_path[4096];    /* checkpoints to this file ("" for none), at pass boundaries */
+  double ckpt_every;       /* at most this often (seconds; 0: every boundary) */
+  double ckpt_last;        /* when the last was written (now_seconds) */
+  double ckpt_run_seconds; /* this run's time at the checkpoint being written */
+  ckpt_state ckpt_state;   /* the state at the boundary being checkpointed */
+  ckpt_state resume;       /* the state a resumed render goes on from (owns first, fin) */
+  int resumed;
 };
 
 /* Builds the accelerator, the light sampler, the camera (autofocus included) and the
@@ -54,6 +66,10 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
 /* The pinhole basis of frame f (the scene's camera animation in a sequence, else the
  * still camera) into ss->lens.view; -1 when up is parallel to the view direction. */
 int session_set_view(session *ss, int f);
+/* At a pass boundary (ss->ckpt_state says which): writes the checkpoint when one is due;
+ * ts are this run's counters, run_t0 its start. A failed write is a warning: the render
+ * goes on. */
+void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0);
 /* Calls the progress callback (if any) with the larger of frac and the share of the time
  * budget spent; non-zero when it asks to cancel. */
 int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget);
