@@ -3,14 +3,20 @@
 #   1. install the Debian packages valo needs (only those missing);
 #   2. a Release build with -Werror in build/, then every ctest test;
 #   3. with CI=true (or --sanitize): an ASan+UBSan build in build-asan/ running every
-#      test except the long `reference` and `slow` ones.
+#      test except the long `reference` and `slow` ones;
+#   4. with CI=true (or --fuzz): the libFuzzer harnesses built with clang 14 under
+#      ASan+UBSan in build-fuzz/, each fuzzed for VALO_FUZZ_SECONDS (default 45 here).
 # VALO_TEST_FULL=1 runs the statistical tests in their full (10x larger) form.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sanitize=0
-[ "${CI:-}" = "true" ] && sanitize=1
-for a in "$@"; do [ "$a" = "--sanitize" ] && sanitize=1; done
-scripts/install-deps.sh
+fuzz=0
+[ "${CI:-}" = "true" ] && sanitize=1 && fuzz=1
+for a in "$@"; do
+  [ "$a" = "--sanitize" ] && sanitize=1
+  [ "$a" = "--fuzz" ] && fuzz=1
+done
+scripts/install-deps.sh --optional
 jobs=$(nproc)
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DVALO_WERROR=ON
 cmake --build build -j"$jobs"
@@ -20,4 +26,14 @@ if [ "$sanitize" = 1 ]; then
   cmake --build build-asan -j"$jobs"
   (cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
      ctest --output-on-failure -j"$jobs" -LE "reference|slow" --timeout 1500)
+fi
+if [ "$fuzz" = 1 ]; then
+  if ! command -v clang-14 >/dev/null; then
+    echo "valo: clang-14 is missing: the fuzz harnesses cannot be built" >&2
+    exit 1
+  fi
+  CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVALO_WERROR=ON -DVALO_SANITIZE=ON -DVALO_FUZZ=ON \
+    -DVALO_FUZZ_SECONDS="${VALO_FUZZ_SECONDS:-45}"
+  cmake --build build-fuzz -j"$jobs" --target fuzzers
+  (cd build-fuzz && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j"$jobs" -L fuzz)
 fi

@@ -82,11 +82,11 @@ static int resumed_at(void) {
   return atoi(p + 4);
 }
 
-typedef struct ckpt_case { const char *name; const char *args[8]; int spp, writes, min_at; } ckpt_case;
+typedef struct ckpt_case { const char *name; const char *args[12]; int spp, writes, min_at; } ckpt_case;
 
 /* argv for one run: the common part, the case's arguments, then `more` (NULL-ended). */
 static void build_args(const char **out, const ckpt_case *c, const char *spp, const char *threads, const char *const *more) {
-  const char *common[] = {"render", scene(), "--res", "96x96", "--seed", "7", "--spp", spp, "--threads", threads, NULL};
+  const char *common[] = {"render", scene(), "--res", "64x64", "--seed", "7", "--spp", spp, "--threads", threads, NULL};
   int n = 0;
   for (int i = 0; common[i]; i++) out[n++] = common[i];
   for (int i = 0; c->args[i]; i++) out[n++] = c->args[i];
@@ -126,11 +126,12 @@ static int one_kill(const ckpt_case *c) {
  * of the budget). */
 static int kill_and_resume(void) {
   static const ckpt_case cases[] = {
-      {"path", {NULL}, 96, 4, 1},
-      {"path adaptive (error rule)", {"--adaptive", NULL}, 96, 12, 49},
-      {"path adaptive (digest rule)", {"--adaptive", "--adaptive-rule", "digest", NULL}, 96, 12, 49},
-      {"photon", {"--integrator", "photon", "--param", "photon.global=20000", "--param", "photon.gather=8", NULL}, 6, 3, 1},
-      {"vpl", {"--integrator", "vpl", NULL}, 12, 3, 1}};
+      {"path", {NULL}, 64, 4, 1},
+      {"path adaptive (error rule)", {"--adaptive", NULL}, 64, 12, 33},
+      {"path adaptive (digest rule)", {"--adaptive", "--adaptive-rule", "digest", NULL}, 64, 12, 33},
+      {"photon", {"--integrator", "photon", "--param", "photon.global=5000", "--param", "photon.caustic=2000", "--param", "photon.gather=4", NULL},
+       6, 3, 1},
+      {"vpl", {"--integrator", "vpl", "--param", "vpl.count=128", NULL}, 12, 3, 1}};
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
     if (one_kill(&cases[i])) return 1;
   return 0;

@@ -258,8 +258,8 @@ static int stats_json(void) {
   return 0;
 }
 
-/* Writes a PNG that is only a signature and a header (IHDR) claiming w x h RGBA pixels:
- * what a decoder reads before it allocates. */
+/* Writes a PNG that is a signature and a header (IHDR) claiming w x h RGBA pixels, then
+ * 16 KiB of zeros: what a decoder reads before it allocates. */
 static const char *png_header_only(const char *name, uint32_t w, uint32_t h) {
   unsigned char b[33] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
   for (int k = 0; k < 4; k++) { b[16 + k] = (unsigned char)(w >> (24 - 8 * k)); b[20 + k] = (unsigned char)(h >> (24 - 8 * k)); }
@@ -271,6 +271,9 @@ static const char *png_header_only(const char *name, uint32_t w, uint32_t h) {
   FILE *f = fopen(p, "wb");
   if (!f) return NULL;
   fwrite(b, 1, sizeof b, f);
+  /* padding, so that the size is one a file of this length could hold (texture.c) */
+  static const unsigned char zero[16384];
+  fwrite(zero, 1, sizeof zero, f);
   fclose(f);
   return p;
 }

@@ -1,9 +1,11 @@
-/* main.c — owns the `valo` command line: argument parsing, the progress bar (with
- * samples/s and ETA on a terminal, periodic plain lines otherwise), the final summary,
- * Ctrl-C handling and exit codes (0 success, 1 error, 2 usage, 130 interrupted).
- * Uses only the public API in valo/valo.h. */
+/* main.c — owns the `valo` command line's run: the output folders' check, the progress
+ * bar (with samples/s and ETA on a terminal, periodic plain lines otherwise), the final
+ * summary, checkpoints and resume, Ctrl-C handling and exit codes (0 success, 1 error,
+ * 2 usage, 130 interrupted). Arguments are parsed by args.c. Uses only the public API in
+ * valo/valo.h. */
 #include "valo/valo.h"
 #include "cli/run_stats.h"
+#include "cli/args.h"
 #include <errno.h>
 #include <limits.h>
 #include <signal.h>
@@ -13,9 +15,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#define EXIT_USAGE 2
 #define EXIT_INTERRUPTED 130
-#define MAX_OUTPUTS 16
 
 static valo_render *volatile g_render;
 static volatile sig_atomic_t g_interrupted;
@@ -41,79 +41,7 @@ static void usage_main(FILE *f) {
           valo_version());
 }
 
-static void usage_render(FILE *f) {
-  fprintf(f,
-          "Usage: valo render SCENE [options]\n\n"
-          "SCENE is a .json scene file (docs/scene-format.md) or a mesh file read by Assimp\n"
-          "(OBJ/MTL, glTF 2.0, PLY, ...; its camera is used, or the view is framed automatically).\n"
-          "Options override the scene file:\n"
-          "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
-          "                         repeat for several outputs (default: SCENE-NAME.png);\n"
-          "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs,\n"
-          "                         ao:FILE ambient occlusion (ao.distance), bent:FILE the bent normal,\n"
-          "                         spp:FILE the samples each pixel received\n");
-  /* the declared options (one table: their flags, defaults, ranges and help) */
-  for (int i = 0; valo_option_at(i); i++) {
-    const valo_option_info *o = valo_option_at(i);
-    if (!o->flag) continue;
-    char head[64];
-    snprintf(head, sizeof head, "%s%s%s", o->flag, o->metavar ? " " : "", o->metavar ? o->metavar : "");
-    const char *h = o->help;
-    int first = 1;
-    while (*h) {
-      size_t n = strcspn(h, "\n");
-      fprintf(f, "  %-22s %.*s\n", first ? head : "", (int)n, h);
-      first = 0;
-      h += n;
-      if (*h) h++;
-    }
-    if (!strcmp(o->flag, "--integrator")) {
-      fprintf(f, "  %-22s one of:", "");
-      for (const char *const *n = valo_integrator_names(); *n; n++) fprintf(f, " %s", *n);
-      fprintf(f, "\n");
-    }
-  }
-  fprintf(f,
-          "  --checkpoint FILE      save the render's state to FILE at pass boundaries (atomically)\n"
-          "  --checkpoint-every S   at most every S seconds (default 60; 0: every pass)\n"
-          "  --resume FILE          go on from a checkpoint (and keep checkpointing to it);\n"
-          "                         the same scene and options; --time is this run's budget\n"
-          "  --stats-json FILE      write the run's figures as JSON: load, build and render\n"
-          "                         seconds, spp, rays, rays/s, peak memory, lost samples\n"
-          "  --help-integrators     the integrators' parameters, with defaults and ranges\n"
-          "  -q, --quiet            no progress or summary\n"
-          "  -h, --help             this text\n");
-}
-
-/* Length of an output's AOV prefix ("albedo:", "normal:", "depth:", "spp:"), or 0. */
-static size_t aov_prefix(const char *out) {
-  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
-  for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++)
-    if (!strncmp(out, prefixes[k], strlen(prefixes[k]))) return strlen(prefixes[k]);
-  return 0;
-}
-
 typedef struct progress_state { int tty; int quiet; double last_print; int spp_total; double time_budget; int frames; } progress_state;
-
-/* Where the frame number goes in an output name: a "%d" or "%0Nd" (N < 10). Returns the
- * offset of the '%' and the conversion's length in *len, -1 when there is none, -2 when
- * the name has another '%' (not allowed). */
-static int frame_pattern(const char *name, int *len) {
-  const char *p = strchr(name, '%');
-  if (!p) return -1;
-  const char *q = p + 1;
-  if (*q == '0') { q++; if (*q >= '1' && *q <= '9') q++; else return -2; }
-  if (*q != 'd' || strchr(q + 1, '%')) return -2;
-  *len = (int)(q + 1 - p);
-  return (int)(p - name);
-}
-/* name with its frame pattern replaced by frame f. */
-static void frame_name(const char *name, int f, char *out, size_t n) {
-  int len, at = frame_pattern(name, &len);
-  if (at < 0) { snprintf(out, n, "%s", name); return; }
-  int width = len > 2 ? name[at + 2] - '0' : 0;
-  snprintf(out, n, "%.*s%0*d%s", at, name, width, f, name + at + len);
-}
 
 typedef struct frame_out { const char *const *outputs; int nout; int frames; int quiet; const valo_output_options *oo; } frame_out;
 /* The frame callback: writes the outputs with a frame pattern, and at the last frame the
@@ -173,96 +101,15 @@ static double now_seconds(void) {
 }
 
 static int cmd_render(int argc, char **argv) {
-  valo_options opt;
-  valo_options_init(&opt);
-  valo_output_options oo;
-  valo_output_options_init(&oo);
-  valo_load_options lo;
-  valo_load_options_init(&lo);
-  const char *scene_path = NULL, *outputs[MAX_OUTPUTS], *stats_json = NULL, *ckpt = NULL, *resume = NULL;
-  double ckpt_every = 60;
-  int nout = 0, quiet = 0;
-  for (int i = 0; i < argc; i++) {
-    const char *a = argv[i];
-    const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-    if (!strcmp(a, "-h") || !strcmp(a, "--help")) { usage_render(stdout); return 0; }
-    if (!strcmp(a, "--help-integrators")) {
-      char buf[8192];
-      for (const char *const *n = valo_integrator_names(); *n; n++)
-        if (!valo_integrator_describe(*n, buf, sizeof buf)) fputs(buf, stdout);
-      return 0;
-    }
-    if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) { quiet = 1; continue; }
-    if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-      if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
-      i++;
-      if (nout == MAX_OUTPUTS) { fprintf(stderr, "valo: at most %d outputs\n", MAX_OUTPUTS); return EXIT_USAGE; }
-      outputs[nout++] = val;
-      continue;
-    }
-    if (!strcmp(a, "--stats-json") || !strcmp(a, "--checkpoint") || !strcmp(a, "--resume") || !strcmp(a, "--checkpoint-every")) {
-      if (!val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
-      i++;
-      if (a[2] == 's') stats_json = val;
-      else if (a[2] == 'r') resume = val;
-      else if (!strcmp(a, "--checkpoint")) ckpt = val;
-      else {
-        char *end;
-        ckpt_every = strtod(val, &end);
-        if (end == val || *end || !(ckpt_every >= 0 && ckpt_every <= 1e9)) {
-          fprintf(stderr, "valo: --checkpoint-every: \"%s\" is not a number of seconds from 0 to 1e9\n", val);
-          return EXIT_USAGE;
-        }
-      }
-      continue;
-    }
-    if (a[0] == '-' && a[1]) {
-      /* a declared option (valo_option_at): a flag alone, or a flag and its value */
-      const valo_option_info *info = NULL;
-      for (int k = 0; valo_option_at(k); k++)
-        if (valo_option_at(k)->flag && !strcmp(valo_option_at(k)->flag, a)) info = valo_option_at(k);
-      if (!info) { fprintf(stderr, "valo: unknown option \"%s\" (see valo render --help)\n", a); return EXIT_USAGE; }
-      if (info->metavar && !val) { fprintf(stderr, "valo: %s needs a value\n", a); return EXIT_USAGE; }
-      valo_error perr;
-      if (valo_option_set(a, info->metavar ? val : NULL, &opt, &lo, &oo, &perr)) {
-        fprintf(stderr, "valo: %s: %s\n", a, perr.message);
-        return EXIT_USAGE;
-      }
-      if (info->metavar) i++;
-      continue;
-    }
-    if (!scene_path) scene_path = a;
-    else { fprintf(stderr, "valo: more than one scene given (\"%s\" and \"%s\")\n", scene_path, a); return EXIT_USAGE; }
-  }
-  if (!scene_path) { fprintf(stderr, "valo: no scene given\n"); usage_render(stderr); return EXIT_USAGE; }
-  if (opt.noise_threshold != VALO_UNSET && !(opt.adaptive > 0)) {
-    opt.adaptive = VALO_ADAPTIVE_ERROR;
-    if (!quiet) fprintf(stderr, "valo: note: --noise-threshold turns on adaptive sampling (--adaptive)\n");
-  }
-  char default_out[1024];
-  if (nout == 0) {
-    const char *base = strrchr(scene_path, '/');
-    base = base ? base + 1 : scene_path;
-    const char *dot = strrchr(base, '.');
-    int len = dot ? (int)(dot - base) : (int)strlen(base);
-    snprintf(default_out, sizeof default_out, "%.*s.png", len, base);
-    outputs[nout++] = default_out;
-  }
-  int aovs = 0; /* the AOVs the outputs ask for */
-  for (int i = 0; i < nout; i++) {
-    if (aov_prefix(outputs[i]) && strncmp(outputs[i], "spp:", 4)) aovs |= 1;
-    if (!strncmp(outputs[i], "ao:", 3) || !strncmp(outputs[i], "bent:", 5)) aovs |= VALO_AOVS_AO;
-    int plen, pat = frame_pattern(outputs[i], &plen);
-    if (pat == -2) { fprintf(stderr, "valo: %s: a '%%' in an output name must be a frame pattern, %%d or %%04d\n", outputs[i]); return EXIT_USAGE; }
-    if (pat >= 0 && opt.frames == VALO_UNSET) { fprintf(stderr, "valo: %s: a frame pattern needs --frames\n", outputs[i]); return EXIT_USAGE; }
-    const char *dot = strrchr(outputs[i], '.');
-    if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
-      fprintf(stderr, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", outputs[i]);
-      return EXIT_USAGE;
-    }
-  }
-  if (aovs) opt.aovs = aovs;
-
+  cli_args ca;
+  int prc = cli_parse_render(argc, argv, &ca, stdout, stderr);
+  if (prc >= 0) return prc;
+  valo_options opt = ca.opt;
+  valo_output_options oo = ca.oo;
+  valo_load_options lo = ca.lo;
+  const char *scene_path = ca.scene_path, *const *outputs = ca.outputs, *stats_json = ca.stats_json, *ckpt = ca.ckpt, *resume = ca.resume;
+  double ckpt_every = ca.ckpt_every;
+  int nout = ca.nout, quiet = ca.quiet;
   if (resume && !ckpt) ckpt = resume; /* a resumed render keeps checkpointing to its file */
   /* Every output's folder must exist and be writable before hours of rendering. */
   const char *extra[2] = {stats_json, ckpt};

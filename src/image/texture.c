@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 /* Texels are 16 bytes: a header that claims more than this many (4 GiB of texels) is
  * refused from stb's header read, before anything is decoded or allocated. */
@@ -33,12 +34,21 @@ static int png_header_size(const char *path, int *w, int *h) {
   return 1;
 }
 
-static valo_status check_size(int ok, int w, int h, const char *name, valo_error *err) {
+/* The most pixels a file of `bytes` can decode to: no format stb reads packs more than
+ * about 8 300 pixels into a byte (deflate's 1032:1 on 1-bit PNG rows; RLE and JPEG far
+ * less), so a header claiming more is refused before its decoder runs through pixels
+ * the data cannot hold. */
+#define PIXELS_PER_BYTE_MAX 10000ull
+
+static valo_status check_size(int ok, int w, int h, size_t bytes, const char *name, valo_error *err) {
   if (ok && (w < 1 || h < 1))
     return err_set(err, VALO_ERR_PARSE, "%s: the image header gives a size of %d x %d pixels", name, w, h);
   if (ok && (unsigned long long)w * (unsigned long long)h > TEXTURE_MAX_PIXELS)
     return err_set(err, VALO_ERR_NOMEM, "%s: image of %d x %d pixels is larger than valo's texture limit (%llu pixels, %llu MiB as float RGBA)",
                    name, w, h, TEXTURE_MAX_PIXELS, TEXTURE_MAX_PIXELS * 16 >> 20);
+  if (ok && (unsigned long long)w * (unsigned long long)h > PIXELS_PER_BYTE_MAX * bytes + 65536)
+    return err_set(err, VALO_ERR_PARSE, "%s: the image header claims %d x %d pixels, more than its %zu bytes can hold (damaged)", name, w,
+                   h, bytes);
   if (ok) {
     /* float RGBA, and the decoder's 8-bit copy (at most 4 channels) while converting */
     char what[96];
@@ -72,7 +82,7 @@ valo_status texture_load_memory(texture *t, const unsigned char *data, size_t le
   if (len > (size_t)INT32_MAX) return err_set(err, VALO_ERR_INVALID, "%s: embedded image too large", name);
   int w = 0, h = 0, n = 0;
   int ok = stbi_info_from_memory(data, (int)len, &w, &h, &n);
-  valo_status st = check_size(ok, w, h, name, err);
+  valo_status st = check_size(ok, w, h, len, name, err);
   if (st) return st;
   unsigned char *img = stbi_load_from_memory(data, (int)len, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_PARSE, "%s: cannot decode image: %s", name, stbi_failure_reason());
@@ -102,7 +112,8 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
   int w = 0, h = 0, n = 0;
   int ok = stbi_info(path, &w, &h, &n);
   if (!ok) ok = png_header_size(path, &w, &h); /* a size stb refuses to report */
-  valo_status st = check_size(ok, w, h, path, err);
+  struct stat sb;
+  valo_status st = check_size(ok, w, h, stat(path, &sb) == 0 && sb.st_size > 0 ? (size_t)sb.st_size : 0, path, err);
   if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());

@@ -21,10 +21,16 @@ valo_status json_check_keys(jctx *c, const cJSON *obj, const char *where, const 
     for (const char *const *a = allowed; *a; a++)
       if (!strcmp(it->string, *a)) { ok = 1; break; }
     if (!ok) {
+      /* the key is the file's: as long as it likes (snprintf returns the length it
+       * wanted, so n is clamped to what was written) */
       char msg[512];
-      int n = snprintf(msg, sizeof msg, "unknown key \"%s\" (allowed:", it->string);
-      for (const char *const *a = allowed; *a && n < (int)sizeof msg - 40; a++) n += snprintf(msg + n, sizeof msg - n, " %s", *a);
-      snprintf(msg + n, sizeof msg - n, ")");
+      int n = snprintf(msg, sizeof msg, "unknown key \"%.200s%s\" (allowed:", it->string, strlen(it->string) > 200 ? "..." : "");
+      if (n < 0 || n > (int)sizeof msg - 1) n = (int)sizeof msg - 1;
+      for (const char *const *a = allowed; *a && n < (int)sizeof msg - 40; a++) {
+        int k = snprintf(msg + n, sizeof msg - (size_t)n, " %s", *a);
+        n = k < 0 || n + k > (int)sizeof msg - 1 ? (int)sizeof msg - 1 : n + k;
+      }
+      snprintf(msg + n, sizeof msg - (size_t)n, ")");
       return json_bad(c, where, msg);
     }
   }

@@ -125,6 +125,19 @@ static int tok_number(const char *b, const char *e, double *v) {
   return end == buf + n && end != buf;
 }
 
+/* Whether pass 2 keeps a vertex line cut off by the end of the file: it has the numbers
+ * it needs before the first token that is not one. Other lines: 1. */
+static int truncated_line_kept(const char *s, const char *e) {
+  const char *tb[64], *te[64];
+  int nt = tokens(s, e, tb, te, 64);
+  int kv = tok_is(tb[0], te[0], "v"), kt = tok_is(tb[0], te[0], "vt"), kn = tok_is(tb[0], te[0], "vn");
+  if (!(kv || kt || kn)) return 1;
+  int got = 0;
+  double v;
+  for (int k = 1; k < nt && k < 64 && tok_number(tb[k], te[k], &v); k++) got++;
+  return got >= (kt ? 1 : 3);
+}
+
 static int line_printable(const char *s, const char *e) {
   for (const char *p = s; p < e; p++)
     if ((unsigned char)*p < 32 && *p != '\t') return 0;
@@ -269,7 +282,8 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
     line++;
     const char *tb[2], *te[2];
     int nt = tokens(s, e, tb, te, 2);
-    if (nt == 0) continue;
+    if (nt == 0 || !line_printable(s, e)) continue; /* pass 2 refuses or ignores it */
+    if (next >= end && e == end && len > 0 && txt[len - 1] != '\n' && !truncated_line_kept(s, e)) continue; /* pass 2 drops it */
     if (tok_is(tb[0], te[0], "v")) total[0]++;
     else if (tok_is(tb[0], te[0], "vt")) total[1]++;
     else if (tok_is(tb[0], te[0], "vn")) total[2]++;
@@ -297,6 +311,13 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
     int nt = tokens(s, e, tb, te, 64);
     if (nt == 0 || *tb[0] == '#') { ob_put(&o, s, (size_t)(next - s)); continue; }
     if (!line_printable(s, e)) {
+      /* control bytes in a vertex or face line: a damaged file (dropping the line would
+       * shift every index after it) */
+      if (tok_is(tb[0], te[0], "v") || tok_is(tb[0], te[0], "vt") || tok_is(tb[0], te[0], "vn") || tok_is(tb[0], te[0], "f")) {
+        st = err_set(err, VALO_ERR_PARSE, "%s:%d: control bytes (binary data) in a %.*s line: the file is damaged", path, line,
+                     (int)(te[0] - tb[0]), tb[0]);
+        goto done;
+      }
       if (!not_understood++) first_nu = line;
       continue;
     }

@@ -15,6 +15,7 @@ int ply_is_ply(const unsigned char *data, size_t len);
 /* Checks the PLY held in data (len bytes, read from path, named in messages). Returns
  * VALO_OK or an error "path: what is wrong" (with the line for header and ASCII faults). */
 valo_status ply_check(const char *path, const unsigned char *data, size_t len, valo_error *err);
-/* Reads path and checks it; VALO_OK for a file that is not a PLY. */
+/* Reads path and checks it; VALO_OK for a file that is not a PLY (a name ending in .ply
+ * must be one). */
 valo_status ply_check_file(const char *path, valo_error *err);
 #endif

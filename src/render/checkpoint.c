@@ -64,10 +64,13 @@ static void options_text(const session *ss, char *out, size_t cap) {
     case OPT_SIZE: snprintf(v, sizeof v, "%dx%d", ((const int *)f)[0], ((const int *)f)[1]); break;
     case OPT_NAME: case OPT_PARAMS: snprintf(v, sizeof v, "%.*s", (int)d->size, f); break;
     }
-    n += (size_t)snprintf(out + n, n < cap ? cap - n : 0, "%s %s\n", d->info.flag ? d->info.flag : d->info.json, v);
+    int k = snprintf(out + n, cap - n, "%s %s\n", d->info.flag ? d->info.flag : d->info.json, v);
+    n = k < 0 || n + (size_t)k >= cap ? cap - 1 : n + (size_t)k;
   }
-  for (int i = 0; ss->integ->params && ss->integ->params[i].name; i++)
-    n += (size_t)snprintf(out + n, n < cap ? cap - n : 0, "--param %s.%s=%.17g\n", ss->integ->name, ss->integ->params[i].name, ss->param[i]);
+  for (int i = 0; ss->integ->params && ss->integ->params[i].name; i++) {
+    int k = snprintf(out + n, cap - n, "--param %s.%s=%.17g\n", ss->integ->name, ss->integ->params[i].name, ss->param[i]);
+    n = k < 0 || n + (size_t)k >= cap ? cap - 1 : n + (size_t)k;
+  }
 }
 
 /* ---- writing ---- */
