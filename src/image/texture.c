@@ -34,19 +34,25 @@ static int png_header_size(const char *path, int *w, int *h) {
   return 1;
 }
 
-/* The most pixels a file of `bytes` can decode to: no format stb reads packs more than
- * about 8 300 pixels into a byte (deflate's 1032:1 on 1-bit PNG rows; RLE and JPEG far
- * less), so a header claiming more is refused before its decoder runs through pixels
- * the data cannot hold. */
-#define PIXELS_PER_BYTE_MAX 10000ull
+/* The most pixels a file can decode to per byte, by its format: deflate packs 1 032 bytes
+ * into one, 8 pixels a byte in 1-bit PNG rows (GIF's LZW less); a JPEG block needs a few
+ * bits; the run-length formats stb reads (TGA, BMP, PSD, PIC) at most 128 pixels in 2
+ * bytes. A header claiming more is refused before its decoder runs through pixels the
+ * data cannot hold (a 37 KB TGA claiming 4112 x 4112 kept stb busy for seconds). */
+static unsigned long long pixels_per_byte_max(const unsigned char *head, size_t n) {
+  if (n >= 4 && head[0] == 0x89 && head[1] == 'P' && head[2] == 'N' && head[3] == 'G') return 10000;
+  if (n >= 4 && !memcmp(head, "GIF8", 4)) return 10000;
+  if (n >= 2 && head[0] == 0xff && head[1] == 0xd8) return 2000;
+  return 256;
+}
 
-static valo_status check_size(int ok, int w, int h, size_t bytes, const char *name, valo_error *err) {
+static valo_status check_size(int ok, int w, int h, size_t bytes, unsigned long long per_byte, const char *name, valo_error *err) {
   if (ok && (w < 1 || h < 1))
     return err_set(err, VALO_ERR_PARSE, "%s: the image header gives a size of %d x %d pixels", name, w, h);
   if (ok && (unsigned long long)w * (unsigned long long)h > TEXTURE_MAX_PIXELS)
     return err_set(err, VALO_ERR_NOMEM, "%s: image of %d x %d pixels is larger than valo's texture limit (%llu pixels, %llu MiB as float RGBA)",
                    name, w, h, TEXTURE_MAX_PIXELS, TEXTURE_MAX_PIXELS * 16 >> 20);
-  if (ok && (unsigned long long)w * (unsigned long long)h > PIXELS_PER_BYTE_MAX * bytes + 65536)
+  if (ok && (unsigned long long)w * (unsigned long long)h > per_byte * bytes + 65536)
     return err_set(err, VALO_ERR_PARSE, "%s: the image header claims %d x %d pixels, more than its %zu bytes can hold (damaged)", name, w,
                    h, bytes);
   if (ok) {
@@ -82,7 +88,7 @@ valo_status texture_load_memory(texture *t, const unsigned char *data, size_t le
   if (len > (size_t)INT32_MAX) return err_set(err, VALO_ERR_INVALID, "%s: embedded image too large", name);
   int w = 0, h = 0, n = 0;
   int ok = stbi_info_from_memory(data, (int)len, &w, &h, &n);
-  valo_status st = check_size(ok, w, h, len, name, err);
+  valo_status st = check_size(ok, w, h, len, pixels_per_byte_max(data, len), name, err);
   if (st) return st;
   unsigned char *img = stbi_load_from_memory(data, (int)len, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_PARSE, "%s: cannot decode image: %s", name, stbi_failure_reason());
@@ -113,7 +119,11 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
   int ok = stbi_info(path, &w, &h, &n);
   if (!ok) ok = png_header_size(path, &w, &h); /* a size stb refuses to report */
   struct stat sb;
-  valo_status st = check_size(ok, w, h, stat(path, &sb) == 0 && sb.st_size > 0 ? (size_t)sb.st_size : 0, path, err);
+  unsigned char head[4] = {0, 0, 0, 0};
+  FILE *hf = fopen(path, "rb");
+  size_t hn = hf ? fread(head, 1, sizeof head, hf) : 0;
+  if (hf) fclose(hf);
+  valo_status st = check_size(ok, w, h, stat(path, &sb) == 0 && sb.st_size > 0 ? (size_t)sb.st_size : 0, pixels_per_byte_max(head, hn), path, err);
   if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());

@@ -103,6 +103,9 @@ static int ascii_read(ply_reader *r, ply_type t, double *out) {
   const unsigned char *tok;
   size_t len;
   if (!ascii_token(r, &tok, &len) || len > 63) return 0;
+  /* a control byte (a NUL would end the number early here, not in Assimp's reader) */
+  for (size_t k = 0; k < len; k++)
+    if (tok[k] < 32 || tok[k] == 127) return 0;
   char buf[64];
   memcpy(buf, tok, len);
   buf[len] = 0;
