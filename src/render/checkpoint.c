@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #define CKPT_MAGIC "VALOCKP1"
+#define OPTS_CAP 65536 /* the options text, at most */
 
 static uint64_t fnv(uint64_t h, const void *p, size_t n) {
   const unsigned char *b = p;
@@ -87,10 +88,11 @@ static void put_str(wbuf *w, const char *s) { uint32_t n = (uint32_t)strlen(s); 
 valo_status checkpoint_write(const session *ss, const thread_stats *ts, const char *path, valo_error *err) {
   char tmp[4200];
   if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp) return err_set(err, VALO_ERR_INVALID, "%s: name too long", path);
-  static char opts[65536];
-  options_text(ss, opts, sizeof opts);
+  char *opts = malloc(OPTS_CAP);
+  if (!opts) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path);
+  options_text(ss, opts, OPTS_CAP);
   FILE *f = fopen(tmp, "wb");
-  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot write the checkpoint: %s", path, strerror(errno));
+  if (!f) { free(opts); return err_set(err, VALO_ERR_IO, "%s: cannot write the checkpoint: %s", path, strerror(errno)); }
   wbuf w = {f, FNV0, 0, 0};
   const film *fm = &ss->film;
   size_t np = film_pixels(fm);
@@ -100,6 +102,7 @@ valo_status checkpoint_write(const session *ss, const thread_stats *ts, const ch
   uint64_t sh = scene_hash(ss->s);
   put(&w, &sh, sizeof sh);
   put_str(&w, opts);
+  free(opts);
   put_u32(&w, (uint32_t)fm->width);
   put_u32(&w, (uint32_t)fm->height);
   int32_t st[6] = {ss->spp_done, ss->ckpt_state.phase, ss->ckpt_state.stage, ss->ckpt_state.stages, ss->image_frames,
@@ -184,6 +187,7 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   size_t got = fread(data, 1, n, f);
   fclose(f);
   valo_status st = VALO_OK;
+  char *opts = NULL, *mine = NULL; /* the options texts, stored and this render's */
   if (got != n) { st = err_set(err, VALO_ERR_IO, "%s: cannot read the checkpoint", path); goto done; }
   if (n < 8 + 16 || memcmp(data, CKPT_MAGIC, 8)) {
     st = err_set(err, VALO_ERR_PARSE, "%s: not a valo checkpoint%s", path, n >= 8 && !memcmp(data, "VALOCKP", 7) ? " of this format" : "");
@@ -202,7 +206,9 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   }
   rbuf r = {data, n - 16, 8, 0};
   char ver[64], spath[1100];
-  static char opts[65536], mine[65536];
+  opts = malloc(OPTS_CAP);
+  mine = malloc(OPTS_CAP);
+  if (!opts || !mine) { st = err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); goto done; }
   get_str(&r, ver, sizeof ver);
   if (!r.bad && strcmp(ver, valo_version())) {
     st = err_set(err, VALO_ERR_INVALID, "%s: the checkpoint was made by valo %s; this is valo %s: refused", path, ver, valo_version());
@@ -216,8 +222,8 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
                  strcmp(spath, ss->s->path) ? "" : ", which has changed since");
     goto done;
   }
-  get_str(&r, opts, sizeof opts);
-  options_text(ss, mine, sizeof mine);
+  get_str(&r, opts, OPTS_CAP);
+  options_text(ss, mine, OPTS_CAP);
   if (!r.bad && strcmp(opts, mine)) {
     char why[600];
     first_difference(opts, mine, why, sizeof why);
@@ -268,6 +274,8 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   memcpy(ss->total.lost, c + 2, sizeof ss->total.lost);
   ss->render_seconds = secs;
 done:
+  free(opts);
+  free(mine);
   free(data);
   return st;
 }
