@@ -33,9 +33,9 @@ if [ "$fuzz" = 1 ]; then
     echo "valo: clang-14 is missing: the fuzz harnesses cannot be built" >&2
     exit 1
   fi
+  rm -rf build-fuzz/fuzz-corpus # the same start as any other run of this commit (configure makes it anew)
   CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVALO_WERROR=ON -DVALO_SANITIZE=ON -DVALO_FUZZ=ON \
     -DVALO_FUZZ_SECONDS="${VALO_FUZZ_SECONDS:-60}"
   cmake --build build-fuzz -j"$jobs" --target fuzzers
-  rm -rf build-fuzz/fuzz-corpus/* # the same start as any other run of this commit
   (cd build-fuzz && UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j"$jobs" -L fuzz)
 fi
