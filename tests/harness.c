@@ -224,23 +224,28 @@ static double wall_now(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap) {
-  char log[1200];
-  snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
-  double t0 = wall_now();
+pid_t spawn_cli(const char *const *args, const char *log) {
   pid_t pid = fork();
   if (pid == 0) {
     int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1); dup2(fd, 2);
     close(fd);
-    const char *argv[32];
+    const char *argv[40];
     int n = 0;
     argv[n++] = VALO_EXE;
-    for (int i = 0; args[i] && n < 31; i++) argv[n++] = args[i];
+    for (int i = 0; args[i] && n < 39; i++) argv[n++] = args[i];
     argv[n] = NULL;
     execv(VALO_EXE, (char *const *)argv);
     _exit(127);
   }
+  return pid;
+}
+
+int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap) {
+  char log[1200];
+  snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
+  double t0 = wall_now();
+  pid_t pid = spawn_cli(args, log);
   int status = 0;
   if (sigint_ms > 0) {
     struct timespec d = {sigint_ms / 1000, (long)(sigint_ms % 1000) * 1000000L};

@@ -68,4 +68,8 @@ void compare_images(const float *img, const float *ref, int w, int h, int block,
  * (and to stderr); run_cli_seconds gets the wall time. */
 int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap);
 extern double run_cli_seconds;
+/* Starts valo with args (NULL-ended, at most 38) in a child process, its standard output
+ * and error to the file log (created or truncated); returns the child's pid. */
+#include <sys/types.h>
+pid_t spawn_cli(const char *const *args, const char *log);
 #endif

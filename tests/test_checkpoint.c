@@ -63,18 +63,7 @@ static int run_and_kill(const char *const *args, const char *ckpt, int writes) {
   else snprintf(dir, sizeof dir, ".");
   int in = inotify_init1(IN_NONBLOCK);
   if (in < 0 || inotify_add_watch(in, dir, IN_MOVED_TO) < 0) { fprintf(stderr, "inotify: %s\n", strerror(errno)); return 1; }
-  pid_t pid = fork();
-  if (pid == 0) {
-    int fd = open("/dev/null", O_WRONLY);
-    dup2(fd, 1); dup2(fd, 2);
-    const char *argv[40];
-    int n = 0;
-    argv[n++] = VALO_EXE;
-    for (int i = 0; args[i] && n < 39; i++) argv[n++] = args[i];
-    argv[n] = NULL;
-    execv(VALO_EXE, (char *const *)argv);
-    _exit(127);
-  }
+  pid_t pid = spawn_cli(args, "/dev/null");
   int seen = 0, status = 0;
   for (;;) {
     struct pollfd pf = {in, POLLIN, 0};

@@ -33,6 +33,12 @@ static void human(uint64_t b, char *out, size_t n) {
   else snprintf(out, n, "%.1f KiB", (double)b / 1024.0);
 }
 
+valo_status mem_check_pixels(uint64_t w, uint64_t h, uint64_t bytes_per_pixel, const char *name, valo_error *err) {
+  char what[64];
+  snprintf(what, sizeof what, "%llu x %llu pixels", (unsigned long long)w, (unsigned long long)h);
+  return mem_check(w * h * bytes_per_pixel, name, what, err);
+}
+
 valo_status mem_check(uint64_t bytes, const char *name, const char *what, valo_error *err) {
   uint64_t lim = mem_limit();
   if (bytes <= lim) return VALO_OK;

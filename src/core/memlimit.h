@@ -13,4 +13,6 @@ uint64_t mem_limit(void);
 /* VALO_OK when `bytes` fit within the limit; otherwise VALO_ERR_NOMEM with the message
  * "<name>: <what>: <size> needed, more than the <limit> of this machine's memory". */
 valo_status mem_check(uint64_t bytes, const char *name, const char *what, valo_error *err);
+/* mem_check for w x h pixels of bytes_per_pixel each, described as "W x H pixels". */
+valo_status mem_check_pixels(uint64_t w, uint64_t h, uint64_t bytes_per_pixel, const char *name, valo_error *err);
 #endif

@@ -87,9 +87,7 @@ valo_status hdr_decode(const char *name, const unsigned char *d, size_t n, image
   if (!rle && (uint64_t)h * w * 4 > left)
     return err_set(err, VALO_ERR_PARSE, "%s: HDR pixels end early: %ld x %ld flat pixels need %llu bytes; the file has %llu",
                    name, w, h, (unsigned long long)((uint64_t)h * w * 4), (unsigned long long)left);
-  char what[96];
-  snprintf(what, sizeof what, "%ld x %ld pixels", w, h);
-  valo_status mst = mem_check((uint64_t)w * (uint64_t)h * 12, name, what, err);
+  valo_status mst = mem_check_pixels((uint64_t)w, (uint64_t)h, 12, name, err);
   if (mst) return mst;
   float *rgb = malloc((size_t)w * (size_t)h * 3 * sizeof(float));
   unsigned char *scan = rle ? malloc((size_t)w * 4) : NULL;

@@ -182,9 +182,7 @@ static valo_status read_pfm(const char *path, image *out, valo_error *err) {
     return err_set(err, VALO_ERR_PARSE, "%s: not a little-endian RGB PFM file", path);
   }
   fgetc(f);
-  char what[96];
-  snprintf(what, sizeof what, "%d x %d pixels", w, h);
-  valo_status mst = mem_check((uint64_t)w * (uint64_t)h * 12, path, what, err);
+  valo_status mst = mem_check_pixels((uint64_t)w, (uint64_t)h, 12, path, err);
   if (mst) { fclose(f); return mst; }
   out->w = w; out->h = h;
   out->rgb = malloc((size_t)w * h * 3 * sizeof(float));
@@ -294,9 +292,7 @@ static valo_status read_exr(const char *path, image *out, valo_error *err) {
   exr_get_data_window(ctx, 0, &dw);
   int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
   if (w <= 0 || h <= 0 || w > 65536 || h > 65536) { st = err_set(err, VALO_ERR_PARSE, "%s: bad data window", path); goto done; }
-  char what[96];
-  snprintf(what, sizeof what, "%d x %d pixels", w, h);
-  if ((st = mem_check((uint64_t)w * (uint64_t)h * 12, path, what, err))) goto done;
+  if ((st = mem_check_pixels((uint64_t)w, (uint64_t)h, 12, path, err))) goto done;
   buf = calloc((size_t)w * h * 3, sizeof(float));
   if (!buf) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
   char use[256];

@@ -9,23 +9,18 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <sys/stat.h>
 
 /* Texels are 16 bytes: a header that claims more than this many (4 GiB of texels) is
  * refused from stb's header read, before anything is decoded or allocated. */
 #define TEXTURE_MAX_PIXELS (1ull << 28)
 
 /* ok: stb read the header (when it did not, decoding fails below with stb's reason). */
-/* The size a PNG's header (IHDR) claims: 1 and *w, *h, or 0 when path is not a PNG. stb
- * refuses to report sizes above 2^30 bytes of 8-bit texels, without saying them. */
-static int png_header_size(const char *path, int *w, int *h) {
-  unsigned char b[24];
-  FILE *f = fopen(path, "rb");
-  if (!f) return 0;
-  size_t got = fread(b, 1, sizeof b, f);
-  fclose(f);
+/* The size a PNG's header (IHDR) claims, from the file's first `got` bytes b: 1 and *w,
+ * *h, or 0 when it is not a PNG. stb refuses to report sizes above 2^30 bytes of 8-bit
+ * texels, without saying them. */
+static int png_header_size(const unsigned char *b, size_t got, int *w, int *h) {
   static const unsigned char sig[16] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R'};
-  if (got < sizeof b || memcmp(b, sig, sizeof sig)) return 0;
+  if (got < 24 || memcmp(b, sig, sizeof sig)) return 0;
   uint32_t pw = (uint32_t)b[16] << 24 | (uint32_t)b[17] << 16 | (uint32_t)b[18] << 8 | b[19];
   uint32_t ph = (uint32_t)b[20] << 24 | (uint32_t)b[21] << 16 | (uint32_t)b[22] << 8 | b[23];
   if (pw == 0 || ph == 0 || pw > INT32_MAX || ph > INT32_MAX) return 0;
@@ -55,13 +50,8 @@ static valo_status check_size(int ok, int w, int h, size_t bytes, unsigned long 
   if (ok && (unsigned long long)w * (unsigned long long)h > per_byte * bytes + 65536)
     return err_set(err, VALO_ERR_PARSE, "%s: the image header claims %d x %d pixels, more than its %zu bytes can hold (damaged)", name, w,
                    h, bytes);
-  if (ok) {
-    /* float RGBA, and the decoder's 8-bit copy (at most 4 channels) while converting */
-    char what[96];
-    snprintf(what, sizeof what, "%d x %d pixels", w, h);
-    return mem_check((uint64_t)w * (uint64_t)h * 20, name, what, err);
-  }
-  return VALO_OK;
+  /* float RGBA, and the decoder's 8-bit copy (at most 4 channels) while converting */
+  return ok ? mem_check_pixels((uint64_t)w, (uint64_t)h, 20, name, err) : VALO_OK;
 }
 
 
@@ -102,9 +92,7 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
     image im;
     valo_status st = image_read(path, &im, err);
     if (st) return st;
-    char what[96];
-    snprintf(what, sizeof what, "%d x %d pixels", im.w, im.h);
-    if ((st = mem_check((uint64_t)im.w * (uint64_t)im.h * 28, path, what, err))) { image_free(&im); return st; }
+    if ((st = mem_check_pixels((uint64_t)im.w, (uint64_t)im.h, 28, path, err))) { image_free(&im); return st; }
     t->px = malloc((size_t)im.w * im.h * 4 * sizeof(float));
     if (!t->px) { image_free(&im); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); }
     for (size_t i = 0; i < (size_t)im.w * im.h; i++) {
@@ -117,13 +105,17 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
   }
   int w = 0, h = 0, n = 0;
   int ok = stbi_info(path, &w, &h, &n);
-  if (!ok) ok = png_header_size(path, &w, &h); /* a size stb refuses to report */
-  struct stat sb;
-  unsigned char head[4] = {0, 0, 0, 0};
+  /* the file's first bytes (its format, a PNG's size) and its length */
+  unsigned char head[24];
+  size_t hn = 0, bytes = 0;
   FILE *hf = fopen(path, "rb");
-  size_t hn = hf ? fread(head, 1, sizeof head, hf) : 0;
-  if (hf) fclose(hf);
-  valo_status st = check_size(ok, w, h, stat(path, &sb) == 0 && sb.st_size > 0 ? (size_t)sb.st_size : 0, pixels_per_byte_max(head, hn), path, err);
+  if (hf) {
+    hn = fread(head, 1, sizeof head, hf);
+    if (fseek(hf, 0, SEEK_END) == 0 && ftell(hf) > 0) bytes = (size_t)ftell(hf);
+    fclose(hf);
+  }
+  if (!ok) ok = png_header_size(head, hn, &w, &h); /* a size stb refuses to report */
+  valo_status st = check_size(ok, w, h, bytes, pixels_per_byte_max(head, hn), path, err);
   if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);
   if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());

@@ -18,14 +18,14 @@
 #include "load/obj_check.h"
 #include "load/ply_check.h"
 #include <assimp/cfileio.h>
-
-#define MESH_MEMORY_FACTOR 8
 #include <assimp/GltfMaterial.h>
 #include <assimp/texture.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#define MESH_MEMORY_FACTOR 8 /* a mesh file is counted at this many times its size (load_mesh) */
 
 typedef struct mat34 { float m[3][4]; } mat34;
 
