@@ -224,28 +224,35 @@ static double wall_now(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-pid_t spawn_cli(const char *const *args, const char *log) {
+pid_t spawn_exe(const char *exe, const char *const *args, const char *log) {
   pid_t pid = fork();
   if (pid == 0) {
+    setsid(); /* its own session: a test can signal everything it started (pkill -s) */
     int fd = open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     dup2(fd, 1); dup2(fd, 2);
     close(fd);
     const char *argv[40];
     int n = 0;
-    argv[n++] = VALO_EXE;
+    argv[n++] = exe;
     for (int i = 0; args[i] && n < 39; i++) argv[n++] = args[i];
     argv[n] = NULL;
-    execv(VALO_EXE, (char *const *)argv);
+    execvp(exe, (char *const *)argv);
     _exit(127);
   }
   return pid;
 }
 
+pid_t spawn_cli(const char *const *args, const char *log) { return spawn_exe(VALO_EXE, args, log); }
+
 int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap) {
+  return run_exe(VALO_EXE, args, sigint_ms, timeout_s, out, cap);
+}
+
+int run_exe(const char *exe, const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap) {
   char log[1200];
   snprintf(log, sizeof log, "%s/out.txt", scratch_dir());
   double t0 = wall_now();
-  pid_t pid = spawn_cli(args, log);
+  pid_t pid = spawn_exe(exe, args, log);
   int status = 0;
   if (sigint_ms > 0) {
     struct timespec d = {sigint_ms / 1000, (long)(sigint_ms % 1000) * 1000000L};
@@ -258,7 +265,7 @@ int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, si
     if (wall_now() - t0 > timeout_s) {
       kill(pid, SIGKILL);
       waitpid(pid, &status, 0);
-      fprintf(stderr, "valo hung: killed after %d s\n", timeout_s);
+      fprintf(stderr, "%s hung: killed after %d s\n", exe, timeout_s);
       run_cli_seconds = wall_now() - t0;
       return 999;
     }

@@ -68,8 +68,12 @@ void compare_images(const float *img, const float *ref, int w, int h, int block,
  * (and to stderr); run_cli_seconds gets the wall time. */
 int run_cli(const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap);
 extern double run_cli_seconds;
-/* Starts valo with args (NULL-ended, at most 38) in a child process, its standard output
- * and error to the file log (created or truncated); returns the child's pid. */
+/* Starts valo with args (NULL-ended, at most 38) in a child process of its own session
+ * (whose id is its pid), its standard output and error to the file log (created or
+ * truncated); returns the child's pid. */
 #include <sys/types.h>
 pid_t spawn_cli(const char *const *args, const char *log);
+/* The same for another program (found on PATH when exe has no slash: mpirun). */
+pid_t spawn_exe(const char *exe, const char *const *args, const char *log);
+int run_exe(const char *exe, const char *const *args, int sigint_ms, int timeout_s, char *out, size_t cap);
 #endif

@@ -212,6 +212,37 @@ typedef struct valo_stats {
 } valo_stats;
 VALO_API void valo_render_stats(const valo_render *r, valo_stats *out);
 
+/* Rendering across processes (MPI; docs/performance.md). valo_mpi_init joins the MPI job
+ * when an MPI launcher (mpirun, srun) started the process, before anything else, and
+ * returns how many processes the launcher started (1 outside one). valo_mpi_size is how
+ * many ranks share the work: 1 without MPI, or when valo was built without it (then a
+ * launcher's K > 1 is the caller's error to report). Under K ranks every rank loads the
+ * same scene and creates the same render; rank 0 runs it (budgets, progress, adaptive
+ * plans, checkpoints) and alone should write outputs, handing out tiles to the others,
+ * whose valo_render_run returns when rank 0's does. The image is byte-identical to one
+ * process's. valo_render_resume and valo_render_checkpoint_to do nothing on other ranks.
+ * Image-wide integrators (restir-di, restir-gi) need one rank. Not thread-safe: call from
+ * the main thread. */
+VALO_API int valo_mpi_init(int *argc, char ***argv);
+VALO_API int valo_mpi_rank(void);
+VALO_API int valo_mpi_size(void);
+/* Collective over the ranks: each passes a code (0: all well; a valo_status or an exit
+ * code) and, when it is not 0, its message in err; returns the code of the lowest rank
+ * whose code is not 0 (0 when none), whose message err then holds on every rank
+ * ("rank K (host): ..." on the others). One rank alone: returns code. */
+VALO_API int valo_mpi_agree(int code, valo_error *err);
+VALO_API void valo_mpi_finalize(void);
+/* Rank k's share of the last run under MPI (k < valo_mpi_size(), on rank 0): its host,
+ * threads, tiles and samples rendered, rays traced, peak memory, and seconds spent rendering. -1 when
+ * there is none (one process, another rank, or no run yet). */
+typedef struct valo_rank_stats {
+  char host[64];
+  int threads;
+  uint64_t tiles, samples, rays, peak_memory_bytes;
+  double busy_seconds;
+} valo_rank_stats;
+VALO_API int valo_render_rank_stats(const valo_render *r, int k, valo_rank_stats *out);
+
 /* Output settings for display-referred formats (PNG). EXR/PFM are always linear. */
 typedef struct valo_output_options {
   float exposure;         /* stops; 0 by default */

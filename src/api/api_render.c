@@ -9,6 +9,7 @@
 #include "render/session.h"
 #include "render/output.h"
 #include "render/checkpoint.h"
+#include "render/dist.h"
 #include "core/error.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,6 +36,9 @@ VALO_API valo_status valo_render_create(const valo_scene *vs, const valo_options
   resolved_options ro;
   valo_render *r = NULL;
   valo_status st = options_resolve(&vs->file_opts, opts, &ro, err);
+  if (!st && dist_size() > 1 && ro.integ->kind == INTEGRATOR_IMAGE)
+    st = err_set(err, VALO_ERR_INVALID, "%s is image-wide (its stages share the whole image each frame): it runs in one process, not across %d MPI ranks",
+                 ro.integ->name, dist_size());
   if (!st && !(r = calloc(1, sizeof *r))) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
   if (!st) {
     r->warn_fn = vs->warn_fn;
@@ -80,6 +84,7 @@ VALO_API valo_status valo_render_checkpoint_to(valo_render *r, const char *path,
   clear_err(err);
   valo_status st = checkpointable(r, err);
   if (st) return st;
+  if (dist_rank() > 0) return VALO_OK; /* rank 0 checkpoints for every rank */
   if (!path || !*path || strlen(path) >= sizeof r->ss->ckpt_path) return err_set(err, VALO_ERR_INVALID, "no checkpoint file, or its name is too long");
   if (!(every_seconds >= 0)) return err_set(err, VALO_ERR_INVALID, "checkpoint interval %g: must be 0 or more seconds", every_seconds);
   snprintf(r->ss->ckpt_path, sizeof r->ss->ckpt_path, "%s", path);
@@ -92,6 +97,7 @@ VALO_API valo_status valo_render_resume(valo_render *r, const char *path, valo_e
   valo_status st = checkpointable(r, err);
   if (st) return st;
   if (r->ss->resumed || r->ss->spp_done > 0) return err_set(err, VALO_ERR_INVALID, "resume before the render runs");
+  if (dist_rank() > 0) return VALO_OK; /* rank 0 resumes and hands its film out */
   log_scope scope;
   log_scope_enter(&scope, r->warn_fn, r->warn_user);
   st = checkpoint_read(r->ss, path, err);
@@ -133,6 +139,30 @@ VALO_API void valo_render_stats(const valo_render *r, valo_stats *o) {
   snprintf(o->accel, sizeof o->accel, "%s", ss->opt.accel);
   snprintf(o->sampler, sizeof o->sampler, "%s", ss->opt.sampler);
   snprintf(o->light_sampler, sizeof o->light_sampler, "%s", ss->opt.light_sampler);
+}
+
+VALO_API int valo_render_rank_stats(const valo_render *r, int k, valo_rank_stats *out) {
+  memset(out, 0, sizeof *out);
+  if (!r || k < 0 || k >= r->ss->nranks) return -1;
+  const rank_stats *rs = &r->ss->ranks[k];
+  snprintf(out->host, sizeof out->host, "%s", rs->host);
+  out->threads = rs->threads;
+  out->tiles = rs->tiles;
+  out->samples = rs->samples;
+  out->rays = rs->rays;
+  out->peak_memory_bytes = rs->peak_memory;
+  out->busy_seconds = rs->busy_seconds;
+  return 0;
+}
+
+VALO_API int valo_mpi_init(int *argc, char ***argv) { return dist_init(argc, argv); }
+VALO_API int valo_mpi_rank(void) { return dist_rank(); }
+VALO_API int valo_mpi_size(void) { return dist_size(); }
+VALO_API void valo_mpi_finalize(void) { dist_finalize(); }
+VALO_API int valo_mpi_agree(int code, valo_error *err) {
+  valo_error local;
+  if (!err) { err = &local; local.message[0] = 0; }
+  return dist_agree(code, err);
 }
 
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) { film_resolve(&r->ss->film, rgb_out); }

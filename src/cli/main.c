@@ -1,7 +1,8 @@
 /* main.c — owns the `valo` command line's run: the output folders' check, the progress
  * bar (with samples/s and ETA on a terminal, periodic plain lines otherwise), the final
  * summary, checkpoints and resume, Ctrl-C handling and exit codes (0 success, 1 error,
- * 2 usage, 130 interrupted). Arguments are parsed by args.c. Uses only the public API in
+ * 2 usage, 130 interrupted), and the ranks of an MPI run (rank 0 reports and writes).
+ * Arguments are parsed by args.c. Uses only the public API in
  * valo/valo.h. */
 #include "valo/valo.h"
 #include "cli/run_stats.h"
@@ -100,65 +101,81 @@ static double now_seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int cmd_render(int argc, char **argv) {
-  cli_args ca;
-  int prc = cli_parse_render(argc, argv, &ca, stdout, stderr);
-  if (prc >= 0) return prc;
-  valo_options opt = ca.opt;
-  valo_output_options oo = ca.oo;
-  valo_load_options lo = ca.lo;
-  const char *scene_path = ca.scene_path, *const *outputs = ca.outputs, *stats_json = ca.stats_json, *ckpt = ca.ckpt, *resume = ca.resume;
-  double ckpt_every = ca.ckpt_every;
-  int nout = ca.nout, quiet = ca.quiet;
-  if (resume && !ckpt) ckpt = resume; /* a resumed render keeps checkpointing to its file */
-  /* Every output's folder must exist and be writable before hours of rendering. */
-  const char *extra[2] = {stats_json, ckpt};
-  for (int i = 0; i < nout + 2; i++) {
-    if (i >= nout && !extra[i - nout]) continue;
-    const char *file = i >= nout ? extra[i - nout] : outputs[i] + aov_prefix(outputs[i]);
+/* Warnings of ranks above 0 are dropped: rank 0 prints the same ones. */
+static void quiet_warning(void *user, const char *message) { (void)user; (void)message; }
+
+/* Everything before the render runs: the output folders, the scene, the render, the
+ * resume. 0, or an exit code with the message in err (printed here on rank 0). */
+static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_scene **sc, valo_render **r, double *load_s, valo_error *err) {
+  double t0 = now_seconds();
+  int rank = valo_mpi_rank();
+  /* Every output's folder must exist and be writable before hours of rendering (rank 0
+   * alone writes). */
+  const char *extra[2] = {ca->stats_json, ckpt};
+  for (int i = 0; i < ca->nout + 2 && rank == 0; i++) {
+    if (i >= ca->nout && !extra[i - ca->nout]) continue;
+    const char *file = i >= ca->nout ? extra[i - ca->nout] : ca->outputs[i] + aov_prefix(ca->outputs[i]);
     char dir[4096];
     const char *slash = strrchr(file, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);
     else snprintf(dir, sizeof dir, ".");
     if (access(dir, W_OK) != 0) {
-      fprintf(stderr, "valo: error: %s: cannot write there: folder %s %s\n", i >= nout ? extra[i - nout] : outputs[i], dir,
-              errno == ENOENT ? "does not exist" : strerror(errno));
+      snprintf(err->message, sizeof err->message, "%s: cannot write there: folder %s %s", i >= ca->nout ? extra[i - ca->nout] : ca->outputs[i], dir,
+               errno == ENOENT ? "does not exist" : strerror(errno));
       return 1;
     }
   }
-
-  valo_error err;
-  double t0 = now_seconds();
-  valo_scene *sc = NULL;
-  if (valo_scene_load_with(scene_path, &lo, &sc, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
+  if (valo_scene_load_with(ca->scene_path, &ca->lo, sc, err)) return 1;
+  *load_s = now_seconds() - t0;
   valo_options file_opts;
-  valo_scene_file_options(sc, &file_opts);
+  valo_scene_file_options(*sc, &file_opts);
   /* --time alone: the scene file's spp (if any) still bounds the render, whichever comes
    * first; otherwise only the time does. */
-  if (opt.time_budget > 0 && opt.spp == VALO_UNSET) opt.spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
-  double load_s = now_seconds() - t0;
-  valo_render *r = NULL;
-  if (opt.params[0]) {
+  if (opt->time_budget > 0 && opt->spp == VALO_UNSET) opt->spp = file_opts.spp != VALO_UNSET ? file_opts.spp : 1048576;
+  if (opt->params[0]) {
     /* --param entries are checked here, so that a mistyped one is a usage error */
-    valo_options fo;
-    valo_scene_file_options(sc, &fo);
-    const char *integ = opt.integrator[0] ? opt.integrator : fo.integrator[0] ? fo.integrator : "path";
-    if (valo_integrator_check_params(integ, opt.params, &err)) {
-      fprintf(stderr, "valo: --param: %s (valo render --help-integrators lists them)\n", err.message);
-      valo_scene_destroy(sc);
+    const char *integ = opt->integrator[0] ? opt->integrator : file_opts.integrator[0] ? file_opts.integrator : "path";
+    if (valo_integrator_check_params(integ, opt->params, err)) {
+      char m[sizeof err->message];
+      snprintf(m, sizeof m, "--param: %.900s (valo render --help-integrators lists them)", err->message);
+      snprintf(err->message, sizeof err->message, "%s", m);
       return EXIT_USAGE;
     }
   }
-  if (valo_render_create(sc, &opt, &r, &err)) {
-    fprintf(stderr, "valo: error: %s\n", err.message);
-    valo_scene_destroy(sc);
-    return 1;
-  }
-  if ((resume && valo_render_resume(r, resume, &err)) || (ckpt && valo_render_checkpoint_to(r, ckpt, ckpt_every, &err))) {
-    fprintf(stderr, "valo: error: %s\n", err.message);
+  if (valo_render_create(*sc, opt, r, err)) return 1;
+  if (rank > 0) valo_render_set_warning_handler(*r, quiet_warning, NULL);
+  if ((ca->resume && valo_render_resume(*r, ca->resume, err)) || (ckpt && valo_render_checkpoint_to(*r, ckpt, ca->ckpt_every, err))) return 1;
+  return 0;
+}
+
+static int cmd_render(int argc, char **argv) {
+  int rank = valo_mpi_rank();
+  cli_args ca;
+  /* every rank parses the same arguments; rank 0 alone says what is wrong */
+  FILE *devnull = rank > 0 ? fopen("/dev/null", "w") : NULL;
+  int prc = cli_parse_render(argc, argv, &ca, devnull ? devnull : stdout, devnull ? devnull : stderr);
+  if (devnull) fclose(devnull);
+  if (prc >= 0) return prc;
+  valo_options opt = ca.opt;
+  valo_output_options oo = ca.oo;
+  const char *scene_path = ca.scene_path, *const *outputs = ca.outputs, *stats_json = ca.stats_json, *ckpt = ca.ckpt, *resume = ca.resume;
+  int nout = ca.nout, quiet = ca.quiet || rank > 0;
+  if (resume && !ckpt) ckpt = resume; /* a resumed render keeps checkpointing to its file */
+  if (rank > 0) valo_set_warning_handler(quiet_warning, NULL);
+
+  valo_error err;
+  err.message[0] = 0;
+  double load_s = 0;
+  valo_scene *sc = NULL;
+  valo_render *r = NULL;
+  int src = setup(&ca, &opt, ckpt, &sc, &r, &load_s, &err);
+  /* under MPI every rank learns whether any failed, and rank 0 says which and why */
+  src = valo_mpi_agree(src, &err);
+  if (src) {
+    if (rank == 0) fprintf(stderr, "valo: error: %s\n", err.message);
     valo_render_destroy(r);
     valo_scene_destroy(sc);
-    return 1;
+    return src;
   }
   valo_stats st;
   valo_render_stats(r, &st);
@@ -176,8 +193,10 @@ static int cmd_render(int argc, char **argv) {
     else if (time_total > 0 && spp_total >= 1048576) snprintf(budget, sizeof budget, "time budget %g s", time_total);
     else if (time_total > 0) snprintf(budget, sizeof budget, "%d spp or %g s, whichever comes first", spp_total, time_total);
     else snprintf(budget, sizeof budget, "%d spp", spp_total);
-    fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %s, %s integrator, %s, %d threads\n", scene_path,
-            (unsigned long long)st.triangles, st.width, st.height, budget, st.integrator, st.accel, st.threads);
+    char ranks[48] = "";
+    if (valo_mpi_size() > 1) snprintf(ranks, sizeof ranks, " on each of %d MPI ranks", valo_mpi_size());
+    fprintf(stderr, "valo: %s: %llu triangles, %dx%d, %s, %s integrator, %s, %d threads%s\n", scene_path,
+            (unsigned long long)st.triangles, st.width, st.height, budget, st.integrator, st.accel, st.threads, ranks);
     if (resume) fprintf(stderr, "valo: resuming from %s at %d spp\n", resume, st.spp_done);
     if (!valo_scene_has_light(sc))
       fprintf(stderr, "valo: warning: the scene has no light: the image will be black\n");
@@ -185,10 +204,18 @@ static int cmd_render(int argc, char **argv) {
   g_render = r;
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_sigint;
+  sa.sa_handler = rank > 0 ? SIG_IGN : on_sigint;
   sigaction(SIGINT, &sa, NULL);
-  valo_status rs = valo_render_run(r, on_progress, &ps, &err);
+  /* mpirun passes Ctrl-C on as SIGTERM to every rank (and SIGKILL a second later): rank
+   * 0 stops and writes what is finished, the others go on until it tells them to stop */
+  if (valo_mpi_size() > 1) sigaction(SIGTERM, &sa, NULL);
+  valo_status rs = valo_render_run(r, rank == 0 ? on_progress : NULL, &ps, &err);
   g_render = NULL;
+  if (rank > 0) {
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+    return rs && rs != VALO_ERR_CANCELLED ? 1 : 0;
+  }
   if (ps.tty && !quiet) fprintf(stderr, "\n");
   int rc = 0;
   valo_render_stats(r, &st);
@@ -229,7 +256,10 @@ static int cmd_render(int argc, char **argv) {
   }
   uint64_t peak = run_peak_memory();
   if (stats_json) {
-    run_report rep = {scene_path, rc == 0 ? "ok" : rc == EXIT_INTERRUPTED ? "interrupted" : "error", rc, load_s, &st, peak};
+    valo_rank_stats rks[256];
+    int nr = 0;
+    while (nr < 256 && valo_render_rank_stats(r, nr, &rks[nr]) == 0) nr++;
+    run_report rep = {scene_path, rc == 0 ? "ok" : rc == EXIT_INTERRUPTED ? "interrupted" : "error", rc, load_s, &st, peak, rks, nr};
     if (run_stats_write_json(stats_json, &rep) && rc == 0) rc = 1;
   }
   if (!quiet) {
@@ -246,6 +276,11 @@ static int cmd_render(int argc, char **argv) {
             "peak memory %.0f MB; lost: %s\n",
             (unsigned long long)st.triangles, load_s, st.build_seconds, st.render_seconds, st.spp_done, (double)st.rays,
             st.render_seconds > 0 ? st.rays / st.render_seconds * 1e-6 : 0.0, (double)peak / 1048576.0, lost);
+    valo_rank_stats k;
+    for (int i = 0; valo_render_rank_stats(r, i, &k) == 0; i++)
+      fprintf(stderr, "valo: rank %d (%s, %d threads): %llu tiles, %llu samples, %.3g rays, %.2f Mrays/s over %.2f s busy, peak memory %.0f MB\n", i,
+              k.host, k.threads, (unsigned long long)k.tiles, (unsigned long long)k.samples, (double)k.rays,
+              k.busy_seconds > 0 ? (double)k.rays / k.busy_seconds * 1e-6 : 0.0, k.busy_seconds, (double)k.peak_memory_bytes / 1048576.0);
   }
   valo_render_destroy(r);
   valo_scene_destroy(sc);
@@ -256,7 +291,16 @@ int main(int argc, char **argv) {
   if (argc < 2) { usage_main(stderr); return EXIT_USAGE; }
   if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) { usage_main(stdout); return 0; }
   if (!strcmp(argv[1], "--version")) { printf("valo %s\n", valo_version()); return 0; }
-  if (!strcmp(argv[1], "render")) return cmd_render(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "render")) {
+    int launched = valo_mpi_init(&argc, &argv);
+    if (launched > valo_mpi_size()) {
+      fprintf(stderr, "valo: error: started as %d MPI processes, but this valo was built without MPI (install libopenmpi-dev and rebuild)\n", launched);
+      return 1;
+    }
+    int rc = cmd_render(argc - 2, argv + 2);
+    valo_mpi_finalize();
+    return rc;
+  }
   fprintf(stderr, "valo: unknown command \"%s\" (see valo --help)\n", argv[1]);
   return EXIT_USAGE;
 }

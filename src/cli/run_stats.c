@@ -51,7 +51,20 @@ static void put_report(FILE *f, const run_report *r) {
     put_string(f, valo_loss_name(k));
     fprintf(f, ": %llu", (unsigned long long)st->lost[k]);
   }
-  fprintf(f, "\n  }\n}\n");
+  fprintf(f, "\n  }");
+  if (r->nranks > 0) {
+    fprintf(f, ",\n  \"ranks\": [");
+    for (int k = 0; k < r->nranks; k++) {
+      const valo_rank_stats *q = &r->ranks[k];
+      fprintf(f, "%s\n    {\"rank\": %d, \"host\": ", k ? "," : "", k);
+      put_string(f, q->host);
+      fprintf(f, ", \"threads\": %d, \"tiles\": %llu, \"samples\": %llu, \"rays\": %llu, \"busy_seconds\": %.9f, \"rays_per_second\": %.9g, \"peak_memory_bytes\": %llu}",
+              q->threads, (unsigned long long)q->tiles, (unsigned long long)q->samples, (unsigned long long)q->rays, q->busy_seconds,
+              q->busy_seconds > 0 ? (double)q->rays / q->busy_seconds : 0.0, (unsigned long long)q->peak_memory_bytes);
+    }
+    fprintf(f, "\n  ]");
+  }
+  fprintf(f, "\n}\n");
 }
 
 int run_stats_write_json(const char *path, const run_report *r) {

@@ -16,6 +16,8 @@ typedef struct run_report {
   double load_seconds;
   const valo_stats *st;
   uint64_t peak_memory;     /* bytes */
+  const valo_rank_stats *ranks; /* under MPI: every rank's share (nranks), else NULL, 0 */
+  int nranks;
 } run_report;
 
 /* Writes the report as JSON to path, atomically (a temporary file beside it, flushed to

@@ -3,7 +3,6 @@
 #include "render/tiles.h"
 #include "core/clock.h"
 #include "core/error.h"
-#include "core/threadpool.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,19 +72,6 @@ static void prio_select(prio *a, size_t n, size_t k) {
   }
 }
 
-typedef struct adapt_job { session *ss; const prio *sel; int64_t n; thread_stats *ts; } adapt_job;
-static void adapt_chunk(void *user, int64_t item, int thread) {
-  adapt_job *j = user;
-  if (atomic_load_explicit(&j->ss->cancel, memory_order_relaxed)) return;
-  int64_t lo = item * 64, hi = lo + 64 < j->n ? lo + 64 : j->n;
-  for (int64_t k = lo; k < hi; k++) {
-    uint32_t pix = j->sel[k].i;
-    int x = (int)(pix % (uint32_t)j->ss->opt.width), y = (int)(pix / (uint32_t)j->ss->opt.width);
-    int c = (int)j->ss->film.count[pix];
-    tiles_sample_pixel(j->ss, x, y, c, c + ADAPT_BATCH, &j->ts[thread]);
-  }
-}
-
 /* The "digest" rule after the first pass: rounds that give ADAPT_BATCH more samples to
  * the 1/ADAPT_FRACTION of pixels with the highest priority (N sum s^2 / (sum s)^2 - 1) / N,
  * on each pixel's own samples so far (biased: docs/integrators.md), until the budget or
@@ -95,7 +81,8 @@ valo_status adapt_digest(session *ss, int uniform_spp, double total, double budg
   size_t np = (size_t)ss->opt.width * ss->opt.height;
   double taken = ss->resumed && ss->resume.phase == CKPT_ADAPT_DIGEST ? ss->resume.taken : (double)uniform_spp * (double)np;
   prio *pr = malloc(np * sizeof *pr);
-  if (!pr) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  uint32_t *target = malloc(np * sizeof *target);
+  if (!pr || !target) { free(pr); free(target); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   size_t k = np / ADAPT_FRACTION > 0 ? np / ADAPT_FRACTION : 1;
   double thr2 = ss->opt.noise_threshold > 0 ? ss->opt.noise_threshold * ss->opt.noise_threshold : 0;
   valo_status st = VALO_OK;
@@ -112,8 +99,10 @@ valo_status adapt_digest(session *ss, int uniform_spp, double total, double budg
     qsort(pr, sel, sizeof *pr, prio_cmp);
     if (!(pr[0].p > 0)) break; /* every pixel below the noise threshold */
     while (sel > 0 && !(pr[sel - 1].p > 0)) sel--;
-    adapt_job aj = {ss, pr, (int64_t)sel, ts};
-    parallel_for(ss->opt.threads, ((int64_t)sel + 63) / 64, adapt_chunk, &aj);
+    /* the chosen pixels ADAPT_BATCH samples more, through the tiles (coherent rays) */
+    memcpy(target, ss->film.count, np * sizeof *target);
+    for (size_t q = 0; q < sel; q++) target[pr[q].i] += ADAPT_BATCH;
+    if ((st = tiles_render_to(ss, target, ts, err))) break;
     if (atomic_load(&ss->cancel)) { st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np)); break; }
     taken += (double)sel * ADAPT_BATCH;
     double el = now_seconds() - t0;
@@ -128,6 +117,7 @@ valo_status adapt_digest(session *ss, int uniform_spp, double total, double budg
   }
   ss->spp_done = (int)(taken / (double)np);
   free(pr);
+  free(target);
   return st;
 }
 
@@ -258,7 +248,7 @@ valo_status adapt_error(session *ss, double total, double budget, double t0, val
       }
     }
     double s0 = now_seconds();
-    tiles_render_to(ss, target, ts); /* tiles keep rays coherent */
+    if ((st = tiles_render_to(ss, target, ts, err))) break; /* tiles keep rays coherent */
     if (atomic_load(&ss->cancel)) {
       st = err_set(err, VALO_ERR_CANCELLED, "render cancelled after %d spp", (int)(taken / (double)np));
       break;

@@ -3,6 +3,7 @@
 #include "render/adaptive.h"
 #include "render/tiles.h"
 #include "render/checkpoint.h"
+#include "render/dist.h"
 #include "core/clock.h"
 #include "core/error.h"
 #include "core/memlimit.h"
@@ -14,6 +15,7 @@ static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2)
 
 int session_set_view(session *ss, int f) {
   camera c = ss->opt.frames > 0 ? scene_camera_at(ss->s, &ss->cam_still, (float)f) : ss->cam_still;
+  ss->view_frame = f;
   return cam_view_make(&c, ss->opt.width, ss->opt.height, &ss->lens.view);
 }
 
@@ -107,6 +109,7 @@ void session_destroy(session *ss) {
   if (!ss) return;
   free(ss->resume.first);
   free(ss->resume.fin);
+  free(ss->ranks);
   accel_destroy(ss->acc);
   light_sampler_free(&ss->ctx.ls);
   if (ss->integ && ss->integ->destroy && ss->istate) ss->integ->destroy(ss->istate);
@@ -184,6 +187,8 @@ static valo_status run_finish(session *ss, thread_stats *ts, double t0, valo_sta
   memset(&ss->prep, 0, sizeof ss->prep);
   for (int t = 0; t < ss->opt.threads; t++) thread_stats_add(&sum, &ts[t]);
   free(ts);
+  if (dist_size() > 1 && dist_rank() > 0) return st; /* rank 0 counts and reports every rank's */
+  if (dist_size() > 1) dist_finish(ss, &sum);
   thread_stats_add(&ss->total, &sum);
   const uint64_t *run = sum.lost;
   for (int k = 0; k < VALO_LOSS_COUNT; k++) {
@@ -200,6 +205,7 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
   thread_stats *ts = calloc((size_t)threads, sizeof *ts);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   double t0 = now_seconds();
+  if (dist_size() > 1 && dist_rank() > 0) return run_finish(ss, ts, t0, dist_worker(ss, ts, err));
   if (ss->opt.frames > 0) return run_finish(ss, ts, t0, run_sequence(ss, progress, user, ts, err));
   double budget = ss->opt.time_budget > 0 ? ss->opt.time_budget : 0;
   int pass_spp = 1;

@@ -18,6 +18,10 @@ typedef struct session session;
  * of the digest rule; taken: samples over the whole film. */
 enum { CKPT_UNIFORM = 0, CKPT_ADAPT_ERROR = 1, CKPT_ADAPT_DIGEST = 2 };
 typedef struct ckpt_state { int phase, stage, stages; double taken; uint32_t *first, *fin; } ckpt_state;
+/* One rank's share of a render under MPI (render/dist.h): its host, threads, the tiles
+ * and samples it rendered, its rays (prepare's included), its peak memory (bytes) and the
+ * seconds it spent rendering. */
+typedef struct rank_stats { char host[64]; int threads; uint64_t tiles, samples, rays, peak_memory; double busy_seconds; } rank_stats;
 /* Called after each frame of a sequence (opt.frames > 0), from the thread that runs it. */
 typedef valo_status (*session_frame_fn)(void *user, int frame, valo_error *err);
 
@@ -53,6 +57,10 @@ struct session {
   ckpt_state ckpt_state;   /* the state at the boundary being checkpointed */
   ckpt_state resume;       /* the state a resumed render goes on from (owns first, fin) */
   int resumed;
+  int view_frame;          /* the frame whose camera ss->lens holds */
+  struct dist_state *dist; /* rank 0 under MPI: the other ranks' state (render/dist.c) */
+  rank_stats *ranks;       /* rank 0 under MPI, after a run: every rank's share, nranks of them */
+  int nranks;
 };
 
 /* Builds the accelerator, the light sampler, the camera (autofocus included) and the

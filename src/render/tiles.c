@@ -1,8 +1,9 @@
 /* tiles.c — see tiles.h. Every sample draws its random numbers from (seed, pixel, sample
  * index, dimension), and each pixel's samples are summed in sample order, so the image is
- * the same for any thread count or tile order. */
+ * the same for any thread count, tile order or number of processes (render/dist.c). */
 #include "render/tiles.h"
 #include "render/aov.h"
+#include "render/dist.h"
 #include "core/threadpool.h"
 #include "core/error.h"
 
@@ -10,7 +11,6 @@ typedef struct pass_job {
   session *ss;
   int s0, s1;             /* sample indices [s0, s1) */
   const uint32_t *target; /* or, when not NULL: each pixel from its count up to target[pix] */
-  int tiles_x;
   thread_stats *ts;       /* one per thread */
 } pass_job;
 
@@ -25,31 +25,47 @@ void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats 
   }
 }
 
-static void render_tile(void *user, int64_t item, int thread) {
-  pass_job *j = user;
-  session *ss = j->ss;
-  if (session_cancelled(ss)) return;
-  thread_stats *ts = &j->ts[thread];
-  int tx = (int)(item % j->tiles_x), ty = (int)(item / j->tiles_x);
-  int x0 = tx * TILE, y0 = ty * TILE;
-  int x1 = x0 + TILE < ss->opt.width ? x0 + TILE : ss->opt.width;
-  int y1 = y0 + TILE < ss->opt.height ? y0 + TILE : ss->opt.height;
+int64_t tiles_count(const session *ss) {
+  int64_t tx = (ss->opt.width + TILE - 1) / TILE, ty = (ss->opt.height + TILE - 1) / TILE;
+  return tx * ty;
+}
+
+void tiles_rect(const session *ss, int64_t tile, int *x0, int *y0, int *x1, int *y1) {
+  int tiles_x = (ss->opt.width + TILE - 1) / TILE;
+  *x0 = (int)(tile % tiles_x) * TILE;
+  *y0 = (int)(tile / tiles_x) * TILE;
+  *x1 = *x0 + TILE < ss->opt.width ? *x0 + TILE : ss->opt.width;
+  *y1 = *y0 + TILE < ss->opt.height ? *y0 + TILE : ss->opt.height;
+}
+
+uint64_t tiles_render_tile(session *ss, int64_t tile, int s0, int s1, const uint32_t *target, thread_stats *ts) {
+  int x0, y0, x1, y1;
+  tiles_rect(ss, tile, &x0, &y0, &x1, &y1);
+  uint64_t taken = 0;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
-      if (!j->target) { tiles_sample_pixel(ss, x, y, j->s0, j->s1, ts); continue; }
+      if (!target) { tiles_sample_pixel(ss, x, y, s0, s1, ts); taken += (uint64_t)(s1 - s0); continue; }
       size_t pix = (size_t)y * (size_t)ss->opt.width + (size_t)x;
-      int c = (int)ss->film.count[pix], t = (int)j->target[pix];
-      if (t > c) tiles_sample_pixel(ss, x, y, c, t, ts);
+      int c = (int)ss->film.count[pix], t = (int)target[pix];
+      if (t > c) { tiles_sample_pixel(ss, x, y, c, t, ts); taken += (uint64_t)(t - c); }
     }
+  return taken;
 }
 
-static void run_tiles(session *ss, int s0, int s1, const uint32_t *target, thread_stats *ts) {
-  int tiles_x = (ss->opt.width + TILE - 1) / TILE, tiles_y = (ss->opt.height + TILE - 1) / TILE;
-  pass_job job = {ss, s0, s1, target, tiles_x, ts};
-  parallel_for(ss->opt.threads, (int64_t)tiles_x * tiles_y, render_tile, &job);
+static void render_tile(void *user, int64_t item, int thread) {
+  pass_job *j = user;
+  if (session_cancelled(j->ss)) return;
+  tiles_render_tile(j->ss, item, j->s0, j->s1, j->target, &j->ts[thread]);
 }
 
-void tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts) { run_tiles(ss, 0, 0, target, ts); }
+static valo_status run_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err) {
+  if (dist_size() > 1) return dist_tiles(ss, s0, s1, target, prep, ts, err);
+  pass_job job = {ss, s0, s1, target, ts};
+  parallel_for(ss->opt.threads, tiles_count(ss), render_tile, &job);
+  return VALO_OK;
+}
+
+valo_status tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts, valo_error *err) { return run_tiles(ss, 0, 0, target, -1, ts, err); }
 
 valo_status tiles_render(session *ss, int s0, int s1, thread_stats *ts, valo_error *err) {
   for (int a = s0; a < s1;) {
@@ -59,7 +75,8 @@ valo_status tiles_render(session *ss, int s0, int s1, thread_stats *ts, valo_err
       valo_status pst = ss->integ->prepare(ss->istate, &ss->ctx, a, err);
       if (pst) return pst;
     }
-    run_tiles(ss, a, b, NULL, ts);
+    valo_status st = run_tiles(ss, a, b, NULL, ss->integ->prepare ? a : -1, ts, err);
+    if (st) return st;
     if (atomic_load(&ss->cancel)) return err_set(err, VALO_ERR_CANCELLED, "render cancelled");
     a = b;
   }

@@ -9,8 +9,14 @@
  * time, each after its prepare). VALO_ERR_CANCELLED when the session was cancelled. */
 valo_status tiles_render(session *ss, int s0, int s1, thread_stats *ts, valo_error *err);
 /* Takes each pixel from its count up to target[pix] (adaptive sampling), tile by tile;
- * the caller checks for cancellation. */
-void tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts);
+ * the caller checks for cancellation. Fails only when another rank failed (MPI). */
+valo_status tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts, valo_error *err);
+/* The tiles of the film, and tile t's pixels [x0, x1) x [y0, y1). */
+int64_t tiles_count(const session *ss);
+void tiles_rect(const session *ss, int64_t tile, int *x0, int *y0, int *x1, int *y1);
+/* Takes samples [s0, s1) of every pixel of tile t, or (target not NULL) each pixel from
+ * its count up to target[pix]; returns the samples taken. */
+uint64_t tiles_render_tile(session *ss, int64_t tile, int s0, int s1, const uint32_t *target, thread_stats *ts);
 /* Takes samples [s0, s1) of pixel (x, y) in order. */
 void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts);
 #endif
