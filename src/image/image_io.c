@@ -1,6 +1,7 @@
 /* image_io.c — see image_io.h. */
 #include "image/image_io.h"
 #include "image/hdr.h"
+#include "core/atomicfile.h"
 #include "core/error.h"
 #include "core/memlimit.h"
 #include "image/tonemap.h"
@@ -14,7 +15,6 @@
 #include <string.h>
 #include <strings.h>
 #include <unistd.h>
-#include <stdatomic.h>
 
 static void exr_quiet(exr_const_context_t ctxt, exr_result_t code, const char *msg);
 
@@ -24,20 +24,8 @@ static const char *ext_of(const char *path) {
   return dot + 1;
 }
 
-static void temp_name(const char *path, char *out, size_t n) {
-  static atomic_uint counter;
-  unsigned k = atomic_fetch_add(&counter, 1);
-  const char *slash = strrchr(path, '/');
-  if (slash) snprintf(out, n, "%.*s/.%s.tmp%ld.%u", (int)(slash - path), path, slash + 1, (long)getpid(), k);
-  else snprintf(out, n, ".%s.tmp%ld.%u", path, (long)getpid(), k);
-}
-
 static valo_status commit_temp(const char *tmp, const char *path, valo_error *err) {
-  if (rename(tmp, path) != 0) {
-    int e = errno;
-    remove(tmp);
-    return err_set(err, VALO_ERR_IO, "%s: cannot write: %s", path, strerror(e));
-  }
+  if (atomic_commit(tmp, path) != 0) return err_set(err, VALO_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
   return VALO_OK;
 }
 
@@ -131,7 +119,7 @@ valo_status image_write(const char *path, int w, int h, const float *px, const v
   int kind = !strcasecmp(ext, "exr") ? 0 : !strcasecmp(ext, "pfm") ? 1 : !strcasecmp(ext, "png") ? 2 : -1;
   if (kind < 0) return err_set(err, VALO_ERR_UNSUPPORTED, "%s: unknown output format \".%s\" (use .exr, .pfm or .png)", path, ext);
   char tmp[4200];
-  temp_name(path, tmp, sizeof tmp);
+  if (atomic_temp_name(path, tmp, sizeof tmp)) return err_set(err, VALO_ERR_INVALID, "%s: name too long", path);
   valo_status st = VALO_OK;
   char msg[256] = "";
   if (kind == 0) st = write_exr(tmp, w, h, px, msg, sizeof msg);

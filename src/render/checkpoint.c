@@ -5,6 +5,7 @@
  * Numbers are written in this machine's byte order (a checkpoint moves between runs,
  * not machines). */
 #include "render/checkpoint.h"
+#include "core/atomicfile.h"
 #include "core/error.h"
 #include "core/memlimit.h"
 #include "core/options.h"
@@ -87,7 +88,7 @@ static void put_str(wbuf *w, const char *s) { uint32_t n = (uint32_t)strlen(s); 
 
 valo_status checkpoint_write(const session *ss, const thread_stats *ts, const char *path, valo_error *err) {
   char tmp[4200];
-  if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp) return err_set(err, VALO_ERR_INVALID, "%s: name too long", path);
+  if (atomic_temp_name(path, tmp, sizeof tmp)) return err_set(err, VALO_ERR_INVALID, "%s: name too long", path);
   char *opts = malloc(OPTS_CAP);
   if (!opts) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path);
   options_text(ss, opts, OPTS_CAP);
@@ -127,19 +128,13 @@ valo_status checkpoint_write(const session *ss, const thread_stats *ts, const ch
   put(&w, &secs, sizeof secs);
   uint64_t tail[2] = {w.len, w.h};
   if (fwrite(tail, 1, sizeof tail, f) != sizeof tail) w.bad = 1;
-  if (fflush(f) || fsync(fileno(f))) w.bad = 1;
   if (fclose(f)) w.bad = 1;
-  if (w.bad || rename(tmp, path)) {
+  if (w.bad) {
     int e = errno;
     remove(tmp);
     return err_set(err, VALO_ERR_IO, "%s: cannot write the checkpoint: %s", path, strerror(e));
   }
-  /* the rename itself reaches the disk with the folder */
-  char dir[4096];
-  const char *slash = strrchr(path, '/');
-  snprintf(dir, sizeof dir, "%.*s", slash ? (slash == path ? 1 : (int)(slash - path)) : 1, slash ? path : ".");
-  int fd = open(dir, O_RDONLY);
-  if (fd >= 0) { fsync(fd); close(fd); }
+  if (atomic_commit(tmp, path)) return err_set(err, VALO_ERR_IO, "%s: cannot write the checkpoint: %s", path, strerror(errno));
   return VALO_OK;
 }
 
