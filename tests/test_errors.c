@@ -615,7 +615,8 @@ static int options_docs(void) {
   /* and the other way: every --flag named in README.md and the docs exists */
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
   const char *docs[] = {"README.md", "docs/scene-format.md", "docs/integrators.md"};
-  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume", NULL};
+  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume",
+                                        "--integrators", "--reference", "--crop", NULL}; /* the last three: valo compare's */
   int named = 0;
   for (int k = 0; k < 3; k++) {
     char path[600];

@@ -269,6 +269,13 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path,
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out);
 VALO_API void valo_render_destroy(valo_render *r);
 
+/* Reads an EXR, PFM or Radiance HDR into linear RGB (w*h*3 floats, top row first; free
+ * with valo_image_free); writes one (.exr, .pfm, or .png through o, NULL: the defaults)
+ * atomically as valo_render_write does. */
+VALO_API valo_status valo_image_read(const char *path, int *w, int *h, float **rgb, valo_error *err);
+VALO_API valo_status valo_image_write(const char *path, int w, int h, const float *rgb, const valo_output_options *o, valo_error *err);
+VALO_API void valo_image_free(float *rgb);
+
 /* The declared options (one table: the command line's flags, the JSON scene file's
  * keys, defaults, ranges and help all come from it). valo_option_at(i) is entry i (NULL
  * past the last): its flag ("--spp", or NULL for a scene-file key only), the value it

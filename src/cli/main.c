@@ -7,6 +7,7 @@
 #include "valo/valo.h"
 #include "cli/run_stats.h"
 #include "cli/args.h"
+#include "cli/compare.h"
 #include <errno.h>
 #include <limits.h>
 #include <signal.h>
@@ -37,6 +38,8 @@ static void usage_main(FILE *f) {
           "  valo render SCENE [options]   render a scene (JSON scene file, or an OBJ/glTF/PLY mesh)\n"
           "  valo --help                   this text\n"
           "  valo render --help            the render options\n"
+          "  valo compare SCENE --integrators A,B (--time S | --spp N) -o DIR\n"
+          "                                the integrators side by side at equal time: an HTML report\n"
           "  valo --version                print the version\n\n"
           "Exit codes: 0 success, 1 error (bad input, failed write), 2 usage error, 130 interrupted.\n",
           valo_version());
@@ -301,6 +304,7 @@ int main(int argc, char **argv) {
     valo_mpi_finalize();
     return rc;
   }
+  if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 2, argv + 2);
   fprintf(stderr, "valo: unknown command \"%s\" (see valo --help)\n", argv[1]);
   return EXIT_USAGE;
 }
