@@ -1,7 +1,8 @@
 /* test_mpi.c — rendering across processes, as a user runs it: `mpirun --oversubscribe -n 3
  * valo render ...` on one machine. The EXR is byte-identical to one process's (other
- * thread counts too) for path with AOVs, photon, vpl, adaptive sampling under both rules,
- * a sequence of frames and a time budget (against one process at the spp it reached);
+ * thread counts too) for path with AOVs (and an image of one tile, where ranks get no
+ * work), photon, vpl, adaptive sampling under both rules, a sequence of frames and a
+ * time budget (against one process at the spp it reached);
  * every rank renders tiles and --stats-json lists each; a run killed with SIGKILL resumes
  * from its checkpoint under MPI to the same bytes; Ctrl-C on mpirun writes what is
  * finished and leaves no process behind; restir-di and a missing scene are refused with
@@ -147,6 +148,10 @@ static int identical_path(void) {
   const char *args[] = {scene(), "--res", "160x120", "--spp", "24", "--seed", "3", NULL};
   const char *outs[] = {"img.exr", "albedo:alb.exr", "ao:ao.exr", "depth:depth.pfm", NULL};
   if (identical("path with AOVs", args, outs)) return 1;
+  /* one tile: some ranks get no work at all, and are only told to stop */
+  const char *tiny[] = {scene(), "--res", "8x8", "--spp", "4", NULL};
+  const char *one[] = {"img.exr", NULL};
+  if (identical("one tile", tiny, one)) return 1;
   /* every rank took part, and the stats say so */
   const char *json = path_in("stats.json");
   const char *a[] = {scene(), "--res", "160x120", "--spp", "24", "--seed", "3", "-q", "-o", path_in("s.exr"), "--stats-json", json, NULL};
