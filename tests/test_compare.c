@@ -1,7 +1,8 @@
 /* test_compare.c — `valo compare` as a user runs it: the report's figures (summary.json and
  * the page's table) equal the relMSE and bias recomputed here from the EXRs it wrote,
  * against the reference it names (the longest render, or a given file); every file the
- * page shows is there; the page loads nothing from elsewhere; wrong input is refused; and
+ * page shows is there; the page loads nothing from elsewhere; wrong input is refused;
+ * Ctrl-C stops it with exit 130 and no report; and
  * headless Chromium renders the page (a screenshot, and its DOM's figures equal the
  * EXRs'). Chromium missing: that case skips, and fails under CI=true. */
 #include "harness.h"
@@ -158,6 +159,13 @@ static int reference_and_refusals(void) {
   CHECK(strstr(g_out, "--time") && strstr(g_out, "--spp"), "the missing budget is not said");
   RUN(2, "compare", scene(), "--spp", "2", "-o", dir);
   RUN(2, "compare", scene(), "--integrators", "path", "--spp", "2", "--crop", "1,2,3", "-o", dir);
+  /* Ctrl-C: exit 130, no report */
+  char dir4[1200];
+  snprintf(dir4, sizeof dir4, "%s/report4", scratch_dir());
+  const char *const ia[] = {"compare", scene(), "--integrators", "path,vpl", "--time", "30", "--res", "64x48", "-o", dir4, NULL};
+  int irc = run_cli(ia, 1500, 120, g_out, sizeof g_out);
+  CHECK(irc == 130, "Ctrl-C: exit %d, expected 130", irc);
+  CHECK(access(in_dir(dir4, "index.html"), F_OK) != 0, "an interrupted comparison wrote a report");
   RUN(0, "compare", "--help");
   CHECK(strstr(g_out, "--integrators") && strstr(g_out, "--reference"), "compare --help lacks its options");
   return 0;

@@ -3,12 +3,15 @@
  * its error can be plotted against time; relMSE and mean bias against a reference EXR
  * (or the longest of the renders); the outputs in one folder: NAME.exr and NAME.png per
  * integrator, NAME_error.png (the per-pixel error as a heat map), NAME_crop.png (the crop),
- * summary.json and index.html (report.c). Uses only the public API. */
+ * summary.json and index.html (report.c). A progress line per render on a terminal;
+ * Ctrl-C stops with exit 130 and no report. Uses only the public API. */
 #include "cli/compare.h"
 #include "cli/args.h"
 #include "cli/report.h"
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,14 +47,25 @@ static double relmse(const float *img, const float *ref, size_t n, double *bias)
   return e / (3.0 * (double)n);
 }
 
-typedef struct snap_state { valo_render *r; cmp_run *run; size_t np; const float *ref; double next; } snap_state;
+typedef struct snap_state { valo_render *r; cmp_run *run; size_t np; const float *ref; double next; int tty, index, count; } snap_state;
+
+static volatile sig_atomic_t g_stop;
+static void on_sigint(int sig) {
+  (void)sig;
+  if (g_stop) _exit(130);
+  g_stop = 1;
+}
 
 /* The progress callback: at moments growing by 1.5x from 0.05 s, the error against the
  * reference file, or (none given) the image, until the reference is known. */
 static int on_progress(void *user, double frac, int spp, double seconds) {
-  (void)frac;
   snap_state *s = user;
   cmp_run *run = s->run;
+  if (s->tty) {
+    fprintf(stderr, "\rvalo: [%d/%d] %-12s %3d%%  %d spp  %.1f s ", s->index + 1, s->count, run->name, (int)(frac * 100 + 0.5), spp, seconds);
+    fflush(stderr);
+  }
+  if (g_stop) return 1;
   if (seconds < s->next || run->nsnap >= CMP_MAX_SNAPS) return 0;
   float *px = malloc(s->np * 3 * sizeof *px);
   if (!px) return 0;
@@ -70,7 +84,7 @@ static int on_progress(void *user, double frac, int spp, double seconds) {
 }
 
 /* Renders one integrator; fills run (pixels, figures, moments). 0 or an exit code. */
-static int render_one(valo_scene *sc, valo_options opt, const char *name, const char *dir, const float *ref, cmp_run *run) {
+static int render_one(valo_scene *sc, valo_options opt, const char *name, const char *dir, const float *ref, int index, int count, cmp_run *run) {
   snprintf(opt.integrator, sizeof opt.integrator, "%s", name);
   snprintf(run->name, sizeof run->name, "%s", name);
   valo_error err;
@@ -89,12 +103,18 @@ static int render_one(valo_scene *sc, valo_options opt, const char *name, const 
   run->w = st.width;
   run->h = st.height;
   size_t np = (size_t)st.width * st.height;
-  snap_state ss = {r, run, np, ref, 0.05};
+  snap_state ss = {r, run, np, ref, 0.05, isatty(2), index, count};
   valo_status rs = valo_render_run(r, on_progress, &ss, &err);
+  if (ss.tty) fprintf(stderr, "\n");
+  if (rs == VALO_ERR_CANCELLED || g_stop) {
+    fprintf(stderr, "valo: interrupted during %s; no report written\n", name);
+    valo_render_destroy(r);
+    return 130;
+  }
   if (rs) {
     fprintf(stderr, "valo: error: %s: %s\n", name, err.message);
     valo_render_destroy(r);
-    return rs == VALO_ERR_CANCELLED ? 130 : 1;
+    return 1;
   }
   valo_render_stats(r, &st);
   run->seconds = st.render_seconds;
@@ -239,6 +259,10 @@ int cmd_compare(int argc, char **argv) {
     snprintf(names[rep.nruns++], sizeof names[0], "%.*s", (int)len, p);
     p = e ? e + 1 : p + len;
   }
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_sigint;
+  sigaction(SIGINT, &sa, NULL); /* Ctrl-C: the render stops, no report; twice: at once */
   if (mkdir(dir, 0755) != 0 && errno != EEXIST) { fprintf(stderr, "valo: error: %s: cannot make the folder: %s\n", dir, strerror(errno)); return 1; }
   valo_error err;
   valo_scene *sc = NULL;
@@ -257,7 +281,7 @@ int cmd_compare(int argc, char **argv) {
   for (int k = 0; k < rep.nruns && !rc; k++) {
     rep.runs[k].w = rw;
     rep.runs[k].h = rh;
-    rc = render_one(sc, opt, names[k], dir, ref, &rep.runs[k]);
+    rc = render_one(sc, opt, names[k], dir, ref, k, rep.nruns, &rep.runs[k]);
   }
   valo_scene_destroy(sc);
   if (!rc && !refpath) {
