@@ -164,8 +164,8 @@ static int identical_path(void) {
 static int identical_prepare(void) {
   NEED_MPI();
   const char *outs[] = {"img.exr", NULL};
-  const char *photon[] = {scene(), "--res", "96x72", "--spp", "5", "--integrator", "photon", NULL};
-  const char *vpl[] = {scene(), "--res", "96x72", "--spp", "5", "--integrator", "vpl", NULL};
+  const char *photon[] = {scene(), "--res", "64x48", "--spp", "3", "--integrator", "photon", NULL};
+  const char *vpl[] = {scene(), "--res", "64x48", "--spp", "3", "--integrator", "vpl", NULL};
   return identical("photon", photon, outs) || identical("vpl", vpl, outs);
 }
 
