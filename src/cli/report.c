@@ -47,6 +47,13 @@ static int finish(FILE *f, const char *tmp, const char *dir, const char *name) {
   return 0;
 }
 
+/* The width an image is shown at: small films scaled up by a whole factor (pixelated) to
+ * at least 240 pixels, large ones down to 400. */
+static int shown_width(int w) {
+  if (w >= 240) return w > 400 ? 400 : w;
+  return w * ((240 + w - 1) / w);
+}
+
 static const char *ref_name(const cmp_report *r) { return r->reference[0] ? r->reference : r->runs[r->ref_run - 1].name; }
 
 int report_write_summary(const cmp_report *r, const char *dir) {
@@ -156,7 +163,7 @@ int report_write_html(const cmp_report *r, const char *dir) {
   fprintf(f, "</table>\n<h2>Images</h2>\n<div>\n");
   for (int k = 0; k < r->nruns; k++)
     fprintf(f, "<figure><img src=\"%s.png\" width=\"%d\" alt=\"%s\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name,
-            r->runs[k].w > 400 ? 400 : r->runs[k].w, r->runs[k].name, r->runs[k].name);
+            shown_width(r->runs[k].w), r->runs[k].name, r->runs[k].name);
   fprintf(f, "</div>\n<h2>Crop: x %d, y %d, %d &times; %d pixels, 4&times;</h2>\n<div>\n", r->crop[0], r->crop[1], r->crop[2], r->crop[3]);
   for (int k = 0; k < r->nruns; k++)
     fprintf(f, "<figure><img src=\"%s_crop.png\" alt=\"%s crop\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name, r->runs[k].name,
@@ -165,7 +172,7 @@ int report_write_html(const cmp_report *r, const char *dir) {
              "to 1 (yellow).</p>\n<div>\n");
   for (int k = 0; k < r->nruns; k++)
     fprintf(f, "<figure><img src=\"%s_error.png\" width=\"%d\" alt=\"%s error\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name,
-            r->runs[k].w > 400 ? 400 : r->runs[k].w, r->runs[k].name, r->runs[k].name);
+            shown_width(r->runs[k].w), r->runs[k].name, r->runs[k].name);
   fprintf(f, "</div>\n<h2>relMSE against time</h2>\n");
   put_svg(f, r);
   fprintf(f, "<p>Made by valo %s.</p>\n</body></html>\n", valo_version());
