@@ -31,6 +31,12 @@ int test_embree(void);
  * per call slot 0..7). */
 const char *scratch_file(const char *name, const char *text);
 const char *scratch_dir(void);
+/* scratch_dir()/name (one of 8 rotating static buffers). */
+const char *scratch_path(const char *name);
+/* 1 when both files can be read and hold the same bytes. */
+int same_bytes(const char *a, const char *b);
+/* A file's whole text, NUL-ended (malloc'd: free it), or NULL. */
+char *read_text_file(const char *path);
 /* Renders a JSON scene given as text (through the public API) with optional option
  * overrides; returns malloc'd RGB pixels and the size, or NULL (message printed). */
 #include "valo/valo.h"

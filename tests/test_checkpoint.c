@@ -28,26 +28,7 @@ static char g_out[65536];
 #define SAID(text) CHECK(strstr(g_out, text) != NULL, "message lacks \"%s\"", text)
 
 static const char *scene(void) { return VALO_SOURCE_DIR "/scenes/default.json"; }
-static const char *path_in(const char *name) {
-  static char b[4][1200];
-  static int k;
-  char *p = b[k++ & 3];
-  snprintf(p, sizeof b[0], "%s/%s", scratch_dir(), name);
-  return p;
-}
 
-static int same_bytes(const char *a, const char *b) {
-  FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-  int same = fa && fb;
-  while (same) {
-    int ca = fgetc(fa), cb = fgetc(fb);
-    if (ca != cb) same = 0;
-    if (ca == EOF || cb == EOF) break;
-  }
-  if (fa) fclose(fa);
-  if (fb) fclose(fb);
-  return same;
-}
 
 /* Starts valo with args (NULL-ended) and SIGKILLs it once its checkpoint file has been
  * written `writes` times: each write renames a finished file over it, which inotify
@@ -106,7 +87,7 @@ static void build_args(const char **out, const ckpt_case *c, const char *spp, co
 }
 
 static int one_kill(const ckpt_case *c) {
-  const char *full = path_in("full.exr"), *res = path_in("resumed.exr"), *ck = path_in("ck.valo");
+  const char *full = scratch_path("full.exr"), *res = scratch_path("resumed.exr"), *ck = scratch_path("ck.valo");
   char spp[16];
   snprintf(spp, sizeof spp, "%d", c->spp);
   const char *args[40];
@@ -175,9 +156,9 @@ static int write_all(const char *path, const unsigned char *b, size_t n) {
 
 /* Refusals: each exit 1, naming why, and no image written. */
 static int refusals(void) {
-  const char *ck = path_in("good.valo"), *bad = path_in("bad.valo"), *out = path_in("never.exr");
+  const char *ck = scratch_path("good.valo"), *bad = scratch_path("bad.valo"), *out = scratch_path("never.exr");
   RUN(0, "render", scene(), "--res", "32x32", "--spp", "4", "--seed", "7", "-q", "--checkpoint", ck, "--checkpoint-every", "0", "-o",
-      path_in("x.exr"));
+      scratch_path("x.exr"));
   size_t n;
   unsigned char *b = read_all(ck, &n);
   CHECK(b && n > 64, "no checkpoint written");
@@ -228,7 +209,7 @@ static int refusals(void) {
   SAID("resuming from");
   free(b);
   /* what cannot be checkpointed says so */
-  RUN(1, "render", scene(), "--res", "32x32", "--spp", "2", "--frames", "2", "-o", path_in("f%d.png"), "--checkpoint", ck);
+  RUN(1, "render", scene(), "--res", "32x32", "--spp", "2", "--frames", "2", "-o", scratch_path("f%d.png"), "--checkpoint", ck);
   SAID("still images");
   RUN(1, "render", scene(), "--res", "32x32", "--spp", "2", "--integrator", "restir-di", "-o", out, "--checkpoint", ck);
   SAID("image-wide");

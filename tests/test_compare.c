@@ -17,18 +17,6 @@
 
 static char g_out[65536];
 
-static char *slurp(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  fseek(f, 0, SEEK_END);
-  long n = ftell(f);
-  fseek(f, 0, SEEK_SET);
-  char *b = malloc((size_t)n + 1);
-  if (b && fread(b, 1, (size_t)n, f) != (size_t)n) { free(b); b = NULL; }
-  if (b) b[n] = 0;
-  fclose(f);
-  return b;
-}
 
 static const char *in_dir(const char *dir, const char *name) {
   static char b[4][1400];
@@ -56,7 +44,7 @@ static int close_to(double a, double b) { return fabs(a - b) <= 1e-6 * fabs(b) +
 /* Checks dir's report: each integrator's relMSE and bias in summary.json equal those of its
  * EXR against ref (an EXR path), the page shows them and every image it names exists. */
 static int check_report(const char *dir, const char *ref_path, int expect_runs) {
-  char *js = slurp(in_dir(dir, "summary.json")), *html = slurp(in_dir(dir, "index.html"));
+  char *js = read_text_file(in_dir(dir, "summary.json")), *html = read_text_file(in_dir(dir, "index.html"));
   CHECK(js && html, "summary.json or index.html missing in %s", dir);
   cJSON *root = cJSON_Parse(js);
   CHECK(root != NULL, "summary.json is not JSON");
@@ -115,7 +103,7 @@ static int longest_is_reference(void) {
   char dir[1200];
   snprintf(dir, sizeof dir, "%s/report", scratch_dir());
   RUN(0, "compare", scene(), "--integrators", "path,vpl", "--spp", "6", "--res", "64x48", "-o", dir);
-  char *js = slurp(in_dir(dir, "summary.json"));
+  char *js = read_text_file(in_dir(dir, "summary.json"));
   CHECK(js != NULL, "no summary");
   cJSON *root = cJSON_Parse(js);
   const char *ref = cJSON_GetObjectItem(root, "reference")->valuestring;
@@ -132,7 +120,7 @@ static int longest_is_reference(void) {
   char exr[64];
   snprintf(exr, sizeof exr, "%s.exr", ref);
   int r = check_report(dir, in_dir(dir, exr), 2);
-  char *html = slurp(in_dir(dir, "index.html"));
+  char *html = read_text_file(in_dir(dir, "index.html"));
   CHECK(html && strstr(html, "no reference was given"), "the page does not say there was no reference");
   free(html);
   cJSON_Delete(root);
@@ -148,7 +136,7 @@ static int reference_and_refusals(void) {
   RUN(0, "render", scene(), "--spp", "64", "--res", "64x48", "-q", "-o", ref);
   RUN(0, "compare", scene(), "--integrators", "path,photon", "--time", "0.6", "--res", "64x48", "--reference", ref, "-o", dir);
   if (check_report(dir, ref, 2)) return 1;
-  char *js = slurp(in_dir(dir, "summary.json"));
+  char *js = read_text_file(in_dir(dir, "summary.json"));
   CHECK(js && strstr(js, "\"reference_is_a_render\": false"), "the summary does not name the file as the reference");
   free(js);
   RUN(1, "compare", scene(), "--integrators", "path", "--spp", "2", "--res", "32x32", "--reference", ref, "-o", dir);
@@ -201,8 +189,8 @@ static int chromium_page(void) {
   h = (hd[20] << 24) | (hd[21] << 16) | (hd[22] << 8) | hd[23];
   CHECK(!memcmp(hd + 1, "PNG", 3) && w == 1200 && h == 1600, "the screenshot is %dx%d, expected 1200x1600", w, h);
   /* the browser's DOM holds the summary's figures, which check_report ties to the EXRs */
-  char *dom = slurp(in_dir(dir, "dom.html"));
-  char *js = slurp(in_dir(dir, "summary.json"));
+  char *dom = read_text_file(in_dir(dir, "dom.html"));
+  char *js = read_text_file(in_dir(dir, "summary.json"));
   CHECK(dom && js && strstr(dom, "<svg"), "the DOM has no SVG");
   cJSON *root = cJSON_Parse(js);
   const char *ref = cJSON_GetObjectItem(root, "reference")->valuestring;

@@ -575,22 +575,13 @@ static int sigint_writes_image(void) {
   return 0;
 }
 
-static char *read_text(const char *path) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  char *t = calloc(1, 400000);
-  size_t n = t ? fread(t, 1, 399999, f) : 0;
-  (void)n;
-  fclose(f);
-  return t;
-}
 
 /* The declared options (valo_option_at, one table) and the docs agree: every flag is in
  * the README's list and in --help, every scene-file key in docs/scene-format.md, and every
  * `--flag` the README or the docs name is a real one (or the CLI's own -o, -q, --help,
  * --help-integrators, --version). */
 static int options_docs(void) {
-  char *readme = read_text(VALO_SOURCE_DIR "/README.md"), *fmt = read_text(VALO_SOURCE_DIR "/docs/scene-format.md");
+  char *readme = read_text_file(VALO_SOURCE_DIR "/README.md"), *fmt = read_text_file(VALO_SOURCE_DIR "/docs/scene-format.md");
   CHECK(readme && fmt, "README.md or docs/scene-format.md missing");
   const char *const args[] = {"render", "--help", NULL};
   CHECK(run_valo(args) == 0, "--help failed");
@@ -621,7 +612,7 @@ static int options_docs(void) {
   for (int k = 0; k < 3; k++) {
     char path[600];
     snprintf(path, sizeof path, "%s/%s", VALO_SOURCE_DIR, docs[k]);
-    char *t = read_text(path);
+    char *t = read_text_file(path);
     CHECK(t, "%s missing", docs[k]);
     for (char *p = strstr(t, "`--"); p; p = strstr(p + 1, "`--")) {
       char flag[64];

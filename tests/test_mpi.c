@@ -53,26 +53,7 @@ static int mpi_ready(void) {
   } while (0)
 
 static const char *scene(void) { return VALO_SOURCE_DIR "/scenes/default.json"; }
-static const char *path_in(const char *name) {
-  static char b[8][1200];
-  static int k;
-  char *p = b[k++ & 7];
-  snprintf(p, sizeof b[0], "%s/%s", scratch_dir(), name);
-  return p;
-}
 
-static int same_bytes(const char *a, const char *b) {
-  FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-  int same = fa && fb;
-  while (same) {
-    int ca = fgetc(fa), cb = fgetc(fb);
-    if (ca != cb) same = 0;
-    if (ca == EOF || cb == EOF) break;
-  }
-  if (fa) fclose(fa);
-  if (fb) fclose(fb);
-  return same;
-}
 
 /* argv: `prefix` (NULL-ended), then `args` (NULL-ended), into out (at most 38). */
 static void join(const char **out, const char *const *prefix, const char *const *args) {
@@ -129,17 +110,14 @@ static int identical(const char *what, const char *const *args, const char *cons
 
 /* Every rank of a --stats-json file rendered tiles; returns how many ranks it lists. */
 static int ranks_that_worked(const char *json, int *listed) {
-  FILE *f = fopen(json, "rb");
-  static char text[65536];
-  size_t len = f ? fread(text, 1, sizeof text - 1, f) : 0;
-  if (f) fclose(f);
-  text[len] = 0;
+  char *text = read_text_file(json);
   int worked = 0;
   *listed = 0;
-  for (const char *p = strstr(text, "\"ranks\""); p && (p = strstr(p, "\"tiles\": ")); p++) {
+  for (const char *p = text ? strstr(text, "\"ranks\"") : NULL; p && (p = strstr(p, "\"tiles\": ")); p++) {
     (*listed)++;
     if (atoll(p + 9) > 0) worked++;
   }
+  free(text);
   return worked;
 }
 
@@ -153,8 +131,8 @@ static int identical_path(void) {
   const char *one[] = {"img.exr", NULL};
   if (identical("one tile", tiny, one)) return 1;
   /* every rank took part, and the stats say so */
-  const char *json = path_in("stats.json");
-  const char *a[] = {scene(), "--res", "160x120", "--spp", "24", "--seed", "3", "-q", "-o", path_in("s.exr"), "--stats-json", json, NULL};
+  const char *json = scratch_path("stats.json");
+  const char *a[] = {scene(), "--res", "160x120", "--spp", "24", "--seed", "3", "-q", "-o", scratch_path("s.exr"), "--stats-json", json, NULL};
   CHECK(run_mpi("1", a) == 0, "3 ranks with --stats-json failed");
   int listed = 0, worked = ranks_that_worked(json, &listed);
   CHECK(listed == 3 && worked == 3, "--stats-json lists %d ranks, %d of them rendered tiles (expected 3 and 3)", listed, worked);
@@ -196,18 +174,15 @@ static int identical_frames(void) {
 /* --time on 3 ranks: the spp it reached, rendered by one process, gives the same bytes. */
 static int time_budget(void) {
   NEED_MPI();
-  const char *json = path_in("t.json"), *t3 = path_in("t3.exr"), *t1 = path_in("t1.exr");
+  const char *json = scratch_path("t.json"), *t3 = scratch_path("t3.exr"), *t1 = scratch_path("t1.exr");
   const char *a[] = {scene(), "--res", "128x96", "--time", "1.5", "-q", "-o", t3, "--stats-json", json, NULL};
   CHECK(run_mpi("1", a) == 0, "3 ranks with --time failed");
-  FILE *f = fopen(json, "rb");
-  CHECK(f != NULL, "no stats file");
-  char text[8192];
-  size_t len = fread(text, 1, sizeof text - 1, f);
-  fclose(f);
-  text[len] = 0;
+  char *text = read_text_file(json);
+  CHECK(text != NULL, "no stats file");
   const char *p = strstr(text, "\"spp\": ");
-  CHECK(p != NULL, "no spp in the stats");
-  int spp = atoi(p + 7);
+  int spp = p ? atoi(p + 7) : -1;
+  free(text);
+  CHECK(spp != -1, "no spp in the stats");
   CHECK(spp >= 2, "only %d spp in 1.5 s", spp);
   char s[16];
   snprintf(s, sizeof s, "%d", spp);
@@ -295,7 +270,7 @@ static int leftovers(void) {
  * an uninterrupted render. */
 static int checkpoint_kill_resume(void) {
   NEED_MPI();
-  const char *full = path_in("full.exr"), *res = path_in("res.exr"), *ck = path_in("ck.valo");
+  const char *full = scratch_path("full.exr"), *res = scratch_path("res.exr"), *ck = scratch_path("ck.valo");
   const char *a1[] = {scene(), "--res", "96x72", "--spp", "96", "-q", "-o", full, NULL};
   CHECK(run_one(a1) == 0, "the uninterrupted render failed");
   /* passes grow to about a second each; the fifth checkpoint is a few spp in */
@@ -319,7 +294,7 @@ static int checkpoint_kill_resume(void) {
  * stats say "interrupted", and no process is left. */
 static int ctrl_c(void) {
   NEED_MPI();
-  const char *img = path_in("int.exr"), *ck = path_in("int.valo"), *json = path_in("int.json");
+  const char *img = scratch_path("int.exr"), *ck = scratch_path("int.valo"), *json = scratch_path("int.json");
   remove(img);
   const char *a[] = {scene(), "--res", "160x120", "--spp", "100000", "--checkpoint", ck, "--checkpoint-every", "0", "-o", img, "--stats-json", json, NULL};
   int rc = run_mpi_until(a, ck, 3, SIGINT);
@@ -330,13 +305,11 @@ static int ctrl_c(void) {
   CHECK(image_read(img, &im, NULL) == 0, "%s is not a readable image", img);
   CHECK(im.w == 160 && im.h == 120, "image %dx%d", im.w, im.h);
   image_free(&im);
-  FILE *f = fopen(json, "rb");
-  CHECK(f != NULL, "no stats file");
-  char text[8192];
-  size_t len = fread(text, 1, sizeof text - 1, f);
-  fclose(f);
-  text[len] = 0;
-  CHECK(strstr(text, "\"status\": \"interrupted\"") != NULL, "the stats do not say interrupted");
+  char *text = read_text_file(json);
+  CHECK(text != NULL, "no stats file");
+  int interrupted = strstr(text, "\"status\": \"interrupted\"") != NULL;
+  free(text);
+  CHECK(interrupted, "the stats do not say interrupted");
   CHECK(!leftovers(), "valo processes outlived Ctrl-C");
   return 0;
 }
@@ -349,11 +322,11 @@ static int count(const char *hay, const char *needle) {
 
 static int refusals(void) {
   NEED_MPI();
-  const char *a[] = {scene(), "--res", "32x32", "--integrator", "restir-di", "-o", path_in("r.exr"), NULL};
+  const char *a[] = {scene(), "--res", "32x32", "--integrator", "restir-di", "-o", scratch_path("r.exr"), NULL};
   CHECK(run_mpi("1", a) != 0, "restir-di ran on 3 ranks");
   CHECK(strstr(g_out, "restir-di is image-wide") && strstr(g_out, "one process"), "the refusal does not say why");
   CHECK(count(g_out, "valo: error") == 1, "%d error lines, expected one (rank 0's)", count(g_out, "valo: error"));
-  const char *b[] = {"/nonexistent/scene.json", "-o", path_in("r.exr"), NULL};
+  const char *b[] = {"/nonexistent/scene.json", "-o", scratch_path("r.exr"), NULL};
   CHECK(run_mpi("1", b) != 0, "a missing scene ran");
   CHECK(strstr(g_out, "/nonexistent/scene.json") != NULL, "the message does not name the file");
   CHECK(count(g_out, "valo: error") == 1, "%d error lines, expected one", count(g_out, "valo: error"));

@@ -2,22 +2,13 @@
  * images are the PNGs beside it, its plot an SVG drawn here (relMSE against seconds, both
  * on log axes, a polyline per integrator through the moments compare.c kept). */
 #include "cli/report.h"
+#include "cli/run_stats.h"
 #include "valo/valo.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 static const char *const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8"};
-
-static void put_json_string(FILE *f, const char *s) {
-  fputc('"', f);
-  for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-    if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
-    else if (*p < 0x20) fprintf(f, "\\u%04x", *p);
-    else fputc(*p, f);
-  }
-  fputc('"', f);
-}
 
 static void put_html(FILE *f, const char *s) {
   for (; *s; s++) {
@@ -61,9 +52,9 @@ int report_write_summary(const cmp_report *r, const char *dir) {
   FILE *f = open_in(dir, "summary.json", tmp, sizeof tmp);
   if (!f) return -1;
   fprintf(f, "{\n  \"scene\": ");
-  put_json_string(f, r->scene);
+  json_put_string(f, r->scene);
   fprintf(f, ",\n  \"budget\": {\"seconds\": %.9g, \"spp\": %d},\n  \"reference\": ", r->time_budget, r->spp_budget);
-  put_json_string(f, ref_name(r));
+  json_put_string(f, ref_name(r));
   fprintf(f, ",\n  \"reference_is_a_render\": %s,\n  \"crop\": [%d, %d, %d, %d],\n  \"integrators\": [", r->reference[0] ? "false" : "true", r->crop[0],
           r->crop[1], r->crop[2], r->crop[3]);
   for (int k = 0; k < r->nruns; k++) {
@@ -71,9 +62,9 @@ int report_write_summary(const cmp_report *r, const char *dir) {
     char image[64];
     snprintf(image, sizeof image, "%s.exr", u->name);
     fprintf(f, "%s\n    {\"name\": ", k ? "," : "");
-    put_json_string(f, u->name);
+    json_put_string(f, u->name);
     fprintf(f, ", \"image\": ");
-    put_json_string(f, image);
+    json_put_string(f, image);
     fprintf(f, ", \"seconds\": %.9g, \"spp\": %d, \"rays\": %llu, \"rays_per_second\": %.9g, \"relmse\": %.9g, \"mean_bias\": %.9g,\n     \"curve\": [",
             u->seconds, u->spp, (unsigned long long)u->rays, u->seconds > 0 ? (double)u->rays / u->seconds : 0.0, u->relmse, u->bias);
     for (int s = 0; s < u->nsnap; s++)
@@ -136,6 +127,19 @@ static void put_svg(FILE *f, const cmp_report *r) {
   fprintf(f, "</svg>\n");
 }
 
+/* One row of figures: every integrator's NAME<suffix>.png, captioned with its name;
+ * scaled: shown at shown_width (the crops are shown at their own 4x size). */
+static void put_figures(FILE *f, const cmp_report *r, const char *suffix, int scaled) {
+  fprintf(f, "<div>\n");
+  for (int k = 0; k < r->nruns; k++) {
+    const char *name = r->runs[k].name;
+    fprintf(f, "<figure><img src=\"%s%s.png\"", name, suffix);
+    if (scaled) fprintf(f, " width=\"%d\"", shown_width(r->runs[k].w));
+    fprintf(f, " alt=\"%s%s\"><figcaption>%s</figcaption></figure>\n", name, suffix, name);
+  }
+  fprintf(f, "</div>\n");
+}
+
 int report_write_html(const cmp_report *r, const char *dir) {
   char tmp[4400];
   FILE *f = open_in(dir, "index.html", tmp, sizeof tmp);
@@ -160,20 +164,14 @@ int report_write_html(const cmp_report *r, const char *dir) {
                "<td class=\"relmse\">%.6g</td><td class=\"bias\">%+.4f</td></tr>\n",
             u->name, u->name, u->seconds, u->spp, u->seconds > 0 ? (double)u->rays / u->seconds * 1e-6 : 0.0, u->relmse, u->bias);
   }
-  fprintf(f, "</table>\n<h2>Images</h2>\n<div>\n");
-  for (int k = 0; k < r->nruns; k++)
-    fprintf(f, "<figure><img src=\"%s.png\" width=\"%d\" alt=\"%s\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name,
-            shown_width(r->runs[k].w), r->runs[k].name, r->runs[k].name);
-  fprintf(f, "</div>\n<h2>Crop: x %d, y %d, %d &times; %d pixels, 4&times;</h2>\n<div>\n", r->crop[0], r->crop[1], r->crop[2], r->crop[3]);
-  for (int k = 0; k < r->nruns; k++)
-    fprintf(f, "<figure><img src=\"%s_crop.png\" alt=\"%s crop\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name, r->runs[k].name,
-            r->runs[k].name);
-  fprintf(f, "</div>\n<h2>Per-pixel error</h2>\n<p>log<sub>10</sub> of the pixel's relative squared error from 10<sup>&minus;4</sup> (dark blue) "
-             "to 1 (yellow).</p>\n<div>\n");
-  for (int k = 0; k < r->nruns; k++)
-    fprintf(f, "<figure><img src=\"%s_error.png\" width=\"%d\" alt=\"%s error\"><figcaption>%s</figcaption></figure>\n", r->runs[k].name,
-            shown_width(r->runs[k].w), r->runs[k].name, r->runs[k].name);
-  fprintf(f, "</div>\n<h2>relMSE against time</h2>\n");
+  fprintf(f, "</table>\n<h2>Images</h2>\n");
+  put_figures(f, r, "", 1);
+  fprintf(f, "<h2>Crop: x %d, y %d, %d &times; %d pixels, 4&times;</h2>\n", r->crop[0], r->crop[1], r->crop[2], r->crop[3]);
+  put_figures(f, r, "_crop", 0);
+  fprintf(f, "<h2>Per-pixel error</h2>\n<p>log<sub>10</sub> of the pixel's relative squared error from 10<sup>&minus;4</sup> (dark blue) "
+             "to 1 (yellow).</p>\n");
+  put_figures(f, r, "_error", 1);
+  fprintf(f, "<h2>relMSE against time</h2>\n");
   put_svg(f, r);
   fprintf(f, "<p>Made by valo %s.</p>\n</body></html>\n", valo_version());
   return finish(f, tmp, dir, "index.html");

@@ -14,8 +14,7 @@ uint64_t run_peak_memory(void) {
   return (uint64_t)ru.ru_maxrss * 1024; /* Linux: kilobytes */
 }
 
-/* s as a JSON string (quotes, backslashes and control characters escaped). */
-static void put_string(FILE *f, const char *s) {
+void json_put_string(FILE *f, const char *s) {
   fputc('"', f);
   for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
     if (*p == '"' || *p == '\\') fprintf(f, "\\%c", *p);
@@ -28,15 +27,15 @@ static void put_string(FILE *f, const char *s) {
 static void put_report(FILE *f, const run_report *r) {
   const valo_stats *st = r->st;
   fprintf(f, "{\n  \"valo_version\": ");
-  put_string(f, valo_version());
+  json_put_string(f, valo_version());
   fprintf(f, ",\n  \"scene\": ");
-  put_string(f, r->scene);
+  json_put_string(f, r->scene);
   fprintf(f, ",\n  \"status\": ");
-  put_string(f, r->status);
+  json_put_string(f, r->status);
   fprintf(f, ",\n  \"exit_code\": %d,\n  \"integrator\": ", r->exit_code);
-  put_string(f, st->integrator);
+  json_put_string(f, st->integrator);
   fprintf(f, ",\n  \"accel\": ");
-  put_string(f, st->accel);
+  json_put_string(f, st->accel);
   fprintf(f, ",\n  \"threads\": %d,\n  \"width\": %d,\n  \"height\": %d,\n  \"triangles\": %llu,\n", st->threads, st->width, st->height,
           (unsigned long long)st->triangles);
   fprintf(f, "  \"load_seconds\": %.9f,\n  \"build_seconds\": %.9f,\n  \"render_seconds\": %.9f,\n", r->load_seconds, st->build_seconds,
@@ -48,7 +47,7 @@ static void put_report(FILE *f, const run_report *r) {
           (unsigned long long)st->surface_samples);
   for (int k = 0; k < VALO_LOSS_COUNT; k++) {
     fprintf(f, "%s\n    ", k ? "," : "");
-    put_string(f, valo_loss_name(k));
+    json_put_string(f, valo_loss_name(k));
     fprintf(f, ": %llu", (unsigned long long)st->lost[k]);
   }
   fprintf(f, "\n  }");
@@ -57,7 +56,7 @@ static void put_report(FILE *f, const run_report *r) {
     for (int k = 0; k < r->nranks; k++) {
       const valo_rank_stats *q = &r->ranks[k];
       fprintf(f, "%s\n    {\"rank\": %d, \"host\": ", k ? "," : "", k);
-      put_string(f, q->host);
+      json_put_string(f, q->host);
       fprintf(f, ", \"threads\": %d, \"tiles\": %llu, \"samples\": %llu, \"rays\": %llu, \"busy_seconds\": %.9f, \"rays_per_second\": %.9g, \"peak_memory_bytes\": %llu}",
               q->threads, (unsigned long long)q->tiles, (unsigned long long)q->samples, (unsigned long long)q->rays, q->busy_seconds,
               q->busy_seconds > 0 ? (double)q->rays / q->busy_seconds : 0.0, (unsigned long long)q->peak_memory_bytes);

@@ -1,9 +1,14 @@
 /* run_stats.h — owns what the command line reports about a finished run beside the
- * image: the peak memory of the process and the machine-readable `--stats-json` file. */
+ * image: the peak memory of the process and the machine-readable `--stats-json` file,
+ * and the JSON string writer it shares with the compare report (report.c). */
 #ifndef VALO_CLI_RUN_STATS_H
 #define VALO_CLI_RUN_STATS_H
 #include "valo/valo.h"
 #include <stdint.h>
+#include <stdio.h>
+
+/* s as a JSON string, quoted (quotes, backslashes and control characters escaped). */
+void json_put_string(FILE *f, const char *s);
 
 /* The process's peak resident memory so far, bytes (0 when the system does not say). */
 uint64_t run_peak_memory(void);

@@ -339,10 +339,17 @@ void dist_finish(session *ss, thread_stats *sum) {
 }
 
 /* ---- the other ranks ---- */
-typedef struct worker_job { session *ss; int s0, s1; const uint32_t *target; int64_t t0; thread_stats *ts; } worker_job;
+typedef struct worker_job {
+  session *ss;
+  int s0, s1;
+  const uint32_t *target;
+  int64_t t0;
+  thread_stats *ts;
+  _Atomic uint64_t samples; /* taken in this batch */
+} worker_job;
 static void worker_tile(void *user, int64_t item, int thread) {
   worker_job *j = user;
-  tiles_render_tile(j->ss, j->t0 + item, j->s0, j->s1, j->target, &j->ts[thread]);
+  atomic_fetch_add(&j->samples, tiles_render_tile(j->ss, j->t0 + item, j->s0, j->s1, j->target, &j->ts[thread]));
 }
 
 valo_status dist_worker(session *ss, thread_stats *ts, valo_error *err) {
@@ -384,26 +391,13 @@ valo_status dist_worker(session *ss, thread_stats *ts, valo_error *err) {
       continue;
     }
     tile_states(ss, h[6], n, h[5] ? target : NULL, 1, in.p + sizeof h);
-    worker_job j = {ss, h[3], h[4], h[5] ? target : NULL, h[6], ts};
-    uint64_t before = 0, after = 0;
-    for (int64_t t = h[6]; t < h[6] + n; t++) {
-      int x0, y0, x1, y1;
-      tiles_rect(ss, t, &x0, &y0, &x1, &y1);
-      for (int y = y0; y < y1; y++)
-        for (int x = x0; x < x1; x++) before += ss->film.count[(size_t)y * ss->opt.width + x];
-    }
+    worker_job j = {ss, h[3], h[4], h[5] ? target : NULL, h[6], ts, 0};
     parallel_for(ss->opt.threads, n, worker_tile, &j);
     const int32_t rh[4] = {MSG_RESULT, h[6], n, 0};
     memcpy(out.p, rh, sizeof rh);
     unsigned char *end = tile_states(ss, h[6], n, NULL, 0, out.p + sizeof rh);
-    for (int64_t t = h[6]; t < h[6] + n; t++) {
-      int x0, y0, x1, y1;
-      tiles_rect(ss, t, &x0, &y0, &x1, &y1);
-      for (int y = y0; y < y1; y++)
-        for (int x = x0; x < x1; x++) after += ss->film.count[(size_t)y * ss->opt.width + x];
-    }
     me.tiles += (uint64_t)n;
-    me.samples += after - before;
+    me.samples += atomic_load(&j.samples);
     me.busy_seconds += now_seconds() - t0;
     MPI_Send(out.p, (int)(end - out.p), MPI_BYTE, 0, TAG, MPI_COMM_WORLD);
   }
