@@ -607,7 +607,8 @@ static int options_docs(void) {
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
   const char *docs[] = {"README.md", "docs/scene-format.md", "docs/integrators.md"};
   static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume",
-                                        "--integrators", "--reference", "--crop", NULL}; /* the last three: valo compare's */
+                                        "--integrators", "--reference", "--crop", /* valo compare's */
+                                        "--benchmark", NULL};                      /* valo view's */
   int named = 0;
   for (int k = 0; k < 3; k++) {
     char path[600];

@@ -243,6 +243,32 @@ typedef struct valo_rank_stats {
 } valo_rank_stats;
 VALO_API int valo_render_rank_stats(const valo_render *r, int k, valo_rank_stats *out);
 
+/* Interactive rendering (valo view): the camera moves between steps and the film is
+ * shown as it fills. A camera: position, the point looked at, the up direction and the
+ * vertical field of view in degrees. */
+typedef struct valo_camera {
+  double pos[3], look_at[3], up[3];
+  double fov_deg;
+} valo_camera;
+VALO_API void valo_render_camera(const valo_render *r, valo_camera *out);
+/* Moves the camera (lens and focus unchanged); the next step should restart the film.
+ * VALO_ERR_INVALID when up is parallel to the view direction, the field of view is not in
+ * (0, 180) or the render is a sequence (valo_options.frames). */
+VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c, valo_error *err);
+/* Renders one step on the current camera and returns: per-ray integrators add `spp`
+ * samples per pixel to the film (sample indices going on from the film's count, so a
+ * still camera converges to valo_render_run's image); image-wide integrators (restir-di,
+ * restir-gi) render `spp` frames as frames of a sequence, with temporal reuse from the
+ * previous step's frame reprojected to this camera. restart: empty the film first
+ * (per-ray integrators start again at sample index 0). Not for sequences, adaptive
+ * sampling or more than one MPI rank (VALO_ERR_INVALID). Budgets are the caller's. */
+VALO_API valo_status valo_render_step(valo_render *r, int spp, int restart, valo_error *err);
+/* Copies one layer of the film as linear RGB (width*height*3 floats): "" the image (as
+ * valo_render_pixels), or an AOV by its output prefix without the colon ("albedo",
+ * "normal", "depth", "ao", "bent", "spp") — the render must record it (VALO_ERR_INVALID
+ * otherwise, saying why). */
+VALO_API valo_status valo_render_layer(const valo_render *r, const char *layer, float *rgb_out, valo_error *err);
+
 /* Output settings for display-referred formats (PNG). EXR/PFM are always linear. */
 typedef struct valo_output_options {
   float exposure;         /* stops; 0 by default */

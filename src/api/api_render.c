@@ -165,6 +165,43 @@ VALO_API int valo_mpi_agree(int code, valo_error *err) {
   return dist_agree(code, err);
 }
 
+VALO_API void valo_render_camera(const valo_render *r, valo_camera *o) {
+  memset(o, 0, sizeof *o);
+  if (!r) return;
+  const camera *c = &r->ss->cam_still;
+  const vec3 v[3] = {c->pos, c->look_at, c->up};
+  double *d[3] = {o->pos, o->look_at, o->up};
+  for (int k = 0; k < 3; k++) { d[k][0] = v[k].x; d[k][1] = v[k].y; d[k][2] = v[k].z; }
+  o->fov_deg = c->fov_deg;
+}
+
+VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c, valo_error *err) {
+  clear_err(err);
+  if (!r || !c) return err_set(err, VALO_ERR_INVALID, "no render or no camera");
+  camera cam = r->ss->cam_still;
+  cam.pos = v3((float)c->pos[0], (float)c->pos[1], (float)c->pos[2]);
+  cam.look_at = v3((float)c->look_at[0], (float)c->look_at[1], (float)c->look_at[2]);
+  cam.up = v3((float)c->up[0], (float)c->up[1], (float)c->up[2]);
+  cam.fov_deg = (float)c->fov_deg;
+  return session_set_camera(r->ss, &cam, err);
+}
+
+VALO_API valo_status valo_render_step(valo_render *r, int spp, int restart, valo_error *err) {
+  clear_err(err);
+  if (!r) return err_set(err, VALO_ERR_INVALID, "no render");
+  log_scope scope;
+  log_scope_enter(&scope, r->warn_fn, r->warn_user);
+  valo_status st = session_step(r->ss, spp, restart, err);
+  log_scope_leave(&scope);
+  return st;
+}
+
+VALO_API valo_status valo_render_layer(const valo_render *r, const char *layer, float *rgb_out, valo_error *err) {
+  clear_err(err);
+  if (!r || !layer || !rgb_out) return err_set(err, VALO_ERR_INVALID, "no render, layer or buffer");
+  return output_layer(r->ss, layer, rgb_out, err);
+}
+
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) { film_resolve(&r->ss->film, rgb_out); }
 
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {

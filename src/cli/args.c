@@ -170,3 +170,21 @@ int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err) 
 
   return -1;
 }
+
+int cli_parse_with_own(int argc, char **argv, const char *const *own, const char **values, cli_args *ca, FILE *err) {
+  char **rest = calloc((size_t)argc + 1, sizeof *rest);
+  if (!rest) { fprintf(err, "valo: out of memory\n"); return 1; }
+  int nrest = 0;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "--help") || !strcmp(a, "-h")) { free(rest); return CLI_HELP; }
+    int k = 0;
+    while (own[k] && strcmp(own[k], a)) k++;
+    if (!own[k]) { rest[nrest++] = argv[i]; continue; }
+    if (i + 1 >= argc) { fprintf(err, "valo: %s needs a value\n", a); free(rest); return EXIT_USAGE; }
+    values[k] = argv[++i];
+  }
+  int rc = cli_parse_render(nrest, rest, ca, stdout, err);
+  free(rest);
+  return rc;
+}

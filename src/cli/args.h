@@ -25,6 +25,12 @@ typedef struct cli_args {
  * go on and render, or the exit code: 0 after --help or --help-integrators (printed to
  * out), EXIT_USAGE after a usage error (said on err). */
 int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err);
+/* For commands that take render flags and flags of their own (valo compare, valo view):
+ * own is a NULL-ended list of the command's flags, each taking a value stored in
+ * values[k] (left alone when absent); the rest goes to cli_parse_render. Returns what it
+ * does, or CLI_HELP for --help or -h (the caller prints its own usage). */
+#define CLI_HELP 1000
+int cli_parse_with_own(int argc, char **argv, const char *const *own, const char **values, cli_args *ca, FILE *err);
 /* The render --help text. */
 void usage_render(FILE *f);
 /* Length of an output's AOV prefix ("albedo:", "normal:", "depth:", "ao:", "bent:",

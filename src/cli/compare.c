@@ -209,27 +209,13 @@ static int write_maps(const cmp_report *rep, const cmp_run *run, const float *re
 }
 
 int cmd_compare(int argc, char **argv) {
-  const char *list = NULL, *refpath = NULL, *dir = NULL, *crop_s = NULL;
-  char **rest = calloc((size_t)argc + 1, sizeof *rest);
-  if (!rest) return 1;
-  int nrest = 0;
-  for (int i = 0; i < argc; i++) {
-    const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-    if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage_compare(stdout); free(rest); return 0; }
-    const char **slot = !strcmp(a, "--integrators") ? &list : !strcmp(a, "--reference") ? &refpath
-                      : !strcmp(a, "-o") || !strcmp(a, "--output") ? &dir : !strcmp(a, "--crop") ? &crop_s : NULL;
-    if (slot) {
-      if (!v) { fprintf(stderr, "valo: %s needs a value\n", a); free(rest); return EXIT_USAGE; }
-      *slot = v;
-      i++;
-      continue;
-    }
-    rest[nrest++] = argv[i];
-  }
+  static const char *const own[] = {"--integrators", "--reference", "-o", "--output", "--crop", NULL};
+  const char *val[5] = {NULL, NULL, NULL, NULL, NULL};
   cli_args ca;
-  int prc = cli_parse_render(nrest, rest, &ca, stdout, stderr);
-  free(rest);
+  int prc = cli_parse_with_own(argc, argv, own, val, &ca, stderr);
+  if (prc == CLI_HELP) { usage_compare(stdout); return 0; }
   if (prc >= 0) return prc;
+  const char *list = val[0], *refpath = val[1], *dir = val[2] ? val[2] : val[3], *crop_s = val[4];
   if (!list || !dir) { fprintf(stderr, "valo: compare needs --integrators and -o DIR\n"); usage_compare(stderr); return EXIT_USAGE; }
   if (ca.opt.time_budget == VALO_UNSET && ca.opt.spp == VALO_UNSET) {
     fprintf(stderr, "valo: compare needs a budget that is the same for every integrator: --time SECONDS or --spp N\n");

@@ -8,6 +8,7 @@
 #include "cli/run_stats.h"
 #include "cli/args.h"
 #include "cli/compare.h"
+#include "cli/view.h"
 #include <errno.h>
 #include <limits.h>
 #include <signal.h>
@@ -40,6 +41,7 @@ static void usage_main(FILE *f) {
           "  valo render --help            the render options\n"
           "  valo compare SCENE --integrators A,B (--time S | --spp N) -o DIR\n"
           "                                the integrators side by side at equal time: an HTML report\n"
+          "  valo view SCENE [options]     a window showing the render as it refines; restir in real time\n"
           "  valo --version                print the version\n\n"
           "Exit codes: 0 success, 1 error (bad input, failed write), 2 usage error, 130 interrupted.\n",
           valo_version());
@@ -305,6 +307,7 @@ int main(int argc, char **argv) {
     return rc;
   }
   if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "view")) return cmd_view(argc - 2, argv + 2);
   fprintf(stderr, "valo: unknown command \"%s\" (see valo --help)\n", argv[1]);
   return EXIT_USAGE;
 }

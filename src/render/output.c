@@ -46,6 +46,29 @@ static void aov_resolve(const session *ss, int k, float *px) {
   }
 }
 
+/* VALO_OK when the film holds layer k (-1: the image); name is what the message calls it. */
+static valo_status layer_check(const session *ss, int k, const char *name, valo_error *err) {
+  if (k < 0 || k == AOV_KIND_SPP) return VALO_OK;
+  if (!ss->film.aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", name);
+  if ((k == AOV_KIND_AO || k == AOV_KIND_BENT) && !(ss->opt.aovs & VALO_AOVS_AO))
+    return err_set(err, VALO_ERR_INVALID, "%s: the render was made without the ao AOV (aovs needs VALO_AOVS_AO)", name);
+  return VALO_OK;
+}
+
+valo_status output_layer(const session *ss, const char *layer, float *px, valo_error *err) {
+  int k = -1;
+  if (*layer) {
+    for (k = 0; k < AOV_KIND_COUNT; k++)
+      if (!strncmp(layer, aov_prefixes[k], strlen(layer)) && aov_prefixes[k][strlen(layer)] == ':') break;
+    if (k == AOV_KIND_COUNT) return err_set(err, VALO_ERR_INVALID, "unknown layer \"%s\" (albedo, normal, depth, ao, bent, spp)", layer);
+  }
+  valo_status st = layer_check(ss, k, layer, err);
+  if (st) return st;
+  if (k < 0) film_resolve(&ss->film, px);
+  else aov_resolve(ss, k, px);
+  return VALO_OK;
+}
+
 valo_status output_write(const session *ss, const char *path, const valo_output_options *o, valo_error *err) {
   size_t plen;
   int k = aov_kind_of(path, &plen);
@@ -54,11 +77,9 @@ valo_status output_write(const session *ss, const char *path, const valo_output_
   if (k < 0) {
     tonemap_kind tk;
     if (tonemap_parse(o->tonemap, &tk)) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp, log, reinhard, aces)", o->tonemap);
-  } else if (k != AOV_KIND_SPP) {
-    if (!ss->film.aov) return err_set(err, VALO_ERR_INVALID, "%s: the render was made without AOVs", path);
-    if ((k == AOV_KIND_AO || k == AOV_KIND_BENT) && !(ss->opt.aovs & VALO_AOVS_AO))
-      return err_set(err, VALO_ERR_INVALID, "%s: the render was made without the ao AOV (aovs needs VALO_AOVS_AO)", path);
   }
+  valo_status cst = layer_check(ss, k, path, err);
+  if (cst) return cst;
   float *px = malloc(np * 3 * sizeof(float));
   if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   const valo_output_options *use = o;

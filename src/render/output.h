@@ -6,5 +6,8 @@
 #define VALO_OUTPUT_H
 #include "render/session.h"
 
+/* One layer of the film into px (width*height*3 floats): "" the image, or an AOV named by
+ * its prefix without the colon ("albedo" ... "spp"). */
+valo_status output_layer(const session *ss, const char *layer, float *px, valo_error *err);
 valo_status output_write(const session *ss, const char *path, const valo_output_options *o, valo_error *err);
 #endif

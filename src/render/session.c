@@ -131,8 +131,8 @@ void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0)
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
-  frame_ctx f = {ss->image_frames, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel, ss->opt.frames > 0,
-                 &ss->lens};
+  frame_ctx f = {ss->image_frames, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel,
+                 ss->opt.frames > 0 || ss->stepped, &ss->lens};
   valo_status st = ss->integ->render_frame(ss->istate, &ss->ctx, &f, err);
   if (st) return st;
   ss->image_frames++;
@@ -263,3 +263,40 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
   return run_finish(ss, ts, t0, st);
 }
 
+
+valo_status session_set_camera(session *ss, const camera *c, valo_error *err) {
+  if (ss->opt.frames > 0) return err_set(err, VALO_ERR_INVALID, "the camera of a sequence (frames) follows the scene's animation");
+  if (!(c->fov_deg > 0 && c->fov_deg < 180)) return err_set(err, VALO_ERR_INVALID, "field of view %g: must be in (0, 180) degrees", (double)c->fov_deg);
+  camera keep = ss->cam_still;
+  ss->cam_still.pos = c->pos;
+  ss->cam_still.look_at = c->look_at;
+  ss->cam_still.up = c->up;
+  ss->cam_still.fov_deg = c->fov_deg;
+  if (v3_len(v3_sub(c->look_at, c->pos)) > 0 && !session_set_view(ss, 0)) return VALO_OK;
+  ss->cam_still = keep;
+  session_set_view(ss, 0);
+  return err_set(err, VALO_ERR_INVALID, "the camera looks at its own position, or its up vector is parallel to the view direction");
+}
+
+valo_status session_step(session *ss, int spp, int restart, valo_error *err) {
+  if (ss->opt.frames > 0 || ss->opt.adaptive || dist_size() > 1)
+    return err_set(err, VALO_ERR_INVALID, "steps are for one process rendering a still without adaptive sampling");
+  if (spp < 1 || (int64_t)ss->spp_done * !restart + spp > INT32_MAX) return err_set(err, VALO_ERR_INVALID, "step of %d samples per pixel: out of range", spp);
+  thread_stats *ts = calloc((size_t)ss->opt.threads, sizeof *ts);
+  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  double t0 = now_seconds();
+  atomic_store(&ss->cancel, 0);
+  ss->stepped = 1;
+  if (restart) {
+    film_clear(&ss->film);
+    ss->spp_done = 0;
+  }
+  valo_status st = VALO_OK;
+  if (ss->integ->kind == INTEGRATOR_IMAGE) {
+    for (int k = 0; k < spp && !st; k++)
+      if (!(st = image_frame(ss, ts, err))) ss->spp_done++;
+  } else if (!(st = tiles_render(ss, ss->spp_done, ss->spp_done + spp, ts, err))) {
+    ss->spp_done += spp;
+  }
+  return run_finish(ss, ts, t0, st);
+}

@@ -58,6 +58,7 @@ struct session {
   ckpt_state resume;       /* the state a resumed render goes on from (owns first, fin) */
   int resumed;
   int view_frame;          /* the frame whose camera ss->lens holds */
+  int stepped;             /* rendered by session_step (valo view): image-wide frames as a sequence's */
   struct dist_state *dist; /* rank 0 under MPI: the other ranks' state (render/dist.c) */
   rank_stats *ranks;       /* rank 0 under MPI, after a run: every rank's share, nranks of them */
   int nranks;
@@ -74,6 +75,11 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
 /* The pinhole basis of frame f (the scene's camera animation in a sequence, else the
  * still camera) into ss->lens.view; -1 when up is parallel to the view direction. */
 int session_set_view(session *ss, int f);
+/* Moves the still camera (position, look-at, up, field of view); refused for sequences
+ * and degenerate cameras, which leave it unchanged. */
+valo_status session_set_camera(session *ss, const camera *c, valo_error *err);
+/* One step of interactive rendering (valo_render_step in valo.h). */
+valo_status session_step(session *ss, int spp, int restart, valo_error *err);
 /* At a pass boundary (ss->ckpt_state says which): writes the checkpoint when one is due;
  * ts are this run's counters, run_t0 its start. A failed write is a warning: the render
  * goes on. */
