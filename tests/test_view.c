@@ -1,4 +1,5 @@
-/* test_view.c — `valo view` as a user runs it:
+/* test_view.c — `valo view` as a user runs it, and the library calls under it:
+ *  - steps add up to valo_render_run's image; cameras, layers and steps are checked;
  *  - --benchmark without a display (SDL's dummy driver): prints "fps X" last, and -o writes
  *    the last frame itself — path's one-sample frame equals `valo render --spp 1`, and
  *    restir-di's sixth frame equals frame 5 of `valo render --frames 6 --spp 1` (temporal
@@ -233,7 +234,60 @@ static int xvfb_drag_and_save(void) {
   return rc;
 }
 
+/* The library calls under the viewer: steps on a still camera add up to valo_render_run's
+ * image bit for bit; a moved camera gives another image and moving it back the first;
+ * bad cameras, layers and renders are refused. */
+static int step_api(void) {
+  valo_error err;
+  valo_scene *sc;
+  CHECK(valo_scene_load(scene(), &sc, &err) == VALO_OK, "%s", err.message);
+  valo_options o;
+  valo_options_init(&o);
+  o.width = 32; o.height = 24; o.spp = 4; o.threads = 2;
+  valo_render *a, *b;
+  CHECK(valo_render_create(sc, &o, &a, &err) == VALO_OK && valo_render_run(a, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_create(sc, &o, &b, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_step(b, 1, 1, &err) == VALO_OK && valo_render_step(b, 3, 0, &err) == VALO_OK, "%s", err.message);
+  size_t n = 32 * 24 * 3;
+  float *pa = malloc(n * sizeof *pa), *pb = malloc(n * sizeof *pb), *pc = malloc(n * sizeof *pc);
+  valo_render_pixels(a, pa);
+  CHECK(valo_render_layer(b, "", pb, &err) == VALO_OK, "%s", err.message);
+  CHECK(!memcmp(pa, pb, n * sizeof *pa), "steps of 1 and 3 samples differ from a 4-spp render");
+  CHECK(valo_render_layer(b, "spp", pc, &err) == VALO_OK && pc[0] == 4 && pc[n - 1] == 4, "the spp layer is not 4");
+  CHECK(valo_render_layer(b, "albedo", pc, &err) == VALO_ERR_INVALID && strstr(err.message, "without AOVs"), "albedo without AOVs: %s", err.message);
+  CHECK(valo_render_layer(b, "bogus", pc, &err) == VALO_ERR_INVALID, "an unknown layer was taken");
+  valo_camera c0, c;
+  valo_render_camera(b, &c0);
+  c = c0;
+  c.pos[0] += 0.5;
+  CHECK(valo_render_set_camera(b, &c, &err) == VALO_OK && valo_render_step(b, 4, 1, &err) == VALO_OK, "%s", err.message);
+  valo_render_pixels(b, pc);
+  CHECK(memcmp(pa, pc, n * sizeof *pa) != 0, "moving the camera changed nothing");
+  CHECK(valo_render_set_camera(b, &c0, &err) == VALO_OK && valo_render_step(b, 4, 1, &err) == VALO_OK, "%s", err.message);
+  valo_render_pixels(b, pc);
+  CHECK(!memcmp(pa, pc, n * sizeof *pa), "moving the camera back did not give the first image");
+  c = c0;
+  memcpy(c.look_at, c.pos, sizeof c.pos);
+  CHECK(valo_render_set_camera(b, &c, &err) == VALO_ERR_INVALID, "a camera looking at itself was taken");
+  c = c0;
+  c.fov_deg = 0;
+  CHECK(valo_render_set_camera(b, &c, &err) == VALO_ERR_INVALID, "a field of view of 0 was taken");
+  valo_camera now;
+  valo_render_camera(b, &now);
+  CHECK(!memcmp(&now, &c0, sizeof now), "a refused camera changed the render's");
+  CHECK(valo_render_step(b, 0, 0, &err) == VALO_ERR_INVALID, "a step of 0 samples was taken");
+  valo_render_destroy(a);
+  valo_render_destroy(b);
+  o.adaptive = VALO_ADAPTIVE_ERROR;
+  CHECK(valo_render_create(sc, &o, &a, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_render_step(a, 1, 1, &err) == VALO_ERR_INVALID, "a step of an adaptive render was taken");
+  valo_render_destroy(a);
+  valo_scene_destroy(sc);
+  free(pa); free(pb); free(pc);
+  return 0;
+}
+
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"benchmark_frames", benchmark_frames}, {"refusals", refusals}, {"xvfb_drag_and_save", xvfb_drag_and_save}, {NULL, NULL}};
+  static const test_case cases[] = {{"step_api", step_api}, {"benchmark_frames", benchmark_frames}, {"refusals", refusals}, {"xvfb_drag_and_save", xvfb_drag_and_save}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
