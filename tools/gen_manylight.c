@@ -1,6 +1,7 @@
 /* gen_manylight.c — writes the many-light scenes of docs/integrators.md (restir-di/gi):
- * OBJ+MTL files of small one-sided emissive triangles, each its own colour and power,
- * every one tilted and placed at its own height so no two lie in one plane. Deterministic
+ * OBJ+MTL files of small one-sided emissive triangles, each its own colour and power:
+ * in `room` and `sponza` every one tilted and placed at its own height so no two lie in
+ * one plane; in `walls`, lamps share their face's plane and none overlaps another. Deterministic
  * (a fixed splitmix64 stream); run by hand, the outputs are committed:
  *   gen_manylight room   DIR   -> DIR/manylight-room.obj/.mtl   (room, boxes, 1024 lamps)
  *   gen_manylight sponza DIR   -> DIR/sponza-lamps.obj/.mtl     (1200 lamps for Sponza's atrium)
@@ -61,14 +62,17 @@ static void hsv(double h, double s, double v, double *r, double *g, double *b) {
 
 /* Lamp i: an equilateral triangle of edge `edge` centred at c, turned by rot about its
  * normal nn, emitting (R, G, B) on the side nn points to. */
-static void lamp(FILE *obj, FILE *mtl, int i, v3 c, v3 nn, double edge, double rot, double R, double G, double B) {
+static void lamp_points(v3 c, v3 nn, double edge, double rot, v3 p[3]) {
   v3 t = nrm(crs(nn, fabs(nn.x) < 0.9 ? mk(1, 0, 0) : mk(0, 0, 1))), u = crs(nn, t);
   double r = edge / sqrt(3.0);
-  v3 p[3];
   for (int k = 0; k < 3; k++) {
     double a = rot + 2 * PI * k / 3;
     p[k] = add(c, add(scl(t, r * cos(a)), scl(u, r * sin(a))));
   }
+}
+static void lamp(FILE *obj, FILE *mtl, int i, v3 c, v3 nn, double edge, double rot, double R, double G, double B) {
+  v3 p[3];
+  lamp_points(c, nn, edge, rot, p);
   fprintf(mtl, "newmtl lamp%04d\nKd 0 0 0\nKe %.4f %.4f %.4f\n\n", i, R, G, B);
   fprintf(obj, "usemtl lamp%04d\n", i);
   /* winding so that the emitting side (counter-clockwise) faces along nn */
@@ -104,16 +108,57 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
  * (x = -2) and right (x = 2) faces, facing into the room: equilateral, of edge `edge`,
  * radiance L0 times 1, 20^(1/2) or 20 (a third each), tinted. Lamps are spread over the
  * faces in proportion to their areas. */
+/* Two triangles in one plane (2D points) overlap: no edge normal of either separates them. */
+static int tri2_overlap(const double a[3][2], const double b[3][2]) {
+  for (int s = 0; s < 2; s++) {
+    const double(*t)[2] = s ? b : a;
+    for (int e = 0; e < 3; e++) {
+      double nx = t[(e + 1) % 3][1] - t[e][1], ny = t[e][0] - t[(e + 1) % 3][0];
+      double amin = 1e30, amax = -1e30, bmin = 1e30, bmax = -1e30;
+      for (int k = 0; k < 3; k++) {
+        double pa = a[k][0] * nx + a[k][1] * ny, pb = b[k][0] * nx + b[k][1] * ny;
+        amin = fmin(amin, pa); amax = fmax(amax, pa); bmin = fmin(bmin, pb); bmax = fmax(bmax, pb);
+      }
+      if (amax <= bmin || bmax <= amin) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Lamps on one face lie in one plane, so none may overlap another: where two did, which
+ * one a ray sees is a tie that rounding decides, differently for a shadow ray aimed at one
+ * of them and for a ray that finds whichever is nearer (estimators then disagree by the
+ * share of light from overlaps). Placed by rejection: a lamp that would overlap one
+ * already on its face is drawn again. */
+#define WALL_LAMPS_MAX 2048
 static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, double L0) {
-  for (int i = 0; i < n; i++) {
-    double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd();
+  static double placed[WALL_LAMPS_MAX][3][2];
+  static int face_of[WALL_LAMPS_MAX];
+  for (int i = 0; i < n && i < WALL_LAMPS_MAX; i++) {
     v3 c, nn;
-    double m = edge; /* keep whole triangles on their face */
-    if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); }
-    else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); }
-    else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); }
-    else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); }
-    double rot = 2 * PI * rnd(), R, G, B;
+    double rot, tri[3][2];
+    int face;
+    for (;;) {
+      double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd();
+      double m = edge; /* keep whole triangles on their face */
+      if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); face = 0; }
+      else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); face = 1; }
+      else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); face = 2; }
+      else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); face = 3; }
+      rot = 2 * PI * rnd();
+      v3 p[3];
+      lamp_points(c, nn, edge, rot, p);
+      for (int k = 0; k < 3; k++) {
+        tri[k][0] = face == 2 || face == 3 ? p[k].z : p[k].x;
+        tri[k][1] = face == 0 ? p[k].z : p[k].y;
+      }
+      int clash = 0;
+      for (int j = 0; j < i && !clash; j++) clash = face_of[j] == face && tri2_overlap(tri, (const double(*)[2])placed[j]);
+      if (!clash) break;
+    }
+    memcpy(placed[i], tri, sizeof tri);
+    face_of[i] = face;
+    double R, G, B;
     hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
     int level = (int)(3 * rnd());
     double L = L0 * pow(20.0, 0.5 * level);
