@@ -68,7 +68,8 @@ typedef struct worker {
   int set_cam, n, restart;   /* in */
   valo_camera cam;
   view_layer layer;
-  valo_status st;            /* out */
+  valo_status st;            /* out: the first failure, and whether it was the camera's */
+  int cam_refused;
   valo_error err;
   double dt;
   int spp_done;
@@ -95,7 +96,7 @@ typedef struct viewer {
   float *px;                 /* the layer shown */
   unsigned char *rgb8;
   double sps, fps, msg_until;
-  int frame;               /* steps since the last restart */
+  int frame;               /* frames (real time) or steps since the camera last moved */
   char msg[160];
   const char *save_stem;
   int saves;
@@ -116,16 +117,16 @@ static void say(viewer *v, const char *m) {
   fprintf(stderr, "valo: %s\n", m);
 }
 
-/* (Re)creates the render for integrator v->cur, keeping the camera. */
 static void wait_idle(viewer *v);
+/* (Re)creates the render for integrator v->cur and layer v->layer, keeping the camera;
+ * on failure the current render stays as it was. */
 static int make_render(viewer *v) {
   wait_idle(v);
   valo_options o = v->base;
   snprintf(o.integrator, sizeof o.integrator, "%s", v->integ[v->cur]);
-  v->image_wide = !strncmp(o.integrator, "restir", 6);
-  if (v->image_wide && v->layer != VIEW_LAYER_IMAGE) v->layer = VIEW_LAYER_IMAGE;
-  v->aovs = v->layer != VIEW_LAYER_IMAGE;
-  o.aovs = v->aovs ? 1 | VALO_AOVS_AO : VALO_UNSET;
+  int image_wide = !strncmp(o.integrator, "restir", 6);
+  view_layer layer = image_wide ? VIEW_LAYER_IMAGE : v->layer;
+  o.aovs = layer != VIEW_LAYER_IMAGE ? 1 | VALO_AOVS_AO : VALO_UNSET;
   valo_error err;
   valo_render *r = NULL;
   if (valo_render_create(v->sc, &o, &r, &err)) {
@@ -141,6 +142,9 @@ static int make_render(viewer *v) {
     valo_render_camera(r, &v->cam);
   }
   v->r = r;
+  v->image_wide = image_wide;
+  v->layer = layer;
+  v->aovs = layer != VIEW_LAYER_IMAGE;
   v->dirty = 1;
   return 0;
 }
@@ -261,8 +265,9 @@ static void handle_key(viewer *v, const SDL_KeyboardEvent *k) {
     }
     case SDLK_v: {
       if (v->image_wide) { say(v, "restir-di and restir-gi record no AOVs: the image only"); break; }
+      view_layer was = v->layer;
       v->layer = (view_layer)((v->layer + 1) % VIEW_LAYER_COUNT);
-      if (v->layer != VIEW_LAYER_IMAGE && !v->aovs) make_render(v);
+      if (v->layer != VIEW_LAYER_IMAGE && !v->aovs && make_render(v)) v->layer = was;
       break;
     }
     default: break;
@@ -304,7 +309,8 @@ static void *render_thread(void *arg) {
     valo_error err;
     valo_status st = VALO_OK;
     double t0 = now_s();
-    if (w->set_cam && valo_render_set_camera(v->r, &w->cam, &err)) st = err.status;
+    int refused = w->set_cam && valo_render_set_camera(v->r, &w->cam, &err);
+    if (refused) st = err.status;
     if (!st) st = valo_render_step(v->r, w->n, w->restart, &err);
     double dt = now_s() - t0;
     if (!st) st = valo_render_layer(v->r, layer_names[w->layer], w->back, &err);
@@ -312,6 +318,7 @@ static void *render_thread(void *arg) {
     valo_render_stats(v->r, &vs);
     pthread_mutex_lock(&w->mu);
     w->st = st;
+    w->cam_refused = refused;
     if (st) w->err = err;
     w->dt = dt;
     w->spp_done = vs.spp_done;
@@ -362,6 +369,7 @@ static int collect(viewer *v, int benchmark) {
   int done = w->done;
   w->done = 0;
   valo_status st = w->st;
+  int cam_refused = w->cam_refused;
   valo_error err = w->err;
   double dt = w->dt;
   v->spp_done = w->spp_done;
@@ -371,7 +379,7 @@ static int collect(viewer *v, int benchmark) {
   if (!done) return 0;
   if (st) {
     say(v, err.message);
-    if (st == VALO_ERR_INVALID) { valo_render_camera(v->r, &v->cam); return 1; } /* a camera it refused: back to the last good one */
+    if (cam_refused) { valo_render_camera(v->r, &v->cam); return 1; } /* back to the last good camera */
     return -1;
   }
   v->shown_layer = w->layer;
