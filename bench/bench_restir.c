@@ -155,18 +155,7 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
   job em = {stat, "path", NULL, sd->w, sd->h, 1024, 0, 0, 0, 1, 0, NULL, {NULL}, 0, NULL}; /* every pixel a lamp touches */
   if (run(&em)) return 1;
   g_ok = malloc((size_t)n);
-  for (int y = 0; y < sd->h; y++)
-    for (int x = 0; x < sd->w; x++) {
-      int bad = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int xx = x + dx, yy = y + dy;
-          if (xx < 0 || yy < 0 || xx >= sd->w || yy >= sd->h) continue;
-          const float *p = &em.px[3 * (yy * sd->w + xx)];
-          if (p[0] + p[1] + p[2] > 0) bad = 1;
-        }
-      g_ok[y * sd->w + x] = !bad;
-    }
+  bench_lamp_mask(em.px, sd->w, sd->h, g_ok);
   job_free(&em);
   for (int gi = 0; gi < 2; gi++) {
     const char *refp = gi ? sd->ref_path : sd->ref_direct;

@@ -1,5 +1,5 @@
 /* bench_util.h — owns what the benchmark programs share: a monotonic clock, the relMSE
- * they report (docs/performance.md) and the Cornell scene file with the references'
+ * they report (docs/performance.md), the many-light scenes' lamp mask and the Cornell scene file with the references'
  * camera. */
 #ifndef VALO_BENCH_UTIL_H
 #define VALO_BENCH_UTIL_H
@@ -21,6 +21,24 @@ static inline double bench_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* The pixels to leave out of a many-light relMSE: ok[i] = 0 where em (w*h RGB: emission
+ * seen directly, a render at depth 0) is non-zero at pixel i or one of its 8 neighbours,
+ * 1 elsewhere. Lamps smaller than a pixel are equally noisy for every method. */
+static inline void bench_lamp_mask(const float *em, int w, int h, unsigned char *ok) {
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      int bad = 0;
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+          const float *p = &em[3 * (yy * w + xx)];
+          if (p[0] + p[1] + p[2] > 0) bad = 1;
+        }
+      ok[y * w + x] = !bad;
+    }
 }
 
 /* relMSE of RGB image a against reference b (n pixels): the mean over pixels and channels

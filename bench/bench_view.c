@@ -47,16 +47,7 @@ int main(int argc, char **argv) {
   if (valo_render_create(sc, &o, &r, &err) || valo_render_run(r, NULL, NULL, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
   valo_render_pixels(r, px);
   valo_render_destroy(r);
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      int bad = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < w && yy < h && px[3 * (yy * w + xx)] + px[3 * (yy * w + xx) + 1] + px[3 * (yy * w + xx) + 2] > 0) bad = 1;
-        }
-      ok[y * w + x] = !bad;
-    }
+  bench_lamp_mask(px, w, h, ok);
   valo_options_init(&o);
   o.width = w; o.height = h; o.threads = 2;
   snprintf(o.integrator, sizeof o.integrator, "%s", integ);
@@ -70,23 +61,21 @@ int main(int argc, char **argv) {
     if (valo_render_step(r, 1, 1, &err)) { fprintf(stderr, "%s\n", err.message); return 1; }
     frames++;
     busy += bench_now() - s0;
-    double t = busy;
     if (frames == 1) {
       valo_render_pixels(r, px);
       efirst = bench_relmse(px, ref, n, ok);
     }
-    if (t >= 1 + seconds) break;
-    if (t < 1) { warm = t; continue; }
+    if (busy >= 1 + seconds) break;
+    if (busy < 1) { warm = busy; continue; }
     valo_render_pixels(r, px);
     double e = bench_relmse(px, ref, n, ok);
     emax = e > emax ? e : emax;
     esum += e;
     measured++;
   }
-  double el = busy;
   printf("%s, %s (%s), %dx%d, 2 threads: %.2f fps (%.1f ms a frame, %d frames in %.2f s of rendering); "
          "first frame (no history) relMSE %.4g; after %.2f s of still camera, per-frame relMSE mean %.4g, max %.4g over %d frames\n",
-         argv[1], integ, o.params, w, h, frames / el, 1e3 * el / frames, frames, el, efirst, warm, measured ? esum / measured : 0, emax, measured);
+         argv[1], integ, o.params, w, h, frames / busy, 1e3 * busy / frames, frames, busy, efirst, warm, measured ? esum / measured : 0, emax, measured);
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   valo_image_free(ref);

@@ -218,10 +218,15 @@ void compare_images(const float *img, const float *ref, int w, int h, int block,
 }
 
 double run_cli_seconds;
-static double wall_now(void) {
+double wall_now(void) {
   struct timespec t;
   clock_gettime(CLOCK_MONOTONIC, &t);
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+void nap_ms(int ms) {
+  struct timespec d = {ms / 1000, (long)(ms % 1000) * 1000000L};
+  nanosleep(&d, NULL);
 }
 
 pid_t spawn_exe(const char *exe, const char *const *args, const char *log) {

@@ -68,6 +68,9 @@ int read_aov(const valo_render *r, const char *name, image *out);
  * block-channels); the worst relative block-channel error and where it is. */
 typedef struct cmp_result { double mean_err[3]; double worst_block; int worst_bx, worst_by, worst_c, lit_blocks; } cmp_result;
 void compare_images(const float *img, const float *ref, int w, int h, int block, cmp_result *r);
+/* Seconds on a monotonic clock; sleeping for ms milliseconds. */
+double wall_now(void);
+void nap_ms(int ms);
 /* Runs the valo binary with args (NULL-terminated): sends SIGINT (as Ctrl-C does) after
  * sigint_ms milliseconds when > 0, kills it after timeout_s seconds (a hang: returns 999).
  * Returns the exit code (128+signal if killed); the combined stdout+stderr go to out

@@ -278,12 +278,6 @@ static const char *png_header_only(const char *name, uint32_t w, uint32_t h) {
   return p;
 }
 
-static double wall_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Memory limits: what would need more memory than the machine has (or than
  * VALO_MEMORY_LIMIT allows) fails at once, exit 1, naming the file and the size: a PNG
  * whose header claims 100 000 x 100 000 pixels, a texture and an environment map that
@@ -293,7 +287,7 @@ static int memory_limits(void) {
   write_file("tex.mtl", "newmtl t\nKd 1 1 1\nmap_Kd huge.png\n");
   write_file("tex2.mtl", "newmtl b\nKd 1 1 1\nmap_Kd big.png\n");
   const char *obj = write_file("tex.obj", "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n");
-  double t0 = wall_seconds();
+  double t0 = wall_now();
   EXPECT_FAIL(1, "render", obj, "--res", "8x8", "-o", "x.png");
   SAID("huge.png"); SAID("100000 x 100000"); NO_SANITIZER();
   /* 12 000 x 12 000 is within the fixed texture limit, but 2.7 GiB as float RGBA */
@@ -322,7 +316,7 @@ static int memory_limits(void) {
   SAID("grid.obj"); SAID("reading a mesh file of"); SAID("more than the 16.0 KiB of VALO_MEMORY_LIMIT"); NO_SANITIZER();
   unsetenv("VALO_MEMORY_LIMIT");
   /* each at once, not after allocating or rendering (the film alone would take minutes) */
-  CHECK(wall_seconds() - t0 < 30, "the five refusals took %.1f s", wall_seconds() - t0);
+  CHECK(wall_now() - t0 < 30, "the five refusals took %.1f s", wall_now() - t0);
   EXPECT_FAIL(0, "render", cube, "--res", "8x8", "-o", "x.png");
   return 0;
 }

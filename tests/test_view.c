@@ -3,7 +3,7 @@
  *  - --benchmark without a display (SDL's dummy driver): prints "fps X" last, and -o writes
  *    the last frame itself — path's one-sample frame equals `valo render --spp 1`, and
  *    restir-di's sixth frame equals frame 5 of `valo render --frames 6 --spp 1` (temporal
- *    reuse from frame to frame, no averaging), byte for byte in the pixels;
+ *    reuse from frame to frame, no averaging), the EXR files byte for byte;
  *  - in a window under Xvfb, driven by xdotool: the camera is printed (C), a drag orbits
  *    it, the save key (P) writes the EXR and PNG of the moved view, which differ from the
  *    first camera's render, and Esc quits with exit 0;
@@ -55,16 +55,6 @@ static const char *last_line(const char *s) {
   return p;
 }
 
-static int same_pixels(const char *a, const char *b) {
-  image x, y;
-  if (image_read(a, &x, NULL)) return 0;
-  if (image_read(b, &y, NULL)) { image_free(&x); return 0; }
-  int same = x.w == y.w && x.h == y.h && !memcmp(x.rgb, y.rgb, (size_t)x.w * x.h * 3 * sizeof(float));
-  image_free(&x);
-  image_free(&y);
-  return same;
-}
-
 static int benchmark_frames(void) {
   NEED_VIEWER();
   /* path: a frame is one sample per pixel, the film started again */
@@ -75,7 +65,7 @@ static int benchmark_frames(void) {
   CHECK(sscanf(last_line(g_out), "fps %lf", &fps) == 1 && fps > 0, "the last line is not \"fps X\": %s", last_line(g_out));
   const char *r[] = {"render", scene(), "--res", "64x48", "--spp", "1", "-q", "-o", scratch_path("path-1spp.exr"), NULL};
   CHECK(run_cli(r, 0, 300, g_out, sizeof g_out) == 0, "valo render failed");
-  CHECK(same_pixels(scratch_path("path-frame.exr"), scratch_path("path-1spp.exr")), "path's benchmark frame is not the 1-spp render");
+  CHECK(same_bytes(scratch_path("path-frame.exr"), scratch_path("path-1spp.exr")), "path's benchmark frame is not the 1-spp render");
   /* restir-di: frame 6 carries the history of frames 1-5, as a sequence's frame 5 does
    * (on a still camera: the default scene has no camera animation) */
   const char *ml = scene();
@@ -86,8 +76,8 @@ static int benchmark_frames(void) {
   const char *s[] = {"render", ml, "--integrator", "restir-di", "--param", p, "--res", "48x36", "--spp", "1", "--frames", "6", "-q",
                      "-o", scratch_path("seq-%d.exr"), NULL};
   CHECK(run_cli(s, 0, 300, g_out, sizeof g_out) == 0, "the restir-di sequence failed");
-  CHECK(same_pixels(scratch_path("restir-frame.exr"), scratch_path("seq-5.exr")), "restir-di's sixth benchmark frame is not frame 5 of the sequence");
-  CHECK(!same_pixels(scratch_path("restir-frame.exr"), scratch_path("seq-4.exr")), "frames 4 and 5 are equal: the test cannot tell them apart");
+  CHECK(same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-5.exr")), "restir-di's sixth benchmark frame is not frame 5 of the sequence");
+  CHECK(!same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-4.exr")), "frames 4 and 5 are equal: the test cannot tell them apart");
   fprintf(stderr, "path and restir-di benchmark frames are the frames themselves (fps %.1f)\n", fps);
   return 0;
 }
@@ -112,15 +102,6 @@ static int refusals(void) {
   return 0;
 }
 
-static double now_s(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-static void nap(int ms) {
-  struct timespec d = {ms / 1000, (long)(ms % 1000) * 1000000L};
-  nanosleep(&d, NULL);
-}
 /* Runs an xdotool command line on the display (through the shell); its exit code. */
 static int xdo(const char *display, const char *args) {
   char cmd[1200];
@@ -129,7 +110,7 @@ static int xdo(const char *display, const char *args) {
 }
 /* Waits up to s seconds for text to appear in the file at path. */
 static int wait_for(const char *path, const char *text, double s) {
-  for (double t0 = now_s(); now_s() - t0 < s; nap(100)) {
+  for (double t0 = wall_now(); wall_now() - t0 < s; nap_ms(100)) {
     char *f = read_text_file(path);
     int found = f && strstr(f, text);
     free(f);
@@ -155,18 +136,18 @@ static int camera_positions(const char *log, double first[3], double last[3]) {
  * shown 4x). Sets *v to 0 once it has exited. */
 static int drive(const char *display, const char *log, pid_t *v) {
   CHECK(xdo(display, "search --sync --onlyvisible --name \"valo view\"") == 0, "no viewer window appeared");
-  nap(500);
+  nap_ms(500);
   xdo(display, "search --name \"valo view\" windowfocus --sync");
   CHECK(xdo(display, "key c") == 0 && wait_for(log, "\"camera\"", 20), "C printed no camera");
   CHECK(xdo(display, "search --name \"valo view\" mousemove --window %1 60 120 mousedown 1 sleep 0.1 mousemove --window %1 120 130 sleep 0.1 "
                      "mousemove --window %1 200 140 sleep 0.1 mouseup 1") == 0,
         "xdotool could not drag");
-  nap(1500); /* the moved camera refines */
+  nap_ms(1500); /* the moved camera refines */
   CHECK(xdo(display, "key p") == 0 && wait_for(log, "saved", 30), "P saved nothing");
   CHECK(xdo(display, "key Escape") == 0, "xdotool could not press Esc");
   int status = 0;
   pid_t got = 0;
-  for (double t0 = now_s(); now_s() - t0 < 30 && (got = waitpid(*v, &status, WNOHANG)) == 0;) nap(100);
+  for (double t0 = wall_now(); wall_now() - t0 < 30 && (got = waitpid(*v, &status, WNOHANG)) == 0;) nap_ms(100);
   CHECK(got == *v && WIFEXITED(status) && WEXITSTATUS(status) == 0, "the viewer did not quit with exit 0 after Esc (status %d)", status);
   *v = 0;
   char *text = read_text_file(log);
@@ -205,7 +186,7 @@ static int xvfb_drag_and_save(void) {
   pid_t xs = spawn_exe("Xvfb", xa, scratch_path("xvfb.log"));
   int ok = 0;
   snprintf(cmd, sizeof cmd, "DISPLAY=%s timeout 2 xdotool getmouselocation > /dev/null 2>&1", display);
-  for (double t0 = now_s(); now_s() - t0 < 20 && !ok; nap(100)) ok = system(cmd) == 0;
+  for (double t0 = wall_now(); wall_now() - t0 < 20 && !ok; nap_ms(100)) ok = system(cmd) == 0;
   int rc = 1;
   if (ok) {
     view_env(display);

@@ -1,11 +1,20 @@
-/* args.h — owns the parsed form of `valo render`'s command line (args.c). */
+/* args.h — owns the parsed form of `valo render`'s command line (args.c), what the
+ * other commands parse through it, and the commands' clock. */
 #ifndef VALO_CLI_ARGS_H
 #define VALO_CLI_ARGS_H
 #include "valo/valo.h"
 #include <stddef.h>
 #include <stdio.h>
+#include <time.h>
 
 #define EXIT_USAGE 2
+
+/* Seconds on a monotonic clock (the commands' timing). */
+static inline double cli_now(void) {
+  struct timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
 #define CLI_MAX_OUTPUTS 16
 
 typedef struct cli_args {

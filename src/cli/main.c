@@ -100,11 +100,6 @@ static int on_progress(void *user, double frac, int spp_done, double seconds) {
   return g_interrupted;
 }
 
-static double now_seconds(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Warnings of ranks above 0 are dropped: rank 0 prints the same ones. */
 static void quiet_warning(void *user, const char *message) { (void)user; (void)message; }
@@ -112,7 +107,7 @@ static void quiet_warning(void *user, const char *message) { (void)user; (void)m
 /* Everything before the render runs: the output folders, the scene, the render, the
  * resume. 0, or an exit code with the message in err (printed here on rank 0). */
 static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_scene **sc, valo_render **r, double *load_s, valo_error *err) {
-  double t0 = now_seconds();
+  double t0 = cli_now();
   int rank = valo_mpi_rank();
   /* Every output's folder must exist and be writable before hours of rendering (rank 0
    * alone writes). */
@@ -131,7 +126,7 @@ static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_s
     }
   }
   if (valo_scene_load_with(ca->scene_path, &ca->lo, sc, err)) return 1;
-  *load_s = now_seconds() - t0;
+  *load_s = cli_now() - t0;
   valo_options file_opts;
   valo_scene_file_options(*sc, &file_opts);
   /* --time alone: the scene file's spp (if any) still bounds the render, whichever comes

@@ -105,15 +105,10 @@ typedef struct viewer {
   SDL_Texture *tex;
 } viewer;
 
-static double now_s(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static void say(viewer *v, const char *m) {
   snprintf(v->msg, sizeof v->msg, "%s", m);
-  v->msg_until = now_s() + 3;
+  v->msg_until = cli_now() + 3;
   fprintf(stderr, "valo: %s\n", m);
 }
 
@@ -308,11 +303,11 @@ static void *render_thread(void *arg) {
     pthread_mutex_unlock(&w->mu);
     valo_error err;
     valo_status st = VALO_OK;
-    double t0 = now_s();
+    double t0 = cli_now();
     int refused = w->set_cam && valo_render_set_camera(v->r, &w->cam, &err);
     if (refused) st = err.status;
     if (!st) st = valo_render_step(v->r, w->n, w->restart, &err);
-    double dt = now_s() - t0;
+    double dt = cli_now() - t0;
     if (!st) st = valo_render_layer(v->r, layer_names[w->layer], w->back, &err);
     valo_stats vs;
     valo_render_stats(v->r, &vs);
@@ -410,7 +405,7 @@ static void show(viewer *v) {
   snprintf(l2, sizeof l2, "%s  exposure %+.1f", v->shown_layer ? layer_names[v->shown_layer] : "image", (double)v->oo.exposure);
   const char *lines[3] = {l1, l2, v->msg};
   int fs = v->w * v->scale >= 480 ? 2 : 1;
-  if (v->overlay) view_draw_panel(v->ren, 4, 4, fs, lines, now_s() < v->msg_until ? 3 : 2);
+  if (v->overlay) view_draw_panel(v->ren, 4, 4, fs, lines, cli_now() < v->msg_until ? 3 : 2);
   SDL_RenderPresent(v->ren);
   char title[200];
   snprintf(title, sizeof title, "valo view: %s", l1);
@@ -502,7 +497,7 @@ int cmd_view(int argc, char **argv) {
     started = !(v.wk.back = malloc((size_t)v.w * v.h * 3 * sizeof *v.px)) ? 0 : !pthread_create(&th, NULL, render_thread, &v);
     if (!started) { fprintf(stderr, "valo: error: cannot start the render thread\n"); rc = 1; }
   }
-  double t0 = now_s();
+  double t0 = cli_now();
   long frames = 0;
   int running = !rc && post_step(&v, bench > 0);
   while (!rc && !v.quit) {
@@ -540,7 +535,7 @@ int cmd_view(int argc, char **argv) {
     pthread_join(th, NULL);
   }
   if (!rc && bench) {
-    double el = now_s() - t0;
+    double el = cli_now() - t0;
     if (out && valo_render_write(v.r, out, &v.oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
     if (!rc) printf("fps %.2f\n", (double)bench / el);
   }

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/strutil.h"
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -58,9 +59,12 @@ static valo_status layer_check(const session *ss, int k, const char *name, valo_
 valo_status output_layer(const session *ss, const char *layer, float *px, valo_error *err) {
   int k = -1;
   if (*layer) {
-    for (k = 0; k < AOV_KIND_COUNT; k++)
-      if (!strncmp(layer, aov_prefixes[k], strlen(layer)) && aov_prefixes[k][strlen(layer)] == ':') break;
-    if (k == AOV_KIND_COUNT) return err_set(err, VALO_ERR_INVALID, "unknown layer \"%s\" (albedo, normal, depth, ao, bent, spp)", layer);
+    /* a layer is an output prefix without its colon */
+    char prefix[32];
+    size_t plen = 0;
+    snprintf(prefix, sizeof prefix, "%s:", layer);
+    k = aov_kind_of(prefix, &plen);
+    if (k < 0 || plen != strlen(prefix)) return err_set(err, VALO_ERR_INVALID, "unknown layer \"%s\" (albedo, normal, depth, ao, bent, spp)", layer);
   }
   valo_status st = layer_check(ss, k, layer, err);
   if (st) return st;
