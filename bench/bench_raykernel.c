@@ -232,7 +232,7 @@ int main(int argc, char **argv) {
     if (load(s, res[i], NULL) == 0 && scene_commit(s, &err) == 0) {
       accel *a;
       double t0 = bench_now();
-      if (kdtree_create(s->pos, s->idx, s->ntris, NULL, &a, &err) == 0) {
+      if (kdtree_create(s->pos, s->idx, s->ntris, 2, NULL, &a, &err) == 0) {
         double dt = bench_now() - t0;
         kd_stats st;
         kdtree_stats(a, &st);

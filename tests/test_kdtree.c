@@ -12,6 +12,7 @@
 #include "scene/scene.h"
 #include "geometry/accel.h"
 #include "geometry/triangle.h"
+#include "geometry/kdtree_internal.h"
 #include "geometry/offset.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -444,11 +445,107 @@ static int large_triangles_corner(void) {
   return 0;
 }
 
+
+/* A mesh of 9 546 triangles (a tessellated sphere, a soup of small random
+ * triangles, a large floor and triangles lying in axis planes), so the build's binned
+ * top levels, its parallel subtrees and the join all run without ../shared: the tree
+ * must be byte-identical for 1, 2 and 3 build threads (nodes, groups, ids, alpha lanes),
+ * and its closest hits and shadow queries equal brute force on 20 000 rays. */
+static int filter_odd(const void *user, uint32_t tri, float b1, float b2) { (void)user; return tri % 3 != 0 || b1 < 0.5f + 0.3f * b2; }
+static int synthetic_threads(void) {
+  enum { SU = 48, SV = 64, SOUP = 3000, PLANAR = 400 };
+  uint32_t nt = 2 * SU * SV + SOUP + 2 + PLANAR, nv = (SU + 1) * (SV + 1) + 3 * SOUP + 4 + 3 * PLANAR;
+  vec3 *pos = malloc(nv * sizeof *pos);
+  uint32_t *idx = malloc(3 * (size_t)nt * sizeof *idx), v = 0, t = 0;
+  uint8_t *flags = malloc(nt);
+  for (int i = 0; i <= SU; i++)
+    for (int j = 0; j <= SV; j++) {
+      float th = PI_F * i / SU, ph = 2 * PI_F * j / SV;
+      pos[v++] = v3(0.8f * sinf(th) * cosf(ph), 1 + 0.8f * cosf(th), 0.8f * sinf(th) * sinf(ph));
+    }
+  for (int i = 0; i < SU; i++)
+    for (int j = 0; j < SV; j++) {
+      uint32_t a = i * (SV + 1) + j, b = a + 1, c = a + SV + 1, d = c + 1;
+      idx[3 * t] = a; idx[3 * t + 1] = c; idx[3 * t + 2] = b; t++;
+      idx[3 * t] = b; idx[3 * t + 1] = c; idx[3 * t + 2] = d; t++;
+    }
+  sampler sm = sampler_make(9, 0, 0);
+  for (int i = 0; i < SOUP; i++) {
+    vec3 c = v3(4 * sampler_1d(&sm) - 2, 3 * sampler_1d(&sm), 4 * sampler_1d(&sm) - 2);
+    for (int k = 0; k < 3; k++) {
+      idx[3 * t + k] = v;
+      pos[v++] = v3_add(c, v3(0.2f * sampler_1d(&sm) - 0.1f, 0.2f * sampler_1d(&sm) - 0.1f, 0.2f * sampler_1d(&sm) - 0.1f));
+    }
+    t++;
+  }
+  pos[v] = v3(-5, 0, -5); pos[v + 1] = v3(5, 0, -5); pos[v + 2] = v3(5, 0, 5); pos[v + 3] = v3(-5, 0, 5);
+  idx[3 * t] = v; idx[3 * t + 1] = v + 2; idx[3 * t + 2] = v + 1; t++;
+  idx[3 * t] = v; idx[3 * t + 1] = v + 3; idx[3 * t + 2] = v + 2; t++;
+  v += 4;
+  for (int i = 0; i < PLANAR; i++) { /* in the planes z = -1.5 .. 1.5, a tenth apart */
+    float z = -1.5f + 0.1f * (i % 31), x = 3 * sampler_1d(&sm) - 1.5f, y = 2.5f * sampler_1d(&sm);
+    for (int k = 0; k < 3; k++) { idx[3 * t + k] = v; pos[v++] = v3(x + 0.15f * (k == 1), y + 0.15f * (k == 2), z); }
+    t++;
+  }
+  for (uint32_t i = 0; i < nt; i++) flags[i] = (i % 2) ? 4 : 0;
+  accel_filter f = {filter_odd, NULL, flags, 4};
+  accel *a[3];
+  valo_error err;
+  for (int k = 0; k < 3; k++) CHECK(kdtree_create(pos, idx, nt, k + 1, &f, &a[k], &err) == VALO_OK, "%s", err.message);
+  const kdtree *k0 = (const kdtree *)a[0];
+  for (int k = 1; k < 3; k++) {
+    const kdtree *kk = (const kdtree *)a[k];
+    CHECK(kk->nnodes == k0->nnodes && kk->nprims == k0->nprims, "%d threads: %u nodes, %llu groups; 1 thread: %u, %llu", k + 1,
+          kk->nnodes, (unsigned long long)kk->nprims, k0->nnodes, (unsigned long long)k0->nprims);
+    CHECK(!memcmp(kk->nodes, k0->nodes, k0->nnodes * sizeof *k0->nodes), "%d threads: nodes differ", k + 1);
+    CHECK(!memcmp(kk->prims, k0->prims, k0->nprims * sizeof *k0->prims), "%d threads: triangle groups differ", k + 1);
+    CHECK(!memcmp(kk->ids, k0->ids, 4 * k0->nprims * sizeof *k0->ids), "%d threads: ids differ", k + 1);
+    CHECK(!memcmp(kk->gfilt, k0->gfilt, k0->nprims), "%d threads: alpha lanes differ", k + 1);
+  }
+  kd_stats st;
+  kdtree_stats(a[0], &st);
+  g_filter = &f;
+  int bad = 0, hits = 0, occluded = 0;
+  for (int i = 0; i < 20000; i++) {
+    vec3 o = v3(6 * sampler_1d(&sm) - 3, 3.5f * sampler_1d(&sm) - 0.2f, 6 * sampler_1d(&sm) - 3);
+    vec3 d = sample_uniform_sphere(sampler_1d(&sm), sampler_1d(&sm));
+    if (i % 4 == 0) d = v3(0, 0, d.z < 0 ? -1.0f : 1.0f); /* along z: through the axis-plane triangles */
+    ray r = {o, d, i % 3 ? INFINITY : 2.0f};
+    ray_shear sh = ray_shear_make(r.o, r.d);
+    hit bh = {0, 0, 0, 0}, h;
+    int bf = 0, bo = 0;
+    for (uint32_t q = 0; q < nt; q++) {
+      float tv[9], tt, b1, b2;
+      for (int k = 0; k < 3; k++) memcpy(&tv[3 * k], &pos[idx[3 * q + k]], sizeof(vec3));
+      if (!tri_intersect(&sh, tv, r.tmax, &tt, &b1, &b2) || !filter_passes(q, b1, b2)) continue;
+      bo |= tt < 1.5f;
+      if (!bf || tt < bh.t) { bh.t = tt; bh.tri = q; bf = 1; }
+    }
+    ray sr = r;
+    sr.tmax = 1.5f;
+    int kf = accel_intersect(a[0], &r, &h), ko = accel_occluded(a[0], &sr);
+    hits += bf;
+    occluded += bo;
+    if (kf != bf || (kf && h.t != bh.t) || ko != bo) {
+      if (bad++ < 5) fprintf(stderr, "ray %d: kd found %d t %.9g occluded %d; brute %d t %.9g occluded %d\n", i, kf, kf ? h.t : 0, ko, bf, bh.t, bo);
+    }
+  }
+  g_filter = NULL;
+  fprintf(stderr, "%u triangles: %u node slots, %.2f refs per triangle; %d of 20000 rays hit, %d occluded, %d wrong\n", nt, st.nodes,
+          (double)st.refs / nt, hits, occluded, bad);
+  for (int k = 0; k < 3; k++) accel_destroy(a[k]);
+  free(pos); free(idx); free(flags);
+  CHECK(hits > 5000 && hits < 19000, "%d hits: the rays do not test the tree", hits);
+  CHECK(bad == 0, "%d rays differ from brute force", bad);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"bunny_kdtree", bunny_kdtree}, {"cornell_kdtree", cornell_kdtree},
                                     {"cornell_sphere_kdtree", cornell_sphere_kdtree}, {"suzanne_kdtree", suzanne_kdtree},
                                     {"axis_rays_kdtree", axis_rays_kdtree}, {"camera_rays_kdtree", camera_rays_kdtree},
                                     {"bunny_embree", bunny_embree}, {"cornell_embree", cornell_embree},
-                                    {"large_triangles_corner", large_triangles_corner}, {"alpha_filtered", alpha_filtered}, {NULL, NULL}};
+                                    {"large_triangles_corner", large_triangles_corner}, {"alpha_filtered", alpha_filtered},
+                                    {"synthetic_threads", synthetic_threads}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

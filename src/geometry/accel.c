@@ -5,8 +5,7 @@
 
 valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
                          const accel_filter *filter, accel **out, valo_error *err) {
-  (void)threads;
-  if (!kind || !*kind || !strcmp(kind, "kdtree")) return kdtree_create(pos, idx, ntris, filter, out, err);
+  if (!kind || !*kind || !strcmp(kind, "kdtree")) return kdtree_create(pos, idx, ntris, threads, filter, out, err);
   if (!strcmp(kind, "embree")) return embree_create(pos, idx, ntris, filter, out, err);
   *out = NULL;
   return err_set(err, VALO_ERR_INVALID, "unknown accelerator \"%s\" (kdtree, embree)", kind);

@@ -41,7 +41,7 @@ static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return
 static inline int accel_occluded(const accel *a, const ray *r) { return a->ops->occluded(a, r); }
 static inline void accel_destroy(accel *a) { if (a) a->ops->destroy(a); }
 
-valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads, const accel_filter *filter, accel **out,
                           valo_error *err);
 valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
                           valo_error *err);

@@ -26,14 +26,34 @@ typedef struct kd_builder {
   int oom;
 } kd_builder;
 
-static int ev_cmp(const void *pa, const void *pb) {
-  const kd_event *a = pa, *b = pb;
-  if (a->pos < b->pos) return -1;
-  if (a->pos > b->pos) return 1;
-  return (int)(a->v & 3) - (int)(b->v & 3);
-}
 static inline int ev_less(const kd_event *a, const kd_event *b) {
   return a->pos < b->pos || (a->pos == b->pos && (a->v & 3) < (b->v & 3));
+}
+
+/* Sorts events by ev_less, stably (equal events keep their order): insertion sort for
+ * short runs, then bottom-up merging through tmp (n entries). */
+static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
+  const uint32_t run = 16;
+  for (uint32_t lo = 0; lo < n; lo += run) {
+    uint32_t hi = lo + run < n ? lo + run : n;
+    for (uint32_t i = lo + 1; i < hi; i++) {
+      kd_event x = e[i];
+      uint32_t j = i;
+      while (j > lo && ev_less(&x, &e[j - 1])) { e[j] = e[j - 1]; j--; }
+      e[j] = x;
+    }
+  }
+  kd_event *src = e, *dst = tmp;
+  for (uint32_t w = run; w < n; w *= 2) {
+    for (uint32_t lo = 0; lo < n; lo += 2 * w) {
+      uint32_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n, i = lo, j = mid, m = lo;
+      while (i < mid && j < hi) dst[m++] = ev_less(&src[j], &src[i]) ? src[j++] : src[i++];
+      while (i < mid) dst[m++] = src[i++];
+      while (j < hi) dst[m++] = src[j++];
+    }
+    kd_event *x = src; src = dst; dst = x;
+  }
+  if (src != e) memcpy(e, src, (size_t)n * sizeof *e);
 }
 
 static void evlist_free(evlist *l) { for (int k = 0; k < 3; k++) { free(l->e[k]); l->e[k] = NULL; } }
@@ -104,7 +124,7 @@ static float round_out(double x, int exact, int up) {
 /* Clips triangle v to box and returns conservative bounds of the clipped polygon (0 if
  * empty). Clipping runs in double; a polygon vertex's coordinate is exact when it is an
  * input vertex's, the clipping plane's, or shared by both ends of the clipped edge. */
-static int clip_bounds(const float *v, bbox box, bbox *out) {
+int kd_clip_bounds(const float *v, bbox box, bbox *out) {
   double poly[2][12][3];
   uint8_t exact[2][12];
   int n = 3, cur = 0;
@@ -116,6 +136,9 @@ static int clip_bounds(const float *v, bbox box, bbox *out) {
     for (int sidei = 0; sidei < 2 && n > 0; sidei++) {
       double plane = sidei == 0 ? v3_get(box.lo, axis) : v3_get(box.hi, axis);
       double sgn = sidei == 0 ? 1.0 : -1.0; /* inside: sgn*(x - plane) >= 0 */
+      int inside = 1; /* the polygon wholly inside this plane (most are): nothing to clip */
+      for (int i = 0; i < n && inside; i++) inside = sgn * (poly[cur][i][axis] - plane) >= 0;
+      if (inside) continue;
       int m = 0, nxt = 1 - cur;
       for (int i = 0; i < n; i++) {
         int ic = (i + 1) % n;
@@ -271,17 +294,20 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
       uint32_t t = b->straddle[i];
       const float *v = &kd->tv[9 * (size_t)t];
       bbox cb;
-      if (clip_bounds(v, lbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cb, j); lcount++; }
-      if (clip_bounds(v, rbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cb, j); rcount++; }
+      if (kd_clip_bounds(v, lbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cb, j); lcount++; }
+      if (kd_clip_bounds(v, rbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cb, j); rcount++; }
     }
-    for (int j = 0; j < 3; j++) {
-      qsort(nl_ev[j], nnl[j], sizeof(kd_event), ev_cmp);
-      qsort(nr_ev[j], nnr[j], sizeof(kd_event), ev_cmp);
+    kd_event *tmp = malloc(((size_t)nboth * 2 + 1) * sizeof *tmp);
+    if (!tmp) fail = 1;
+    for (int j = 0; j < 3 && tmp; j++) {
+      ev_sort(nl_ev[j], nnl[j], tmp);
+      ev_sort(nr_ev[j], nnr[j], tmp);
       L.e[j] = merge(L.e[j], L.n[j], nl_ev[j], nnl[j], &L.n[j]);
       R.e[j] = merge(R.e[j], R.n[j], nr_ev[j], nnr[j], &R.n[j]);
       nl_ev[j] = nr_ev[j] = NULL;
       if (!L.e[j] || !R.e[j]) fail = 1;
     }
+    free(tmp);
   }
   for (int j = 0; j < 3; j++) { free(nl_ev[j]); free(nr_ev[j]); }
   if (fail) { b->oom = 1; evlist_free(&L); evlist_free(&R); kd->nodes[node].flags = KD_LEAF; kd->nodes[node].prim_offset = 0; return; }
@@ -384,67 +410,40 @@ void kdtree_stats(const accel *a, kd_stats *st) {
   st->bytes = kd->nnodes * sizeof(kd_node) + kd->nprims * (sizeof(kd_tri4) + 4 * sizeof(uint32_t) + 1);
 }
 
-valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
-                          valo_error *err) {
-  *out = NULL;
-  if (ntris >= (1u << 30)) return err_set(err, VALO_ERR_INVALID, "kd-tree: too many triangles (%u)", ntris);
-  kdtree *kd = calloc(1, sizeof *kd);
-  if (!kd) return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory");
-  kd->base.ops = &kdtree_ops;
-  kd->ntris = ntris;
-  if (filter && filter->pass && filter->tri_flags) { kd->filter = *filter; kd->has_filter = 1; }
-  kd->bounds = bbox_empty();
-  kd_builder b = {kd, NULL, NULL, 0};
-  evlist l = {{0}, {0}, ntris};
-  kd->tv = malloc(((size_t)ntris * 9 + 1) * sizeof(float));
-  b.side = malloc((size_t)ntris + 1);
-  b.straddle = malloc(((size_t)ntris + 1) * sizeof(uint32_t));
-  for (int k = 0; k < 3; k++) l.e[k] = malloc(((size_t)ntris * 2 + 1) * sizeof(kd_event));
-  if (!kd->tv || !b.side || !b.straddle || !l.e[0] || !l.e[1] || !l.e[2]) goto oom;
-  for (uint32_t t = 0; t < ntris; t++) {
-    bbox tb = bbox_empty();
-    for (int v = 0; v < 3; v++) {
-      vec3 p = pos[idx[3 * (size_t)t + v]];
-      memcpy(&kd->tv[9 * (size_t)t + 3 * v], &p, sizeof p);
-      tb = bbox_add(tb, p);
+/* Builds a subtree by the exact sweep from references (their clipped bounds give its
+ * events) into part, whose tv, filter and has_filter are set and whose arrays start
+ * empty. side: a byte per triangle of the whole mesh; straddle: n entries. Returns 0,
+ * or -1 when out of memory. */
+int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth, int bad) {
+  kd_builder b = {part, side, straddle, 0};
+  evlist l = {{0}, {0}, n};
+  kd_event *tmp = malloc(((size_t)n * 2 + 1) * sizeof *tmp);
+  if (!tmp) return -1;
+  for (int k = 0; k < 3; k++) {
+    l.e[k] = malloc(((size_t)n * 2 + 1) * sizeof(kd_event));
+    if (!l.e[k]) { evlist_free(&l); free(tmp); return -1; }
+    for (uint32_t i = 0; i < n; i++) {
+      bbox rb = {v3(refs[i].lo[0], refs[i].lo[1], refs[i].lo[2]), v3(refs[i].hi[0], refs[i].hi[1], refs[i].hi[2])};
+      add_events(l.e[k], &l.n[k], refs[i].tri, rb, k);
     }
-    kd->bounds = bbox_union(kd->bounds, tb);
-    for (int k = 0; k < 3; k++) add_events(l.e[k], &l.n[k], t, tb, k);
+    ev_sort(l.e[k], l.n[k], tmp);
   }
-  for (int k = 0; k < 3; k++) qsort(l.e[k], l.n[k], sizeof(kd_event), ev_cmp);
-  /* The depth limit ends these trees rather than the SAH (other SAH costs gave the same
-   * trees), and each level of it multiplies the duplicated references (2.5 per triangle
-   * on the bunny at pbrt's 1.3 log2 N, 3.7 at 1.5). Triangle data is where incoherent
-   * rays miss the cache, so 1.2 log2 N: 25 % less memory and 4-10 % faster on bounce
-   * rays than 1.3 (A/B in one process; docs/performance.md). */
-  int max_depth = (int)lroundf(8 + 1.2f * log2f((float)(ntris > 1 ? ntris : 1)));
-  if (max_depth > 60) max_depth = 60;
-  /* A tiny mesh is one leaf: testing its triangles four at a time beats any traversal
-   * (the SAH prices a triangle test at 80 traversal steps, not a quarter of an SSE group
-   * test). CornellBox-Original (36 triangles): 12 % faster renders (docs/performance.md). */
-  if (ntris <= KD_FLAT_MAX) max_depth = 0;
-  if (ntris == 0) { evlist_free(&l); }
-  else {
-    uint32_t root = push_node(&b);
-    if (root == UINT32_MAX) goto oom;
-    build(&b, root, kd->bounds, &l, max_depth, 0);
-  }
-  free(b.side); free(b.straddle);
-  free(kd->tv);
-  kd->tv = NULL;
-  if (!b.oom && kd->nnodes) {
-    count_tree(kd, &kd->st);
-    kd_boxer w = {kd->nodes, NULL, 0, 0, 0};
-    boxer_copy(&w, 0);
-    if (w.oom) { free(w.dst); b.oom = 1; }
-    else { free(kd->nodes); kd->nodes = w.dst; kd->nnodes = w.n; kd->cap_nodes = w.cap; }
-  }
-  if (b.oom) { kdtree_free(kd); return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory while building"); }
-  *out = &kd->base;
-  return VALO_OK;
-oom:
-  evlist_free(&l);
-  free(b.side); free(b.straddle);
-  kdtree_free(kd);
-  return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory");
+  free(tmp);
+  uint32_t root = push_node(&b);
+  if (root == UINT32_MAX) { evlist_free(&l); return -1; }
+  build(&b, root, box, &l, depth, bad);
+  return b.oom ? -1 : 0;
+}
+
+/* Statistics of the tree as built, then each chain of empty cuts becomes a box node.
+ * Returns 0, or -1 when out of memory. */
+int kd_box_nodes(kdtree *kd) {
+  if (!kd->nnodes) return 0;
+  count_tree(kd, &kd->st);
+  kd_boxer w = {kd->nodes, NULL, 0, 0, 0};
+  boxer_copy(&w, 0);
+  if (w.oom) { free(w.dst); return -1; }
+  free(kd->nodes);
+  kd->nodes = w.dst; kd->nnodes = w.n; kd->cap_nodes = w.cap;
+  return 0;
 }

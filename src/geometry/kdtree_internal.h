@@ -63,6 +63,14 @@ typedef struct kdtree {
 #define KD_BOX (KD_BELOW_EMPTY | KD_ABOVE_EMPTY)
 #define KD_BOX_SLOTS 4u
 
+/* A triangle reference during the build: its bounds clipped to the node's box. */
+typedef struct kd_ref { float lo[3], hi[3]; uint32_t tri; } kd_ref;
+
+/* The exact sweep (kdtree_build.c), used by the whole build (kdtree_top.c). */
+int kd_clip_bounds(const float *v, bbox box, bbox *out);
+int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth, int bad);
+int kd_box_nodes(kdtree *kd);
+
 /* The kd-tree's accelerator operations (kdtree_traverse.c). */
 extern const accel_ops kdtree_ops;
 void kdtree_free(kdtree *kd);
