@@ -30,10 +30,51 @@ static inline int ev_less(const kd_event *a, const kd_event *b) {
   return a->pos < b->pos || (a->pos == b->pos && (a->v & 3) < (b->v & 3));
 }
 
-/* Sorts events by ev_less, stably (equal events keep their order): insertion sort for
- * short runs, then bottom-up merging through tmp (n entries). */
+/* Sorts events by ev_less, stably (equal events keep their order): radix for long
+ * lists; else insertion sort for short runs, then bottom-up merging through tmp (n
+ * entries). */
+/* The sort key of a position: its bits made to order as unsigned integers (-0 as +0,
+ * since the sweep groups events by ==). */
+static inline uint32_t ev_key(float pos) {
+  float p = pos + 0.0f;
+  uint32_t u;
+  memcpy(&u, &p, sizeof u);
+  return u ^ ((uint32_t)((int32_t)u >> 31) | 0x80000000u);
+}
+
+/* Long lists: a stable LSD radix sort, by type and then by the key's four bytes (a pass
+ * whose byte is the same for every event is skipped). */
+static void ev_radix(kd_event *e, uint32_t n, kd_event *tmp) {
+  uint32_t hist[5][256];
+  memset(hist, 0, sizeof hist);
+  for (uint32_t i = 0; i < n; i++) {
+    uint32_t k = ev_key(e[i].pos);
+    hist[0][e[i].v & 3]++;
+    for (int b = 0; b < 4; b++) hist[1 + b][(k >> (8 * b)) & 255]++;
+  }
+  kd_event *src = e, *dst = tmp;
+  for (int pass = 0; pass < 5; pass++) {
+    uint32_t *h = hist[pass], sum = 0;
+    int skip = 0;
+    for (int d = 0; d < 256; d++) {
+      if (h[d] == n) skip = 1;
+      uint32_t c = h[d];
+      h[d] = sum;
+      sum += c;
+    }
+    if (skip) continue;
+    for (uint32_t i = 0; i < n; i++) {
+      uint32_t d = pass == 0 ? src[i].v & 3 : (ev_key(src[i].pos) >> (8 * (pass - 1))) & 255;
+      dst[h[d]++] = src[i];
+    }
+    kd_event *x = src; src = dst; dst = x;
+  }
+  if (src != e) memcpy(e, src, (size_t)n * sizeof *e);
+}
+
 static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
   const uint32_t run = 16;
+  if (n >= 256) { ev_radix(e, n, tmp); return; }
   for (uint32_t lo = 0; lo < n; lo += run) {
     uint32_t hi = lo + run < n ? lo + run : n;
     for (uint32_t i = lo + 1; i < hi; i++) {
@@ -219,16 +260,17 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
     float lo = v3_get(box.lo, k), hi = v3_get(box.hi, k);
     while (i < n) {
       float p = e[i].pos;
-      uint32_t pe = 0, pp = 0, ps = 0;
-      while (i < n && e[i].pos == p && (e[i].v & 3) == EV_END) { pe++; i++; }
-      while (i < n && e[i].pos == p && (e[i].v & 3) == EV_PLANAR) { pp++; i++; }
-      while (i < n && e[i].pos == p && (e[i].v & 3) == EV_START) { ps++; i++; }
+      /* The events at p, counted by type without a branch per type (most positions
+       * hold one event). */
+      uint32_t cnt[3] = {0, 0, 0};
+      do { cnt[e[i].v & 3]++; i++; } while (i < n && e[i].pos == p);
+      uint32_t pe = cnt[EV_END], pp = cnt[EV_PLANAR], ps = cnt[EV_START];
       np = pp;
       nr -= pp + pe;
       if (p > lo && p < hi) {
         float pl = 2.0f * (a_perp + (p - lo) * a_side) * inv_total;
         float pr = 2.0f * (a_perp + (hi - p) * a_side) * inv_total;
-        for (int planar_left = 0; planar_left < 2; planar_left++) {
+        for (int planar_left = 0; planar_left < 1 + (np > 0); planar_left++) {
           uint32_t cl = nl + (planar_left ? np : 0), cr = nr + (planar_left ? 0 : np);
           float eb = (cl == 0 || cr == 0) ? KD_EMPTY_BONUS : 0.0f;
           float cost = KD_TRAVERSE_COST + KD_ISECT_COST * (1.0f - eb) * (pl * (float)cl + pr * (float)cr);
