@@ -1,6 +1,7 @@
 /* accel.h — owns the one ray-query interface (ARCHITECTURE "Acceleration"): a small ops
- * table {intersect, occluded, destroy} implemented by the SAH kd-tree (kdtree_build.c, kdtree_traverse.c) and by
- * Embree 3 (embree.c), chosen by name when a render is created. Rays have no tmin: origins
+ * table {intersect, occluded, destroy} implemented by the SAH kd-tree (kdtree_top.c,
+ * kdtree_build.c, kdtree_traverse.c) and by Embree 3 (embree.c), chosen by name when a
+ * render is created. Rays have no tmin: origins
  * are offset robustly instead (offset.h), and hits need t > 0. */
 #ifndef VALO_ACCEL_H
 #define VALO_ACCEL_H
@@ -33,8 +34,9 @@ typedef struct accel_filter {
 } accel_filter;
 
 /* kind: "kdtree" or "embree". Triangles are given as indexed vertices; the structure
- * keeps its own copy. threads: used by builders that can use them. filter: NULL or
- * one that outlives the structure. */
+ * keeps its own copy. threads: used by builders that can use them (the kd-tree's build
+ * gives the same tree for any count; <= 0: all). filter: NULL or one that outlives the
+ * structure. */
 valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
                          const accel_filter *filter, accel **out, valo_error *err);
 static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return a->ops->intersect(a, r, h); }

@@ -1,11 +1,12 @@
-/* kdtree_build.c — owns building the SAH kd-tree (layout: kdtree_internal.h): an O(N log N) build after Wald & Havran, "On building
- * fast kd-trees for ray tracing, and on doing that in O(N log N)" (2006) — per-axis event
- * lists sorted once, a linear sweep per node, order-preserving list splitting and exact
- * clipping of straddling triangles to the child voxels — and pbrt's compact 8-byte nodes
- * with a stack-based front-to-back traversal and early exit. Leaf triangles are stored
- * in leaf order in SSE groups of four and tested four at a time (1.3-1.5x faster than
- * one by one; docs/performance.md). SAH constants from digest 000: traversal cost 1,
- * intersection cost 80, empty bonus 0.5; max depth 8 + 1.2 log2 N (pbrt: 1.3). */
+/* kdtree_build.c — owns the exact SAH sweep that builds the kd-tree's subtrees below the
+ * binned top levels (kdtree_top.c; layout: kdtree_internal.h): Wald & Havran, "On
+ * building fast kd-trees for ray tracing, and on doing that in O(N log N)" (2006) —
+ * per-axis event lists sorted once per subtree, a linear sweep per node, order-preserving
+ * list splitting and exact clipping of straddling triangles to the child voxels — and
+ * the leaves: triangles in leaf order in SSE groups of four, tested four at a time
+ * (1.3-1.5x faster than one by one; docs/performance.md). Also the clipping both build
+ * phases use, and the box nodes made once the tree is joined. SAH constants from digest
+ * 000: traversal cost 1, intersection cost 80, empty bonus 0.5. */
 #include "geometry/kdtree_internal.h"
 #include "core/error.h"
 #include <math.h>

@@ -1,6 +1,6 @@
-/* kdtree_internal.h — owns the kd-tree's layout, shared by its build (kdtree_build.c)
- * and its traversal (kdtree_traverse.c): the 8-byte nodes, box nodes, the leaf triangle
- * groups and the tree object. */
+/* kdtree_internal.h — owns the kd-tree's layout, shared by its build (kdtree_top.c,
+ * kdtree_build.c) and its traversal (kdtree_traverse.c): the 8-byte nodes, box nodes,
+ * the leaf triangle groups, the tree object and the build's triangle references. */
 #ifndef VALO_KDTREE_INTERNAL_H
 #define VALO_KDTREE_INTERNAL_H
 #include "geometry/accel.h"
