@@ -100,16 +100,21 @@ static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
 
 static void evlist_free(evlist *l) { for (int k = 0; k < 3; k++) { free(l->e[k]); l->e[k] = NULL; } }
 
-static uint32_t push_node(kd_builder *b) {
-  kdtree *kd = b->kd;
-  if (kd->nnodes >= KD_MAX_NODES) { b->oom = 1; return UINT32_MAX; }
-  if (kd->nnodes == kd->cap_nodes) {
-    uint32_t nc = kd->cap_nodes ? kd->cap_nodes * 2 : 1024;
-    kd_node *n = realloc(kd->nodes, (size_t)nc * sizeof *n);
-    if (!n) { b->oom = 1; return UINT32_MAX; }
-    kd->nodes = n; kd->cap_nodes = nc;
+uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap) {
+  if (*n >= KD_MAX_NODES) return UINT32_MAX;
+  if (*n == *cap) {
+    uint32_t nc = *cap ? *cap * 2 : 256;
+    kd_node *g = realloc(*nodes, (size_t)nc * sizeof *g);
+    if (!g) return UINT32_MAX;
+    *nodes = g; *cap = nc;
   }
-  return kd->nnodes++;
+  return (*n)++;
+}
+
+static uint32_t push_node(kd_builder *b) {
+  uint32_t i = kd_node_push(&b->kd->nodes, &b->kd->nnodes, &b->kd->cap_nodes);
+  if (i == UINT32_MAX) b->oom = 1;
+  return i;
 }
 
 static void make_leaf(kd_builder *b, uint32_t node, const evlist *l) {

@@ -68,6 +68,8 @@ typedef struct kd_ref { float lo[3], hi[3]; uint32_t tri; } kd_ref;
 
 /* The exact sweep (kdtree_build.c), used by the whole build (kdtree_top.c). */
 int kd_clip_bounds(const float *v, bbox box, bbox *out);
+/* Appends a node to a growing array; UINT32_MAX when out of memory or nodes. */
+uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap);
 int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth, int bad);
 int kd_box_nodes(kdtree *kd);
 

@@ -32,14 +32,9 @@ typedef struct kd_top {
 } kd_top;
 
 static uint32_t top_push(kd_top *t) {
-  if (t->nnodes >= KD_MAX_NODES) { t->oom = 1; return UINT32_MAX; }
-  if (t->nnodes == t->cap_nodes) {
-    uint32_t nc = t->cap_nodes ? t->cap_nodes * 2 : 256;
-    kd_node *n = realloc(t->nodes, (size_t)nc * sizeof *n);
-    if (!n) { t->oom = 1; return UINT32_MAX; }
-    t->nodes = n; t->cap_nodes = nc;
-  }
-  return t->nnodes++;
+  uint32_t i = kd_node_push(&t->nodes, &t->nnodes, &t->cap_nodes);
+  if (i == UINT32_MAX) t->oom = 1;
+  return i;
 }
 
 /* Leaves the node to the exact sweep; takes ownership of refs. */
