@@ -1,9 +1,10 @@
 /* bench_raykernel.c — valo's SAH kd-tree against Embree 3 on the same incoherent rays
  * (camera rays plus one cosine-weighted bounce from each camera hit), 1 and 2 threads:
  * build seconds, Mrays/s for closest-hit and for shadow (any-hit) queries, and the
- * kd/Embree ratio. Then the kd-tree build on the dragon's four resolutions (N log N
- * growth, 2 threads) with the tree's bytes and the build's peak resident bytes per triangle. Prints a Markdown table; scenes come from
- * ../shared/scenes (or VALO_SHARED). --classes instead times camera misses, camera hits
+ * kd/Embree ratio, on the bunny, nefertiti, the dragon, Sponza and a Cornell box with the
+ * bunny. Then the kd-tree build on the dragon's four resolutions (N log N growth, 2
+ * threads) with the tree's bytes and the build's peak resident bytes per triangle.
+ * Prints Markdown tables; scenes come from ../shared/scenes (or VALO_SHARED). --classes instead times camera misses, camera hits
  * and bounce rays apart. Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table]
  * [--classes] */
 #include "bench_util.h"

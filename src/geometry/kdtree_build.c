@@ -31,9 +31,6 @@ static inline int ev_less(const kd_event *a, const kd_event *b) {
   return a->pos < b->pos || (a->pos == b->pos && (a->v & 3) < (b->v & 3));
 }
 
-/* Sorts events by ev_less, stably (equal events keep their order): radix for long
- * lists; else insertion sort for short runs, then bottom-up merging through tmp (n
- * entries). */
 /* The sort key of a position: its bits made to order as unsigned integers (-0 as +0,
  * since the sweep groups events by ==). */
 static inline uint32_t ev_key(float pos) {
@@ -73,6 +70,17 @@ static void ev_radix(kd_event *e, uint32_t n, kd_event *tmp) {
   if (src != e) memcpy(e, src, (size_t)n * sizeof *e);
 }
 
+/* Merges sorted a and b into o (na + nb entries), stably: on equal events a's first. */
+static void ev_merge(kd_event *o, const kd_event *a, uint32_t na, const kd_event *b, uint32_t nb) {
+  uint32_t i = 0, j = 0, m = 0;
+  while (i < na && j < nb) o[m++] = ev_less(&b[j], &a[i]) ? b[j++] : a[i++];
+  while (i < na) o[m++] = a[i++];
+  while (j < nb) o[m++] = b[j++];
+}
+
+/* Sorts events by ev_less, stably (equal events keep their order): radix for long
+ * lists; else insertion sort for short runs, then bottom-up merging through tmp (n
+ * entries). */
 static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
   const uint32_t run = 16;
   if (n >= 256) { ev_radix(e, n, tmp); return; }
@@ -88,10 +96,8 @@ static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
   kd_event *src = e, *dst = tmp;
   for (uint32_t w = run; w < n; w *= 2) {
     for (uint32_t lo = 0; lo < n; lo += 2 * w) {
-      uint32_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n, i = lo, j = mid, m = lo;
-      while (i < mid && j < hi) dst[m++] = ev_less(&src[j], &src[i]) ? src[j++] : src[i++];
-      while (i < mid) dst[m++] = src[i++];
-      while (j < hi) dst[m++] = src[j++];
+      uint32_t mid = lo + w < n ? lo + w : n, hi = lo + 2 * w < n ? lo + 2 * w : n;
+      ev_merge(dst + lo, src + lo, mid - lo, src + mid, hi - mid);
     }
     kd_event *x = src; src = dst; dst = x;
   }
@@ -238,12 +244,9 @@ static void add_events(kd_event *dst, uint32_t *n, uint32_t tri, bbox b, int k) 
 static kd_event *merge(kd_event *a, uint32_t na, kd_event *b, uint32_t nb, uint32_t *nout) {
   kd_event *o = malloc(((size_t)na + nb + 1) * sizeof *o);
   if (!o) { free(a); free(b); return NULL; }
-  uint32_t i = 0, j = 0, m = 0;
-  while (i < na && j < nb) o[m++] = ev_less(&b[j], &a[i]) ? b[j++] : a[i++];
-  while (i < na) o[m++] = a[i++];
-  while (j < nb) o[m++] = b[j++];
+  ev_merge(o, a, na, b, nb);
   free(a); free(b);
-  *nout = m;
+  *nout = na + nb;
   return o;
 }
 

@@ -188,32 +188,43 @@ static void top_free(kd_top *t) {
   free(t->tasks); free(t->nodes);
 }
 
+/* A part shares the tree's triangles and hit filter; its arrays start empty. */
+static void part_init(kdtree *part, const kdtree *kd) {
+  part->tv = kd->tv; part->filter = kd->filter; part->has_filter = kd->has_filter;
+}
+
+/* Allocates out's arrays for the top nodes of t and all its tasks' parts, then joins them
+ * depth-first. Returns 0, or -1 when out of memory or past the layout's limits. */
+static int join_all(kdtree *out, const kd_top *t) {
+  uint64_t nn = t->nnodes, np = 0;
+  for (uint32_t i = 0; i < t->ntasks; i++) { nn += t->tasks[i].part.nnodes; np += t->tasks[i].part.nprims; }
+  if (nn > KD_MAX_NODES || np > 0xFFFFFFFFu) return -1;
+  out->nodes = malloc((size_t)nn * sizeof *out->nodes);
+  out->prims = malloc((size_t)(np + 1) * sizeof *out->prims);
+  out->ids = malloc((size_t)(np + 1) * 4 * sizeof *out->ids);
+  out->gfilt = malloc((size_t)np + 1);
+  if (!out->nodes || !out->prims || !out->ids || !out->gfilt) return -1;
+  out->cap_nodes = (uint32_t)nn; out->cap_prims = np;
+  return join(out, t, 0);
+}
+
 /* Builds the subtree of a node into out (tv and filter set, arrays empty): binned
  * levels down to KD_BIN_MIN references, then the exact sweep of each, joined. */
 static int build_subtree(kdtree *out, uint8_t *side, uint32_t *straddle, kd_task *k) {
-  kd_top sub = {(kdtree *)out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0};
+  kd_top sub = {out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0};
   uint32_t root = top_push(&sub);
   if (root == UINT32_MAX) return -1;
   top_build(&sub, root, k->box, k->refs, k->n, k->depth, k->bad);
   k->refs = NULL;
   int fail = sub.oom;
-  uint64_t nn = sub.nnodes, np = 0;
   for (uint32_t i = 0; i < sub.ntasks && !fail; i++) {
     kd_task *f = &sub.tasks[i];
-    f->part.tv = out->tv; f->part.filter = out->filter; f->part.has_filter = out->has_filter;
+    part_init(&f->part, out);
     fail = kd_build_part(&f->part, side, straddle, f->box, f->refs, f->n, f->depth, f->bad);
     free(f->refs);
     f->refs = NULL;
-    nn += f->part.nnodes; np += f->part.nprims;
   }
-  if (!fail && (nn > KD_MAX_NODES || np > 0xFFFFFFFFu)) fail = 1;
-  if (!fail) {
-    out->nodes = malloc((size_t)nn * sizeof *out->nodes);
-    out->prims = malloc((size_t)(np + 1) * sizeof *out->prims);
-    out->ids = malloc((size_t)(np + 1) * 4 * sizeof *out->ids);
-    out->gfilt = malloc((size_t)np + 1);
-    fail = !out->nodes || !out->prims || !out->ids || !out->gfilt || join(out, &sub, 0);
-  }
+  if (!fail) fail = join_all(out, &sub);
   top_free(&sub);
   return fail ? -1 : 0;
 }
@@ -223,8 +234,7 @@ typedef struct kd_run { kd_top *t; uint8_t *side[KD_BUILD_THREADS_MAX]; uint32_t
 static void run_task(void *user, int64_t i, int th) {
   kd_run *run = user;
   kd_task *k = &run->t->tasks[i];
-  const kdtree *kd = run->t->kd;
-  k->part.tv = kd->tv; k->part.filter = kd->filter; k->part.has_filter = kd->has_filter;
+  part_init(&k->part, run->t->kd);
   if (run->oom[th] || build_subtree(&k->part, run->side[th], run->straddle[th], k)) run->oom[th] = 1;
   free(k->refs);
   k->refs = NULL;
@@ -292,17 +302,7 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   parallel_for(nth, t.ntasks, run_task, &run);
   for (int i = 0; i < nth; i++) if (run.oom[i]) goto oom;
 
-  /* Join the parts in depth-first order. */
-  uint64_t nn = t.nnodes, np = 0;
-  for (uint32_t i = 0; i < t.ntasks; i++) { nn += t.tasks[i].part.nnodes; np += t.tasks[i].part.nprims; }
-  if (nn > KD_MAX_NODES || np > 0xFFFFFFFFu) goto oom;
-  kd->nodes = malloc((size_t)nn * sizeof *kd->nodes);
-  kd->prims = malloc((size_t)(np + 1) * sizeof *kd->prims);
-  kd->ids = malloc((size_t)(np + 1) * 4 * sizeof *kd->ids);
-  kd->gfilt = malloc((size_t)np + 1);
-  if (!kd->nodes || !kd->prims || !kd->ids || !kd->gfilt) goto oom;
-  kd->cap_nodes = (uint32_t)nn; kd->cap_prims = np;
-  if (join(kd, &t, 0) || kd_box_nodes(kd)) goto oom;
+  if (join_all(kd, &t) || kd_box_nodes(kd)) goto oom;
   for (int i = 0; i < nth; i++) { free(run.side[i]); free(run.straddle[i]); }
   top_free(&t);
   free(kd->tv);
