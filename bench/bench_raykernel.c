@@ -4,9 +4,9 @@
  * kd/Embree ratio, on the bunny, nefertiti, the dragon, Sponza and a Cornell box with the
  * bunny. Then the kd-tree build on the dragon's four resolutions (N log N growth, 2
  * threads) with the tree's bytes and the build's peak resident bytes per triangle.
- * Prints Markdown tables; scenes come from ../shared/scenes (or VALO_SHARED). --classes instead times camera misses, camera hits
- * and bounce rays apart. Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table]
- * [--classes] */
+ * Prints Markdown tables; scenes come from ../shared/scenes (or VALO_SHARED). --classes
+ * instead times camera misses, camera hits and bounce rays apart. Usage: bench_raykernel
+ * [--quick] [--only NAME] [--no-build-table] [--classes] */
 #include "bench_util.h"
 #include "scene/scene.h"
 #include "load/load.h"
