@@ -6,8 +6,10 @@
  * Embree backend against the same brute force, within float tolerance. camera_rays_kdtree
  * sees every real scene with a camera (veach-mis, veach-bidir, torus, Sponza, the Cornell
  * boxes) through it: camera rays, one bounce, rays grazing the largest triangles and rays
- * starting exactly on a surface, kd-tree against brute force exactly and Embree within
- * tolerance (nearly axis-aligned walls fell out of cells they reach). */
+ * starting exactly on a surface, kd-tree against brute force exactly (except where a ray
+ * grazes brute force's triangle so closely that its t's error bound covers the kd-tree's
+ * farther hit) and Embree within tolerance (nearly axis-aligned walls fell out of cells
+ * they reach). */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"
@@ -32,6 +34,10 @@ static int filter_passes(uint32_t t, float b1, float b2) {
   return !f || !(f->tri_flags[t] & f->flag_bit) || f->pass(f->user, t, b1, b2);
 }
 
+static void tri_verts(const scene *s, uint32_t t, float v[9]) {
+  for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &s->pos[s->idx[3 * t + k]], sizeof(vec3));
+}
+
 static void brute(void *user, int64_t i, int thread) {
   (void)thread;
   bf_job *j = user;
@@ -43,7 +49,7 @@ static void brute(void *user, int64_t i, int thread) {
   hit h = {0, 0, 0, 0};
   for (uint32_t t = 0; t < s->ntris; t++) {
     float v[9];
-    for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &s->pos[s->idx[3 * t + k]], sizeof(vec3));
+    tri_verts(s, t, v);
     float tt, b1, b2;
     if (tri_intersect(&sh, v, INFINITY, &tt, &b1, &b2) && filter_passes(t, b1, b2)) {
       if (tt < j->occl_tmax[i]) occl = 1;
@@ -358,20 +364,31 @@ static int check_camera_scene(const cam_case *c, int scale) {
   free(area);
   extra_job ej = {s, big, nbig, 2 * npix, nextra, rays, cls, bh, bf};
   parallel_for(threads_available(), nextra, extra_ray, &ej);
-  int count[RC_N] = {0}, hits[RC_N] = {0}, bad_kd[RC_N] = {0}, bad_em[RC_N] = {0}, ties = 0;
+  int count[RC_N] = {0}, hits[RC_N] = {0}, bad_kd[RC_N] = {0}, bad_em[RC_N] = {0}, ties = 0, unsure = 0;
   for (int i = 0; i < n; i++) {
     int k = cls[i];
     if (k < 0) continue;
     count[k]++;
     hits[k] += bf[i];
     hit a;
-    int fa = accel_intersect(kd, &rays[i], &a);
-    if (fa != bf[i] || (fa && a.t != bh[i].t)) {
+    int fa = accel_intersect(kd, &rays[i], &a), within = 0;
+    if (fa && bf[i] && a.t != bh[i].t && a.tri != bh[i].tri && a.t > bh[i].t) {
+      /* A ray grazing brute force's triangle (a few 10^-6 rad off its plane) gets a t that
+       * rounding may put farther from the true one than the triangle is long; no spatial
+       * structure can reproduce it, as the ray does not pass there. Then the kd-tree's
+       * (farther) hit must lie within that t's error bound. */
+      float v[9];
+      tri_verts(s, bh[i].tri, v);
+      ray_shear sh = ray_shear_make(rays[i].o, rays[i].d);
+      within = a.t - bh[i].t <= tri_t_error(&sh, v);
+      unsure += within;
+    }
+    if (!within && (fa != bf[i] || (fa && a.t != bh[i].t))) {
       if (bad_kd[k]++ < 3)
         fprintf(stderr, "  %s ray %d (o %.9g %.9g %.9g, d %.9g %.9g %.9g): kd-tree %s t=%.9g, brute force %s t=%.9g\n", rc_names[k], i,
                 rays[i].o.x, rays[i].o.y, rays[i].o.z, rays[i].d.x, rays[i].d.y, rays[i].d.z, fa ? "hit" : "miss", fa ? a.t : 0,
                 bf[i] ? "hit" : "miss", bf[i] ? bh[i].t : 0);
-    } else if (fa && a.tri != bh[i].tri) ties++;
+    } else if (fa && !within && a.tri != bh[i].tri) ties++;
     /* Embree: camera and bounce rays (its own triangle test rounds differently). */
     if (em && k <= RC_BOUNCE) {
       int fe = accel_intersect(em, &rays[i], &a);
@@ -381,13 +398,15 @@ static int check_camera_scene(const cam_case *c, int scale) {
   fprintf(stderr, "%s (%dx%d):", c->file, w, h);
   for (int k = 0; k < RC_N; k++)
     fprintf(stderr, " %s %d rays %d hits, kd-tree/brute mismatches %d%s", rc_names[k], count[k], hits[k], bad_kd[k], k < RC_N - 1 ? ";" : "");
-  fprintf(stderr, "; Embree/brute mismatches camera %d bounce %d; %d ties on shared edges\n", bad_em[0], bad_em[1], ties);
+  fprintf(stderr, "; Embree/brute mismatches camera %d bounce %d; %d ties on shared edges; %d farther hits within brute force's t error\n",
+          bad_em[0], bad_em[1], ties, unsure);
   accel_destroy(kd);
   accel_destroy(em);
   free(rays); free(bh); free(bf); free(cls); free(big);
   scene_free(s);
   CHECK(hits[RC_CAMERA] > count[RC_CAMERA] / 4, "too few camera hits (%d) for the test to mean anything", hits[RC_CAMERA]);
   for (int k = 0; k < RC_N; k++) CHECK(bad_kd[k] == 0, "%d %s rays where the kd-tree and brute force disagree", bad_kd[k], rc_names[k]);
+  CHECK(unsure <= n / 1000, "%d hits farther than brute force's within its t error: too many to be grazing rays", unsure);
   /* Embree rounds its own way: a ray along a shared or open edge may go either way. */
   for (int k = 0; k <= RC_BOUNCE; k++)
     CHECK(bad_em[k] <= count[k] / 2000, "%d %s rays where Embree and brute force disagree", bad_em[k], rc_names[k]);

@@ -73,22 +73,32 @@ static inline int tri_t_double(const ray_shear *s, const float *v, float tmax, f
  * double (tri_t_double). *t is then a function of the ray and the triangle alone, not of
  * the closest hit so far, so the nearest hit does not depend on the order triangles are
  * tested in (kd-tree leaves and brute force agree exactly). */
-static inline int tri_resolve_t(const ray_shear *s, const float *v, float ax, float ay, float az, float bx, float by, float bz, float cx,
-                                float cy, float cz, float u, float w1, float w, float inv, float *t) {
+/* The bound on the float t's error (pbrt-v3 §3.9.6) from the sheared vertices (z scaled),
+ * the edge functions and 1/det. */
+static inline float tri_t_bound(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz, float u, float w1,
+                                float w, float inv) {
   float max_z = max3_abs(az, bz, cz), max_x = max3_abs(ax, bx, cx), max_y = max3_abs(ay, by, cy);
   float dz = fp_gamma(3) * max_z, dx = fp_gamma(5) * (max_x + max_z), dy = fp_gamma(5) * (max_y + max_z);
   float de = 2 * (fp_gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
   float max_e = max3_abs(u, w1, w);
-  float dt = 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
+  return 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
+}
+static inline int tri_resolve_t(const ray_shear *s, const float *v, float ax, float ay, float az, float bx, float by, float bz, float cx,
+                                float cy, float cz, float u, float w1, float w, float inv, float *t) {
+  float dt = tri_t_bound(ax, ay, az, bx, by, bz, cx, cy, cz, u, w1, w, inv);
   if (*t > dt) return 1;
   if (*t < -dt) return 0;
   return tri_t_double(s, v, INFINITY, t);
 }
 
-/* Returns 1 if the ray hits (v0,v1,v2) at 0 < t < tmax; fills t and weights of v1, v2. */
-static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, float *t_out, float *b1_out, float *b2_out) {
+/* The triangle (v0,v1,v2) in the ray's sheared frame: vertices relative to the origin,
+ * sheared (x, y; z not yet scaled), and the edge functions u, w1, w (in double when one
+ * is exactly zero in float). */
+typedef struct tri_sheared { float ax, ay, az, bx, by, bz, cx, cy, cz, u, w1, w; } tri_sheared;
+static inline tri_sheared tri_shear(const ray_shear *s, const float *v) {
   const float *p0 = v, *p1 = v + 3, *p2 = v + 6;
   float o[3] = {s->o.x, s->o.y, s->o.z};
+  tri_sheared q;
   float ax = p0[s->kx] - o[s->kx], ay = p0[s->ky] - o[s->ky], az = p0[s->kz] - o[s->kz];
   float bx = p1[s->kx] - o[s->kx], by = p1[s->ky] - o[s->ky], bz = p1[s->kz] - o[s->kz];
   float cx = p2[s->kx] - o[s->kx], cy = p2[s->ky] - o[s->ky], cz = p2[s->kz] - o[s->kz];
@@ -101,6 +111,25 @@ static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, 
     w1 = (float)((double)ax * cy - (double)ay * cx);
     w = (float)((double)bx * ay - (double)by * ax);
   }
+  q.ax = ax; q.ay = ay; q.az = az; q.bx = bx; q.by = by; q.bz = bz; q.cx = cx; q.cy = cy; q.cz = cz; q.u = u; q.w1 = w1; q.w = w;
+  return q;
+}
+
+/* The bound on the error of the t that tri_intersect computes for this ray and triangle
+ * (infinite when the ray lies in its plane). A ray within a few 10^-6 rad of a
+ * triangle's plane gets a t that may be off by more than the triangle is long, so two
+ * triangles' order along such a ray is decided by rounding (test_kdtree). */
+static inline float tri_t_error(const ray_shear *s, const float *v) {
+  tri_sheared q = tri_shear(s, v);
+  float det = q.u + q.w1 + q.w;
+  if (det == 0) return INFINITY;
+  return tri_t_bound(q.ax, q.ay, q.az * s->sz, q.bx, q.by, q.bz * s->sz, q.cx, q.cy, q.cz * s->sz, q.u, q.w1, q.w, 1.0f / det);
+}
+
+/* Returns 1 if the ray hits (v0,v1,v2) at 0 < t < tmax; fills t and weights of v1, v2. */
+static inline int tri_intersect(const ray_shear *s, const float *v, float tmax, float *t_out, float *b1_out, float *b2_out) {
+  tri_sheared q = tri_shear(s, v);
+  float ax = q.ax, ay = q.ay, az = q.az, bx = q.bx, by = q.by, bz = q.bz, cx = q.cx, cy = q.cy, cz = q.cz, u = q.u, w1 = q.w1, w = q.w;
   if ((u < 0 || w1 < 0 || w < 0) && (u > 0 || w1 > 0 || w > 0)) return 0;
   float det = u + w1 + w;
   if (det == 0) return 0;
