@@ -16,7 +16,7 @@
   {"history", IPARAM_FLOAT, 2, 0, 1000, "the previous frame's M is capped at this many times the current one's (paper: 20)"},          \
   {"spatial", IPARAM_INT, 5, 0, 64, "k: neighbours merged per spatial round"},                                                         \
   {"radius", IPARAM_FLOAT, 0, 0, 1000, "spatial neighbours come from a disc of this many pixels; 0: width / 64 (30 at 1920), >= 3"}, \
-  {"iterations", IPARAM_INT, 1, 0, 8, "n: rounds of spatial reuse"},                                                                   \
+  {"iterations", IPARAM_INT, -1, -1, 8, "n: rounds of spatial reuse; -1: one in sequences, none in stills"},                           \
   {"unbiased", IPARAM_INT, 1, 0, 1, "1: pairwise MIS with visibility (unbiased); 0: 1/M (biased, darker)"},                        \
   {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"}, \
   {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"}

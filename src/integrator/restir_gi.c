@@ -11,7 +11,7 @@
 #include <string.h>
 
 static const integrator_param restir_gi_params[] = {
-    {"candidates", IPARAM_INT, 32, 1, 1024, "M of the direct-light reservoirs (direct=1)"},
+    {"candidates", IPARAM_INT, 8, 1, 1024, "M of the direct-light reservoirs (direct=1)"},
     {"temporal", IPARAM_INT, -1, -1, 1, "1: reuse the previous frame's reservoirs at the reprojected pixel; -1: in sequences only"},
     {"history", IPARAM_FLOAT, 20, 0, 1000, "the previous frame's M is capped at this many times the current one's"},
     {"spatial", IPARAM_INT, 3, 0, 64, "k: neighbours merged per spatial round"},
@@ -23,7 +23,7 @@ static const integrator_param restir_gi_params[] = {
     {"direct", IPARAM_INT, 1, 0, 1, "direct light at the camera hit: 1 restir-di (direct_spatial, direct_iterations), 0 plain next-event estimation"},
     {"jacobian", IPARAM_INT, 1, 0, 1, "1: reused samples carry the solid-angle Jacobian (0 only to show the bias without it)"},
     {"direct_spatial", IPARAM_INT, 3, 0, 64, "direct=1: k of the direct-light reservoirs' spatial rounds"},
-    {"direct_iterations", IPARAM_INT, 1, 0, 8, "direct=1: n, rounds of spatial reuse of the direct-light reservoirs"},
+    {"direct_iterations", IPARAM_INT, -1, -1, 8, "direct=1: n, rounds of spatial reuse of the direct-light reservoirs; -1: one in sequences, none in stills"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 /* ---- GI */
