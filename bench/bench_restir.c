@@ -15,11 +15,13 @@
  * References (bench/references, commands in docs/performance.md): path at high spp.
  * Scenes: the room (scenes/manylight.json), Sponza with lamps, and the walls room
  * (bench/manylight-walls.json: 1 536 lamps 1/1000 of the room's width off its walls and
- * ceiling; reference bench/references/manylight-walls-direct.exr: valo `path
- * --max-depth 1` at 8 192 spp with the light grid, see docs/performance.md for why not
+ * ceiling; references bench/references/manylight-walls-{direct,path}.exr: valo `path
+ * [--max-depth 1]` at 8 192 spp with the light grid, see docs/performance.md for why not
  * Mitsuba 3 here).
  * Usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params "K=V ..."]
- * (--params: restir parameters for every restir run, before each run's own) */
+ * [--stills di|gi|both]
+ * (--params: restir parameters for every restir run, before each run's own; --stills:
+ * only the accumulated stills, of restir-di, restir-gi or both) */
 #include "valo/valo.h"
 #include "bench_util.h"
 #include "image/image_io.h"
@@ -62,6 +64,7 @@ static valo_status grab(void *user, const valo_render *r, int f, valo_error *err
 
 /* Runs j; secs excludes scene loading and the acceleration-structure build. */
 static const char *g_params = ""; /* --params */
+static int g_stills;               /* --stills: 1 direct light, 2 GI, 3 both; only the accumulated stills */
 static int run(job *j) {
   valo_error err;
   valo_scene *sc;
@@ -165,47 +168,56 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
     if (image_read(refp, &ref, &err) || ref.w != sd->w || ref.h != sd->h) { fprintf(stderr, "%s: %s\n", refp, err.message); return 1; }
     const char *integ = gi ? "restir-gi" : "restir-di";
     int depth = gi ? -1 : 1;
+    if (g_stills && !(g_stills & (1 << gi))) { image_free(&ref); continue; }
     printf("\n%s, %s against path%s (%dx%d, 2 threads)\n", sd->name, integ, gi ? "" : " --max-depth 1", sd->w, sd->h);
-    /* time per frame (still, static camera) and per baseline sample */
-    int nf = quick ? 4 : 16;
-    job rt = {stat, integ, NULL, sd->w, sd->h, nf, 0, -1, 0, 3, 0, NULL, {NULL}, 0, NULL};
-    job pt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, "power"};
-    job gt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, NULL};
-    if (run(&rt) || run(&pt) || run(&gt)) return 1;
-    double t_frame = rt.secs / nf, t_spp = pt.secs / nf, t_gspp = gt.secs / nf;
-    int base_spp = (int)lround(t_frame / t_spp), gbase_spp = (int)lround(t_frame / t_gspp);
-    if (base_spp < 1) base_spp = 1;
-    if (gbase_spp < 1) gbase_spp = 1;
-    job_free(&rt); job_free(&pt); job_free(&gt);
-    /* per frame: a static-camera sequence; the last frame (history built) */
-    int seqn = quick ? 8 : 24;
-    job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
-    job rs0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
-    job ris = {stat, integ, "temporal=0 iterations=0", sd->w, sd->h, 1, 1, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
-    job rsp = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, "power"};
-    job ps = {stat, "path", NULL, sd->w, sd->h, base_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, "power"};
-    job gs = {stat, "path", NULL, sd->w, sd->h, gbase_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, NULL};
-    if (run(&rs) || run(&rs0) || run(&ris) || run(&rsp) || run(&ps) || run(&gs)) return 1;
-    double e_rs = 0, e_rs0 = 0, e_rsp = 0, e_ps = 0, e_gs = 0;
-    int last = 4 < rs.nseq ? 4 : rs.nseq;
-    for (int k = rs.nseq - last; k < rs.nseq; k++) {
-      e_rs += bench_relmse(rs.seq[k], ref.rgb, n, g_ok) / last;
-      e_rs0 += bench_relmse(rs0.seq[k], ref.rgb, n, g_ok) / last;
-      e_rsp += bench_relmse(rsp.seq[k], ref.rgb, n, g_ok) / last;
-      e_ps += bench_relmse(ps.seq[k], ref.rgb, n, g_ok) / last;
-      e_gs += bench_relmse(gs.seq[k], ref.rgb, n, g_ok) / last;
+    if (!g_stills) {
+      /* time per frame (a static-camera sequence) and per baseline sample */
+      int nf = quick ? 4 : 16;
+      job rt = {stat, integ, NULL, sd->w, sd->h, 1, nf, -1, 0, 3, 0, NULL, {NULL}, 0, NULL};
+      job rt0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, nf, -1, 0, 3, 0, NULL, {NULL}, 0, NULL};
+      job pt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, "power"};
+      job gt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, NULL};
+      if (run(&rt) || run(&rt0) || run(&pt) || run(&gt)) return 1;
+      double t_frame = rt.secs / nf, t_frame0 = rt0.secs / nf, t_spp = pt.secs / nf, t_gspp = gt.secs / nf;
+      job_free(&rt0);
+      int base_spp = (int)lround(t_frame / t_spp), gbase_spp = (int)lround(t_frame / t_gspp);
+      if (base_spp < 1) base_spp = 1;
+      if (gbase_spp < 1) gbase_spp = 1;
+      job_free(&rt); job_free(&pt); job_free(&gt);
+      /* per frame: a static-camera sequence; the last frame (history built) */
+      int seqn = quick ? 8 : 24;
+      job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+      job rs0 = {stat, integ, "temporal=0", sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+      job ris = {stat, integ, "temporal=0 iterations=0", sd->w, sd->h, 1, 1, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};
+      job rsp = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, "power"};
+      job ps = {stat, "path", NULL, sd->w, sd->h, base_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, "power"};
+      job gs = {stat, "path", NULL, sd->w, sd->h, gbase_spp, seqn, depth, 0, 7, 0, NULL, {NULL}, 0, NULL};
+      if (run(&rs) || run(&rs0) || run(&ris) || run(&rsp) || run(&ps) || run(&gs)) return 1;
+      double e_rs = 0, e_rs0 = 0, e_rsp = 0, e_ps = 0, e_gs = 0;
+      int last = 4 < rs.nseq ? 4 : rs.nseq;
+      for (int k = rs.nseq - last; k < rs.nseq; k++) {
+        e_rs += bench_relmse(rs.seq[k], ref.rgb, n, g_ok) / last;
+        e_rs0 += bench_relmse(rs0.seq[k], ref.rgb, n, g_ok) / last;
+        e_rsp += bench_relmse(rsp.seq[k], ref.rgb, n, g_ok) / last;
+        e_ps += bench_relmse(ps.seq[k], ref.rgb, n, g_ok) / last;
+        e_gs += bench_relmse(gs.seq[k], ref.rgb, n, g_ok) / last;
+      }
+      double e_ris = bench_relmse(ris.seq[0], ref.rgb, n, g_ok);
+      printf("  time per frame: %s %.3f s; path %.3f s per spp with power selection, %.3f s with the light grid -> baselines %d and %d spp per frame\n",
+             integ, t_frame, t_spp, t_gspp, base_spp, gbase_spp);
+      printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g, candidates by power %.4g;"
+             " path (power) %d spp %.4g; path (grid) %d spp %.4g\n",
+             last, seqn, integ, e_rs, e_rs0, e_ris, e_rsp, base_spp, e_ps, gbase_spp, e_gs);
+      printf("  per-frame ratio path (power) / %s: %.2f (spatial only: %.2f); path (grid) / %s: %.2f\n", integ, e_ps / e_rs, e_ps / e_rs0, integ,
+             e_gs / e_rs);
+      /* one frame without history at its own cost: path (grid)'s relMSE scaled to that time */
+      double e_g0 = e_gs * gbase_spp * t_gspp / t_frame0;
+      printf("  one frame without history: %s %.3f s, relMSE %.4g; path (grid) in that time (scaled from %d spp) %.4g; ratio %.2f\n", integ,
+             t_frame0, e_rs0, gbase_spp, e_g0, e_g0 / e_rs0);
+      printf("  temporal stability (mean relative frame-to-frame change): %s %.4f, without temporal %.4f, path (power) %.4f, path (grid) %.4f\n", integ,
+             flicker(&rs, n), flicker(&rs0, n), flicker(&ps, n), flicker(&gs, n));
+      job_free(&rs); job_free(&rs0); job_free(&ris); job_free(&rsp); job_free(&ps); job_free(&gs);
     }
-    double e_ris = bench_relmse(ris.seq[0], ref.rgb, n, g_ok);
-    printf("  time per frame: %s %.3f s; path %.3f s per spp with power selection, %.3f s with the light grid -> baselines %d and %d spp per frame\n",
-           integ, t_frame, t_spp, t_gspp, base_spp, gbase_spp);
-    printf("  per-frame relMSE (last %d of %d static frames): %s %.4g, without temporal %.4g, no reuse (RIS only) %.4g, candidates by power %.4g;"
-           " path (power) %d spp %.4g; path (grid) %d spp %.4g\n",
-           last, seqn, integ, e_rs, e_rs0, e_ris, e_rsp, base_spp, e_ps, gbase_spp, e_gs);
-    printf("  per-frame ratio path (power) / %s: %.2f (spatial only: %.2f); path (grid) / %s: %.2f\n", integ, e_ps / e_rs, e_ps / e_rs0, integ,
-           e_gs / e_rs);
-    printf("  temporal stability (mean relative frame-to-frame change): %s %.4f, without temporal %.4f, path (power) %.4f, path (grid) %.4f\n", integ,
-           flicker(&rs, n), flicker(&rs0, n), flicker(&ps, n), flicker(&gs, n));
-    job_free(&rs); job_free(&rs0); job_free(&ris); job_free(&rsp); job_free(&ps); job_free(&gs);
     /* accumulated at equal time: a still (frames averaged) against path with the same budget */
     double T = seconds > 0 ? seconds : (quick ? 2.0 : 10.0);
     job ra = {stat, integ, NULL, sd->w, sd->h, 1048576, 0, -1, T, 11, 0, NULL, {NULL}, 0, NULL};
@@ -236,7 +248,12 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
     else if (!strcmp(argv[i], "--params") && i + 1 < argc) g_params = argv[++i];
-    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params \"K=V ...\"]\n"); return 2; }
+    else if (!strcmp(argv[i], "--stills") && i + 1 < argc) {
+      const char *w = argv[++i];
+      g_stills = !strcmp(w, "di") ? 1 : !strcmp(w, "gi") ? 2 : !strcmp(w, "both") ? 3 : 0;
+      if (!g_stills) { fprintf(stderr, "--stills: di, gi or both\n"); return 2; }
+    }
+    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params \"K=V ...\"] [--stills di|gi|both]\n"); return 2; }
   }
   static const char *names[3] = {"room", "sponza", "walls"};
   const scene_def scenes[3] = {
@@ -245,7 +262,7 @@ int main(int argc, char **argv) {
       {"Sponza with 1 200 lamps (bench/sponza-lamps.json)", VALO_SOURCE_DIR "/bench/sponza-lamps.json",
        VALO_SOURCE_DIR "/bench/references/sponza-lamps-direct.exr", VALO_SOURCE_DIR "/bench/references/sponza-lamps-path.exr", 320, 180},
       {"walls room (bench/manylight-walls.json, 1 536 lamps 1/1000 of its width off the walls)", VALO_SOURCE_DIR "/bench/manylight-walls.json",
-       VALO_SOURCE_DIR "/bench/references/manylight-walls-direct.exr", NULL, 256, 192}};
+       VALO_SOURCE_DIR "/bench/references/manylight-walls-direct.exr", VALO_SOURCE_DIR "/bench/references/manylight-walls-path.exr", 256, 192}};
   for (int s = 0; s < 3; s++) {
     if (only && strcmp(only, names[s])) continue;
     if (bench_scene(&scenes[s], quick, seconds)) return 1;
