@@ -531,6 +531,23 @@ static int threads_identical(void) {
   return 0;
 }
 
+/* A still (frames averaged) runs no spatial round of the direct-light reservoirs by
+ * default (restir-di iterations=-1, restir-gi direct_iterations=-1): its image is the
+ * one with the rounds set to 0, bit for bit, and not the one with a round. */
+static int stills_skip_direct_round(void) {
+  const char *integ[2] = {"restir-di", "restir-gi"}, *none[2] = {"iterations=0", "direct_iterations=0"},
+             *one[2] = {"iterations=1", "direct_iterations=1"};
+  size_t bytes = (size_t)W * H * 3 * sizeof(float);
+  for (int k = 0; k < 2; k++) {
+    float *a = render_room(integ[k], NULL, 3, 2, 4), *b = render_room(integ[k], none[k], 3, 2, 4), *c = render_room(integ[k], one[k], 3, 2, 4);
+    CHECK(a && b && c, "render failed");
+    CHECK(!memcmp(a, b, bytes), "%s: the default still differs from %s", integ[k], none[k]);
+    CHECK(memcmp(a, c, bytes), "%s: the default still equals %s (the round changed nothing)", integ[k], one[k]);
+    free(a); free(b); free(c);
+  }
+  return 0;
+}
+
 static int bad_parameters(void) {
   const char *bad[4] = {"candidates=0", "radius=-1", "iterations=99", "spatial=1.5"};
   const char *names[4] = {"candidates", "radius", "iterations", "spatial"};
@@ -560,6 +577,7 @@ int main(int argc, char **argv) {
                                     {"gi_reuse_lowers_error", gi_reuse_lowers_error},
                                     {"reuse_rejects_other_surfaces", reuse_rejects_other_surfaces},
                                     {"threads_identical", threads_identical},
+                                    {"stills_skip_direct_round", stills_skip_direct_round},
                                     {"bad_parameters", bad_parameters},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
