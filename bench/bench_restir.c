@@ -162,13 +162,12 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
   job_free(&em);
   for (int gi = 0; gi < 2; gi++) {
     const char *refp = gi ? sd->ref_path : sd->ref_direct;
-    if (!refp) continue;
+    if (!refp || (g_stills && !(g_stills & (1 << gi)))) continue;
     image ref;
     valo_error err;
     if (image_read(refp, &ref, &err) || ref.w != sd->w || ref.h != sd->h) { fprintf(stderr, "%s: %s\n", refp, err.message); return 1; }
     const char *integ = gi ? "restir-gi" : "restir-di";
     int depth = gi ? -1 : 1;
-    if (g_stills && !(g_stills & (1 << gi))) { image_free(&ref); continue; }
     printf("\n%s, %s against path%s (%dx%d, 2 threads)\n", sd->name, integ, gi ? "" : " --max-depth 1", sd->w, sd->h);
     if (!g_stills) {
       /* time per frame (a static-camera sequence) and per baseline sample */
@@ -179,11 +178,10 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
       job gt = {stat, "path", NULL, sd->w, sd->h, nf, 0, depth, 0, 3, 0, NULL, {NULL}, 0, NULL};
       if (run(&rt) || run(&rt0) || run(&pt) || run(&gt)) return 1;
       double t_frame = rt.secs / nf, t_frame0 = rt0.secs / nf, t_spp = pt.secs / nf, t_gspp = gt.secs / nf;
-      job_free(&rt0);
       int base_spp = (int)lround(t_frame / t_spp), gbase_spp = (int)lround(t_frame / t_gspp);
       if (base_spp < 1) base_spp = 1;
       if (gbase_spp < 1) gbase_spp = 1;
-      job_free(&rt); job_free(&pt); job_free(&gt);
+      job_free(&rt); job_free(&rt0); job_free(&pt); job_free(&gt);
       /* per frame: a static-camera sequence; the last frame (history built) */
       int seqn = quick ? 8 : 24;
       job rs = {stat, integ, NULL, sd->w, sd->h, 1, seqn, -1, 0, 7, 0, NULL, {NULL}, 0, NULL};

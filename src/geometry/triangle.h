@@ -67,12 +67,6 @@ static inline int tri_t_double(const ray_shear *s, const float *v, float tmax, f
   return 1;
 }
 
-/* The conservative t > 0 of pbrt-v3 §3.9.6 (hits within t's rounding error of 0 would
- * re-hit the surface a ray leaves), given the sheared vertices, edge functions and
- * 1/det: returns 0 when t is certainly <= 0; when float cannot tell, t is recomputed in
- * double (tri_t_double). *t is then a function of the ray and the triangle alone, not of
- * the closest hit so far, so the nearest hit does not depend on the order triangles are
- * tested in (kd-tree leaves and brute force agree exactly). */
 /* The bound on the float t's error (pbrt-v3 §3.9.6) from the sheared vertices (z scaled),
  * the edge functions and 1/det. */
 static inline float tri_t_bound(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy, float cz, float u, float w1,
@@ -83,6 +77,12 @@ static inline float tri_t_bound(float ax, float ay, float az, float bx, float by
   float max_e = max3_abs(u, w1, w);
   return 3 * (fp_gamma(3) * max_e * max_z + de * max_z + dz * max_e) * fabsf(inv);
 }
+/* The conservative t > 0 of pbrt-v3 §3.9.6 (hits within t's rounding error of 0 would
+ * re-hit the surface a ray leaves), given the sheared vertices, edge functions and
+ * 1/det: returns 0 when t is certainly <= 0; when float cannot tell, t is recomputed in
+ * double (tri_t_double). *t is then a function of the ray and the triangle alone, not of
+ * the closest hit so far, so the nearest hit does not depend on the order triangles are
+ * tested in (kd-tree leaves and brute force agree exactly). */
 static inline int tri_resolve_t(const ray_shear *s, const float *v, float ax, float ay, float az, float bx, float by, float bz, float cx,
                                 float cy, float cz, float u, float w1, float w, float inv, float *t) {
   float dt = tri_t_bound(ax, ay, az, bx, by, bz, cx, cy, cz, u, w1, w, inv);

@@ -275,7 +275,7 @@ static int temporal_on(int t, const frame_ctx *f) { return t > 0 || (t < 0 && f-
 /* Spatial rounds: n, or -1 (restir-di's default and restir-gi's direct light) one in
  * sequences and none in a still: there the shadow rays and targets of a round cost more
  * than the error it removes (on the many-light room, the walls room and Sponza a still
- * without them has 0.6-0.9x the relMSE at equal time; docs/integrators.md). */
+ * without them has 0.8-0.9x the relMSE at equal time; docs/integrators.md). */
 static int spatial_rounds(const restir_cfg *k, const frame_ctx *f) {
   if (k->spatial <= 0) return 0;
   return k->iterations >= 0 ? k->iterations : f->sequence ? 1 : 0;
