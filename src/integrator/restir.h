@@ -10,8 +10,11 @@
 typedef struct di_sample { uint32_t light; vec3 y; } di_sample;
 /* Reservoir: the kept sample, the sum of resampling weights (of the candidates; merges
  * keep only W), the candidate count M and the contribution weight W (an estimate of
- * 1 / pdf(y)). */
-typedef struct di_res { di_sample y; float w_sum, M, W; } di_res;
+ * 1 / pdf(y)); p, p^(y) at the reservoir's own pixel (restir_di_target there, 0 when
+ * none), and f, the unshadowed contribution it found (black when p is 0): merges read
+ * them as the input's own target and shading as the pixel's, instead of evaluating the
+ * light again. */
+typedef struct di_res { di_sample y; float w_sum, M, W, p; rgb f; } di_res;
 /* A GI sample: the sample point x_s, its normal n_s (facing the pixel that found it) and
  * the radiance L^ it sends towards that pixel. */
 typedef struct gi_res { vec3 xs, ns; rgb Lo; float w_sum, M, W; } gi_res;
@@ -29,9 +32,9 @@ typedef struct restir_cfg {
 /* RIS at a surface point: M candidates from the power-proportional light selection and
  * light sampling (stream smp, child j of M for candidate j), kept by streaming weighted
  * reservoir sampling (uniform numbers from rng), target p^ = luminance of the unshadowed
- * f Le |cos| g. Fills *r (W = w_sum / (M p^(y)), no visibility) and, when a sample was
- * kept, *kept (if not NULL) with its light evaluation (for the shadow ray); returns 1
- * when a sample was kept. */
+ * f Le |cos| g. Fills *r (W = w_sum / (M p^(y)), no visibility; p and f by
+ * restir_di_target) and, when a sample was kept, *kept (if not NULL) with its light
+ * evaluation (for the shadow ray); returns 1 when a sample was kept. */
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
                          sampler *rng, di_res *r, light_li *kept);
 /* p^ of DI sample y at a surface point, with the unshadowed contribution in *contrib and

@@ -164,7 +164,7 @@ int restir_merge(const merge_ops *ops, void *u, int unbiased, int can, const flo
     if (p->W > 0) {
       p->p_here = ops->target(u, gs[0], i);
       if (p->p_here > 0 && !ops->visible(u, gs[0], i, ts)) p->p_here = 0;
-      if (unbiased) p->p_own = ops->target(u, gs[i], i);
+      if (unbiased) p->p_own = ops->own ? ops->own(u, i) : ops->target(u, gs[i], i);
     }
     if (can && unbiased) {
       p->p_can = ops->target(u, gs[i], 0);
@@ -247,7 +247,7 @@ static void stage_shade(void *user, int64_t row, int thread) {
     rgb L = g->Le;
     if (g->valid) {
       rgb Lr = c3(0, 0, 0);
-      if (!s->gi || s->direct_restir) Lr = restir_di_shade(c, g, &s->di[s->di_final][pix]);
+      if (!s->gi || s->direct_restir) Lr = restir_di_shade(&s->di[s->di_final][pix]);
       else {
         sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)c->sampler_kind);
         sampler_set_dim(&smp, SDIM_RESTIR_NEE);

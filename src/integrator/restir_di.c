@@ -53,13 +53,14 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
                          sampler *rng, di_res *r, light_li *kept) {
   memset(r, 0, sizeof *r);
   float phat_kept = 0;
+  light_site at = light_locate(&c->ls, it->p);
   for (int i = 0; i < M; i++) {
     sampler cs = sampler_child(smp, (uint32_t)i, (uint32_t)M);
     float ul = sampler_1d(&cs), u1, u2;
     sampler_2d(&cs, &u1, &u2);
     float u = rnd(rng);
     float pmf;
-    uint32_t li = light_select(&c->ls, c->s, it->p, ul, &pmf);
+    uint32_t li = light_select_at(&c->ls, c->s, &at, ul, &pmf);
     if (li == UINT32_MAX || !(pmf > 0)) continue;
     const light *l = &c->s->lights[li];
     light_li ls;
@@ -81,6 +82,11 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
   }
   r->M = (float)M;
   r->W = phat_kept > 0 ? r->w_sum / (r->M * phat_kept) : 0;
+  if (phat_kept > 0) {
+    light_li li;
+    r->p = restir_di_target(c, it, b, fr, wo, &r->y, &r->f, &li);
+    if (!(r->p > 0)) r->f = c3(0, 0, 0);
+  }
   return phat_kept > 0;
 }
 
@@ -105,12 +111,22 @@ void restir_stage_di_initial(void *user, int64_t row, int thread) {
 
 /* DI reservoirs: targets in the light's measure; visibility of the light point the last
  * target found. */
-typedef struct di_merge_ctx { const render_ctx *c; const di_res *const *in; light_li li; } di_merge_ctx;
+typedef struct di_merge_ctx {
+  const render_ctx *c;
+  const di_res *const *in;
+  const gpix *g0;
+  light_li li;
+  float p0[72]; /* each input's target at g0 (when asked) */
+  rgb f0[72];
+} di_merge_ctx;
 static float di_merge_target(void *u, const gpix *at, int j) {
   di_merge_ctx *m = u;
   rgb contrib;
-  return di_target_g(m->c, at, &m->in[j]->y, &contrib, &m->li);
+  float p = di_target_g(m->c, at, &m->in[j]->y, &contrib, &m->li);
+  if (at == m->g0) { m->p0[j] = p; m->f0[j] = p > 0 ? contrib : c3(0, 0, 0); }
+  return p;
 }
+static float di_merge_own(void *u, int j) { return ((di_merge_ctx *)u)->in[j]->p; }
 static int di_merge_visible(void *u, const gpix *at, int j, thread_stats *ts) {
   (void)j;
   di_merge_ctx *m = u;
@@ -122,23 +138,20 @@ static float di_merge_W(void *u, int j) { return ((di_merge_ctx *)u)->in[j]->W; 
  * *out (restir_merge says how). */
 void restir_di_merge(const render_ctx *c, int unbiased, const gpix *const *gs, const di_res *const *in, int n, float cap_M, sampler *rng,
                      thread_stats *ts, di_res *out) {
-  static const merge_ops ops = {di_merge_target, di_merge_visible, di_merge_W};
-  di_merge_ctx m = {.c = c, .in = in};
+  static const merge_ops ops = {di_merge_target, di_merge_own, di_merge_visible, di_merge_W};
+  di_merge_ctx m = {.c = c, .in = in, .g0 = gs[0]};
   float M[72];
   for (int i = 0; i < n; i++) M[i] = in[i]->M;
   memset(out, 0, sizeof *out);
   int kept = restir_merge(&ops, &m, unbiased, in[0]->W > 0, M, gs, n, cap_M, rng, ts, &out->M, &out->W);
-  if (kept >= 0) out->y = in[kept]->y;
+  if (kept >= 0) { out->y = in[kept]->y; out->p = m.p0[kept]; out->f = m.f0[kept]; }
 }
 
-/* Direct light of pixel g from its final reservoir: f Le |cos| g W (the sample is visible:
- * reservoirs hold only samples their pixel sees). */
-rgb restir_di_shade(const render_ctx *c, const gpix *g, const di_res *r) {
-  if (!(r->W > 0)) return c3(0, 0, 0);
-  rgb contrib;
-  light_li li;
-  if (!(di_target_g(c, g, &r->y, &contrib, &li) > 0)) return c3(0, 0, 0);
-  return c3_scale(contrib, r->W);
+/* Direct light of a pixel from its final reservoir: f Le |cos| g W (the sample is visible:
+ * reservoirs hold only samples their pixel sees; f as the reservoir found it there). */
+rgb restir_di_shade(const di_res *r) {
+  if (!(r->W > 0) || !(r->p > 0)) return c3(0, 0, 0);
+  return c3_scale(r->f, r->W);
 }
 
 static valo_status restir_di_create(const render_ctx *c, void **state, valo_error *err) { return restir_create(c, state, 0, err); }

@@ -131,7 +131,7 @@ static float gi_merge_W(void *u, int j) {
  * result's W goes back to pixel gs[0]'s solid angle. */
 void restir_gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const gpix *const *gs, const gi_res *const *in, int n,
                      float cap_M, sampler *rng, thread_stats *ts, gi_res *out) {
-  static const merge_ops ops = {gi_merge_target, gi_merge_visible, gi_merge_W};
+  static const merge_ops ops = {gi_merge_target, NULL, gi_merge_visible, gi_merge_W};
   gi_merge_ctx m = {c, in, gs, use_jacobian};
   float M[72], W;
   for (int i = 0; i < n; i++) M[i] = in[i]->M;

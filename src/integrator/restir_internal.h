@@ -48,10 +48,12 @@ typedef struct stage_job {
 
 /* What merging asks of a kind of reservoir: target(u, at, j), the target of input j's
  * sample at pixel `at` in the measure common to all pixels; visible(u, at, j), whether
- * `at` sees that sample (called right after target of the same pair); W(u, j), input j's
- * contribution weight in that measure (0: none). */
+ * `at` sees that sample (called right after target of the same pair); own(u, j), if not
+ * NULL, input j's target at its own pixel as kept with the input (else target is asked);
+ * W(u, j), input j's contribution weight in that measure (0: none). */
 typedef struct merge_ops {
   float (*target)(void *u, const gpix *at, int j);
+  float (*own)(void *u, int j);
   int (*visible)(void *u, const gpix *at, int j, thread_stats *ts);
   float (*W)(void *u, int j);
 } merge_ops;
@@ -66,7 +68,7 @@ int restir_merge(const merge_ops *ops, void *u, int unbiased, int can, const flo
 void restir_stage_di_initial(void *user, int64_t row, int thread);
 void restir_di_merge(const render_ctx *c, int unbiased, const gpix *const *gs, const di_res *const *in, int n, float cap_M, sampler *rng,
                      thread_stats *ts, di_res *out);
-rgb restir_di_shade(const render_ctx *c, const gpix *g, const di_res *r);
+rgb restir_di_shade(const di_res *r);
 /* GI (restir_gi.c): the initial samples stage, merging, the target. */
 void restir_stage_gi_initial(void *user, int64_t row, int thread);
 void restir_gi_merge(const render_ctx *c, int unbiased, int use_jacobian, const gpix *const *gs, const gi_res *const *in, int n,

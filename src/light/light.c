@@ -170,10 +170,19 @@ static inline float grid_mix_pmf(const light_sampler *ls, const float *row, uint
   return LIGHT_GRID_POWER * alias_pmf(&ls->table, i) + (1 - LIGHT_GRID_POWER) * (i ? row[i] - row[i - 1] : row[0]);
 }
 
+light_site light_locate(const light_sampler *ls, vec3 p) {
+  light_site at = {p, ls->table.n && ls->grid_cdf ? grid_row(ls, p) : NULL};
+  return at;
+}
 uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf) {
+  light_site at = light_locate(ls, p);
+  return light_select_at(ls, s, &at, u, pmf);
+}
+uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
+  vec3 p = at->p;
   if (ls->grid_cdf) {
-    const float *row = grid_row(ls, p);
+    const float *row = at->row;
     if (!row) return alias_sample(&ls->table, u, pmf);
     uint32_t i;
     const float a = LIGHT_GRID_POWER;

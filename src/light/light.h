@@ -40,6 +40,11 @@ void light_sampler_free(light_sampler *ls);
 /* Picks a light for shading point p with u in [0,1); returns its index and *pmf, or
  * UINT32_MAX when no light can reach p. */
 uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf);
+/* Several selections at one point: light_locate finds p's grid cell once, and
+ * light_select_at then picks exactly as light_select(ls, s, p, u, pmf) would. */
+typedef struct light_site { vec3 p; const float *row; } light_site;
+light_site light_locate(const light_sampler *ls, vec3 p);
+uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf);
 /* The probability light_select picks light li at p. */
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p);
 
