@@ -273,8 +273,14 @@ static float solid_angle_if_used(const scene *s, const light *l, vec3 p, vec3 di
   return omega > 0 && omega <= SPH_MAX_SOLID_ANGLE ? omega : 0;
 }
 
-/* Surface UV of point pl on area light l's triangle (barycentrics clamped into it). */
+/* Does area light l's emission have a texture (else its radiance needs no UV)? */
+static inline int area_textured(const scene *s, const light *l) { return s->mats[s->tri_mat[l->tri]].tex_ke >= 0; }
+
+/* Surface UV of point pl on area light l's triangle (barycentrics clamped into it); 0, 0
+ * when its emission has no texture. */
 static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float *tv) {
+  *tu = *tv = 0;
+  if (!area_textured(s, l)) return;
   const uint32_t *ix = &s->idx[3 * l->tri];
   vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
   vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), q = v3_sub(pl, a);
@@ -352,8 +358,8 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     vec3 wi = v3_scale(d, 1 / dist);
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
-    float tu, tv;
-    scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+    float tu = 0, tv = 0;
+    if (area_textured(s, l)) scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
     o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
     if (c3_black(o->L)) return 0;
     o->wi = wi; o->dist = dist; o->p_light = pl; o->n_light = n;
