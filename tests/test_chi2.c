@@ -506,7 +506,7 @@ static double light_pf(void *c, vec3 d) {
   float t, b1, b2;
   if (!tri_intersect(&sh, v, INFINITY, &t, &b1, &b2)) return 0;
   vec3 pl = v3_add(x->p, v3_scale(d, t));
-  return light_pdf_area(x->s, &x->l, x->p, pl, v3_norm(scene_tri_ng(x->s, x->l.tri)));
+  return light_pdf_area(&x->l, x->p, pl, v3_norm(scene_tri_ng(x->s, x->l.tri)));
 }
 static int light_sampling(void) {
   scene *s = scene_new("chi2");
@@ -519,7 +519,8 @@ static int light_sampling(void) {
   m.emission = c3(1, 1, 1);
   CHECK(scene_add_material(s, &m) == 0, "material");
   light_ctx c = {s, {0}, v3(0.2f, 0.1f, 0.3f)};
-  c.l.type = LIGHT_AREA; c.l.tri = 0; c.l.area = 0.5f * v3_len(scene_tri_ng(s, 0)); c.l.L = c3(1, 1, 1); c.l.two_sided = 1;
+  scene_area_light(s, 0, &c.l);
+  c.l.L = c3(1, 1, 1); c.l.two_sided = 1;
   int rc = run_chi2("area light (triangle) from a point", &c, light_sf, light_pf);
   c.p = v3(0.1f, 1.9f, 0.0f); /* close: strongly varying density */
   rc |= run_chi2("area light (triangle) from a close point", &c, light_sf, light_pf);
@@ -547,7 +548,7 @@ static int light_sampling(void) {
       if (j > 9) j = 9;
       if (i + j > 9) { if (i > j) i = 9 - j; else j = 9 - i; }
       obs[i * 10 + j]++;
-      double expect = light_pdf_area(s, &c.l, pf, li.p_light, li.n_light);
+      double expect = light_pdf_area(&c.l, pf, li.p_light, li.n_light);
       double rel = fabs(li.pdf - expect) / expect;
       if (rel > worst_pdf) worst_pdf = rel;
     }

@@ -9,10 +9,9 @@
 
 rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v) {
   rgb L = light_area_emitted(l, ng, w);
-  const material *m = &s->mats[s->tri_mat[l->tri]];
-  if (m->tex_ke < 0 || c3_black(L)) return L;
+  if (l->tex_ke < 0 || c3_black(L)) return L;
   float px[4];
-  texture_lookup(&s->tex[m->tex_ke], u, v, px);
+  texture_lookup(&s->tex[l->tex_ke], u, v, px);
   return c3_mul(L, c3(px[0], px[1], px[2]));
 }
 
@@ -138,17 +137,16 @@ void light_sampler_free(light_sampler *ls) {
 }
 
 /* Can light l send anything to p? Only one-sided area lights can be turned away. */
-static int light_faces(const scene *s, const light *l, vec3 p) {
+static int light_faces(const light *l, vec3 p) {
   if (l->type != LIGHT_AREA || l->two_sided) return 1;
-  const uint32_t *ix = &s->idx[3 * l->tri];
-  return v3_dot(scene_tri_ng(s, l->tri), v3_sub(p, s->pos[ix[0]])) > 0;
+  return v3_dot(l->ng, v3_sub(p, l->v[0])) > 0;
 }
 
 /* The local selection weights at p (power, 0 for lights facing away) and their sum, in
  * one order, so light_select and light_select_pmf agree to the bit. */
 static float facing_weights(const light_sampler *ls, const scene *s, vec3 p, float w[LIGHT_LOCAL_MAX]) {
   float total = 0;
-  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(s, &s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
+  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(&s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
   return total;
 }
 
@@ -248,16 +246,13 @@ static float spot_falloff(const light *l, float cos_t) {
 #define SPH_MAX_SOLID_ANGLE 6.22f
 /* A cheap stand-in for the solid angle that decides the method: area / d^2 to the
  * centroid (no trigonometry). */
-static float tri_solid_angle_est(const scene *s, const light *l, vec3 p) {
-  const uint32_t *ix = &s->idx[3 * l->tri];
-  vec3 cen = v3_scale(v3_add(v3_add(s->pos[ix[0]], s->pos[ix[1]]), s->pos[ix[2]]), 1.0f / 3);
-  float d2 = v3_len2(v3_sub(cen, p));
+static float tri_solid_angle_est(const light *l, vec3 p) {
+  float d2 = v3_len2(v3_sub(l->centroid, p));
   return d2 > 0 ? l->area / d2 : INFINITY;
 }
-static float tri_solid_angle(const scene *s, const light *l, vec3 p, vec3 dir[3]) {
-  const uint32_t *ix = &s->idx[3 * l->tri];
+static float tri_solid_angle(const light *l, vec3 p, vec3 dir[3]) {
   for (int k = 0; k < 3; k++) {
-    vec3 d = v3_sub(s->pos[ix[k]], p);
+    vec3 d = v3_sub(l->v[k], p);
     float len = v3_len(d);
     if (!(len > 0)) return 0;
     dir[k] = v3_scale(d, 1 / len);
@@ -267,22 +262,21 @@ static float tri_solid_angle(const scene *s, const light *l, vec3 p, vec3 dir[3]
 }
 /* The solid angle of area light l from p if it is to be sampled by solid angle (directions
  * to its vertices in dir), else 0: the one decision light_sample and light_pdf_area share. */
-static float solid_angle_if_used(const scene *s, const light *l, vec3 p, vec3 dir[3]) {
-  if (tri_solid_angle_est(s, l, p) < SPH_MIN_SOLID_ANGLE) return 0;
-  float omega = tri_solid_angle(s, l, p, dir);
+static float solid_angle_if_used(const light *l, vec3 p, vec3 dir[3]) {
+  if (tri_solid_angle_est(l, p) < SPH_MIN_SOLID_ANGLE) return 0;
+  float omega = tri_solid_angle(l, p, dir);
   return omega > 0 && omega <= SPH_MAX_SOLID_ANGLE ? omega : 0;
 }
 
 /* Does area light l's emission have a texture (else its radiance needs no UV)? */
-static inline int area_textured(const scene *s, const light *l) { return s->mats[s->tri_mat[l->tri]].tex_ke >= 0; }
+static inline int area_textured(const light *l) { return l->tex_ke >= 0; }
 
 /* Surface UV of point pl on area light l's triangle (barycentrics clamped into it); 0, 0
  * when its emission has no texture. */
 static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float *tv) {
   *tu = *tv = 0;
-  if (!area_textured(s, l)) return;
-  const uint32_t *ix = &s->idx[3 * l->tri];
-  vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+  if (!area_textured(l)) return;
+  vec3 a = l->v[0], b = l->v[1], c = l->v[2];
   vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), q = v3_sub(pl, a);
   float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), q1 = v3_dot(q, e1), q2 = v3_dot(q, e2);
   float den = d11 * d22 - d12 * d12;
@@ -299,7 +293,7 @@ int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o
     float d2 = v3_len2(d);
     if (!(d2 > 0)) return 0;
     float dist = sqrtf(d2);
-    vec3 wi = v3_scale(d, 1 / dist), n = v3_norm(scene_tri_ng(s, l->tri));
+    vec3 wi = v3_scale(d, 1 / dist), n = l->n;
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
     float tu, tv;
@@ -325,11 +319,10 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
   o->delta = 0;
   switch (l->type) {
   case LIGHT_AREA: {
-    const uint32_t *ix = &s->idx[3 * l->tri];
-    vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
-    vec3 n = v3_norm(scene_tri_ng(s, l->tri));
+    vec3 a = l->v[0], b = l->v[1], c = l->v[2];
+    vec3 n = l->n;
     vec3 dir[3];
-    float omega = solid_angle_if_used(s, l, p, dir);
+    float omega = solid_angle_if_used(l, p, dir);
     float b0, b1;
     vec3 pl;
     if (omega > 0) {
@@ -359,7 +352,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
     float tu = 0, tv = 0;
-    if (area_textured(s, l)) scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+    if (area_textured(l)) scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
     o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
     if (c3_black(o->L)) return 0;
     o->wi = wi; o->dist = dist; o->p_light = pl; o->n_light = n;
@@ -399,9 +392,9 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
   return 0;
 }
 
-float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 pl, vec3 nl) {
+float light_pdf_area(const light *l, vec3 p, vec3 pl, vec3 nl) {
   vec3 dir[3];
-  float omega = solid_angle_if_used(s, l, p, dir);
+  float omega = solid_angle_if_used(l, p, dir);
   if (omega > 0) return 1 / omega;
   vec3 d = v3_sub(pl, p);
   float d2 = v3_len2(d);

@@ -68,7 +68,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
 int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g);
 /* Solid-angle density with which light_sample picks direction wi from p to point
  * p_light with normal n_light on area light l (env: the direction alone). */
-float light_pdf_area(const scene *s, const light *l, vec3 p, vec3 p_light, vec3 n_light);
+float light_pdf_area(const light *l, vec3 p, vec3 p_light, vec3 n_light);
 float light_pdf_env(const scene *s, const light *l, vec3 wi);
 /* Radiance the environment sends along -wi (i.e. arriving from direction wi). */
 rgb light_env_radiance(const scene *s, const light *l, vec3 wi);

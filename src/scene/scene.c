@@ -86,6 +86,19 @@ int scene_add_light(scene *s, const light *l) {
   return 0;
 }
 
+void scene_area_light(const scene *s, uint32_t t, light *l) {
+  memset(l, 0, sizeof *l);
+  l->type = LIGHT_AREA;
+  l->tri = t;
+  const uint32_t *ix = &s->idx[3 * t];
+  for (int k = 0; k < 3; k++) l->v[k] = s->pos[ix[k]];
+  l->ng = scene_tri_ng(s, t);
+  l->n = v3_norm(l->ng);
+  l->area = 0.5f * v3_len(l->ng);
+  l->centroid = v3_scale(v3_add(v3_add(l->v[0], l->v[1]), l->v[2]), 1.0f / 3);
+  l->tex_ke = s->mats[s->tri_mat[t]].tex_ke;
+}
+
 static int add_texture(scene *s, texture *t, const char *key) {
   snprintf(t->key, sizeof t->key, "%s", key);
   if (grow((void **)&s->tex, &s->cap_tex, (uint64_t)s->ntex + 1, sizeof *t)) { texture_free(t); return -1; }
@@ -224,10 +237,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
     if (m->tex_alpha >= 0 && (s->tri_flags[t] & TRI_HAS_UVS)) s->tri_flags[t] |= TRI_ALPHA;
     if (c3_black(m->emission)) continue;
     light l;
-    memset(&l, 0, sizeof l);
-    l.type = LIGHT_AREA;
-    l.tri = t;
-    l.area = 0.5f * v3_len(scene_tri_ng(s, t));
+    scene_area_light(s, t, &l);
     l.L = m->emission;
     l.two_sided = m->two_sided;
     if (!(l.area > 0)) continue;

@@ -61,6 +61,12 @@ typedef struct light {
   uint32_t tri;    /* area: triangle index */
   float area;      /* area: triangle area */
   int two_sided;
+  /* area, filled by scene_area_light: copies of what sampling the light reads, so that
+   * it does not chase the triangle's indices and material */
+  vec3 v[3];       /* its vertices */
+  vec3 ng, n;      /* scene_tri_ng and its unit vector */
+  vec3 centroid;   /* (v0 + v1 + v2) / 3 */
+  int tex_ke;      /* its material's emission texture, -1: none */
 } light;
 
 typedef struct camera {
@@ -132,6 +138,9 @@ void scene_free(scene *s);
 int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris);
 uint32_t scene_add_material(scene *s, const material *m); /* UINT32_MAX on OOM */
 int scene_add_light(scene *s, const light *l);
+/* An area light on triangle t: type, tri, area and the copies above (L and two_sided are
+ * the caller's). */
+void scene_area_light(const scene *s, uint32_t t, light *l);
 material material_default(void);
 /* Adds (or finds, by key) a texture from a file; returns its index, or -1 when it cannot
  * be read: with err, err says why (the caller refuses the scene); without, a warning
