@@ -83,6 +83,7 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
   r->M = (float)M;
   r->W = phat_kept > 0 ? r->w_sum / (r->M * phat_kept) : 0;
   if (phat_kept > 0) {
+    /* evaluated as merges and shading would evaluate it here, so they read the same bits */
     light_li li;
     r->p = restir_di_target(c, it, b, fr, wo, &r->y, &r->f, &li);
     if (!(r->p > 0)) r->f = c3(0, 0, 0);

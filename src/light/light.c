@@ -57,14 +57,13 @@ static int grid_build(light_sampler *ls, const scene *s) {
     float pw = ls->power[i];
     switch (l->type) {
     case LIGHT_AREA: {
-      const uint32_t *ix = &s->idx[3 * l->tri];
-      vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
-      g->c = v3_scale(v3_add(v3_add(a, b), c), 1.0f / 3);
+      vec3 a = l->v[0], b = l->v[1], c = l->v[2];
+      g->c = l->centroid;
       g->r = sqrtf(fmaxf(v3_len2(v3_sub(a, g->c)), fmaxf(v3_len2(v3_sub(b, g->c)), v3_len2(v3_sub(c, g->c)))));
       g->w_far = pw / PI_F;
       g->local = 1;
       g->one_sided = !l->two_sided;
-      g->n = scene_tri_ng(s, l->tri);
+      g->n = l->ng;
       g->d = -v3_dot(g->n, a);
       break;
     }
@@ -268,14 +267,11 @@ static float solid_angle_if_used(const light *l, vec3 p, vec3 dir[3]) {
   return omega > 0 && omega <= SPH_MAX_SOLID_ANGLE ? omega : 0;
 }
 
-/* Does area light l's emission have a texture (else its radiance needs no UV)? */
-static inline int area_textured(const light *l) { return l->tex_ke >= 0; }
-
 /* Surface UV of point pl on area light l's triangle (barycentrics clamped into it); 0, 0
  * when its emission has no texture. */
 static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float *tv) {
   *tu = *tv = 0;
-  if (!area_textured(l)) return;
+  if (l->tex_ke < 0) return; /* the radiance reads no UV */
   vec3 a = l->v[0], b = l->v[1], c = l->v[2];
   vec3 e1 = v3_sub(b, a), e2 = v3_sub(c, a), q = v3_sub(pl, a);
   float d11 = v3_dot(e1, e1), d12 = v3_dot(e1, e2), d22 = v3_dot(e2, e2), q1 = v3_dot(q, e1), q2 = v3_dot(q, e2);
@@ -352,7 +348,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
     float tu = 0, tv = 0;
-    if (area_textured(l)) scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+    if (l->tex_ke >= 0) scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
     o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
     if (c3_black(o->L)) return 0;
     o->wi = wi; o->dist = dist; o->p_light = pl; o->n_light = n;
@@ -412,12 +408,11 @@ int light_sample_emit(const scene *s, const light *l, const float u[4], light_em
   o->n = v3(0, 0, 0);
   switch (l->type) {
   case LIGHT_AREA: {
-    const uint32_t *ix = &s->idx[3 * l->tri];
-    vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+    vec3 a = l->v[0], b = l->v[1], c = l->v[2];
     float b0, b1;
     sample_uniform_triangle(u[0], u[1], &b0, &b1);
     o->o = v3_add(v3_add(v3_scale(a, b0), v3_scale(b, b1)), v3_scale(c, 1 - b0 - b1));
-    vec3 n = v3_norm(scene_tri_ng(s, l->tri));
+    vec3 n = l->n;
     float uu = u[2], side = 1;
     if (l->two_sided) { side = uu < 0.5f ? 1.0f : -1.0f; uu = uu < 0.5f ? 2 * uu : 2 * uu - 1; }
     vec3 nn = v3_scale(n, side);
