@@ -5,8 +5,9 @@
  * bunny. Then the kd-tree build on the dragon's four resolutions (N log N growth, 2
  * threads) with the tree's bytes and the build's peak resident bytes per triangle.
  * Prints Markdown tables; scenes come from ../shared/scenes (or VALO_SHARED). --classes
- * instead times camera misses, camera hits and bounce rays apart. Usage: bench_raykernel
- * [--quick] [--only NAME] [--no-build-table] [--classes] */
+ * instead times camera misses, camera hits and bounce rays apart; --bound times the
+ * kd-tree's node walk alone (its leaves free) against the real queries and Embree.
+ * Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] [--classes] [--bound] */
 #include "bench_util.h"
 #include "scene/scene.h"
 #include "load/load.h"
@@ -153,7 +154,56 @@ static void class_table(const char *name, accel *const acc[2], const ray *rays, 
   }
   fflush(stdout);
 }
-static int g_classes;
+static int g_classes, g_bound;
+
+/* --bound: what the kd-tree's node walk alone costs. Each query is traced once
+ * (kdtree_trace); then, alternating, best of REPS, single-threaded: the real queries,
+ * the same walks with no triangle tested (kdtree_walk: leaves cost nothing), and Embree.
+ * walk/Embree is the kd/Embree speed this tree would reach if its leaves were free. */
+static void bound_row(const char *name, const char *kind, accel *const acc[2], const ray *rays, long n, int any) {
+  kd_trace *tr = malloc(sizeof *tr * (size_t)n);
+  if (!tr) return;
+  double sum[5] = {0, 0, 0, 0, 0};
+  long found = 0, wfound = 0, wnodes = 0, wleaves = 0;
+  for (long i = 0; i < n; i++) {
+    found += kdtree_trace(acc[0], &rays[i], any, &tr[i]);
+    sum[0] += tr[i].nodes; sum[1] += tr[i].boxes; sum[2] += tr[i].leaves; sum[3] += tr[i].groups;
+    sum[4] += tr[i].descent;
+  }
+
+  for (long i = 0; i < n; i++) {
+    kd_trace w = tr[i];
+    wfound += kdtree_walk(acc[0], &rays[i], any, &w, 1);
+    wnodes += w.nodes; wleaves += w.leaves;
+  }
+  if (wfound != found || wnodes != (long)sum[0])
+    fprintf(stderr, "note: %s %s: the walk alone finds %ld (trace %ld) and visits %ld nodes (trace %.0f), %ld leaves (%.0f)\n", name, kind,
+            wfound, found, wnodes, sum[0], wleaves, sum[2]);
+  double best[4] = {1e30, 1e30, 1e30, 1e30};
+  volatile long sink = 0;
+  for (int rep = 0; rep < REPS; rep++)
+    for (int k = 0; k < 4; k++) {
+      long c = 0;
+      double t0 = bench_now();
+      for (long i = 0; i < n; i++) {
+        hit h;
+        if (k == 1 || k == 3) { c += kdtree_walk(acc[0], &rays[i], any, &tr[i], k == 1 ? 0 : -1); continue; }
+        const accel *a = acc[k == 0 ? 0 : 1];
+        c += any ? accel_occluded(a, &rays[i]) : accel_intersect(a, &rays[i], &h);
+      }
+      double dt = bench_now() - t0;
+      sink += c;
+      if (dt < best[k]) best[k] = dt;
+    }
+  (void)sink;
+  double m[3];
+  for (int k = 0; k < 3; k++) m[k] = n / best[k] * 1e-6;
+  printf("| %s | %s | %ld | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.0f %% |\n", name, kind, n,
+         sum[0] / n, sum[1] / n, sum[4] / n, sum[2] / n, sum[3] / n, m[0], m[1], m[2], m[0] / m[2], m[1] / m[2], best[2] / (best[0] - best[3]),
+         100 * (1 - best[1] / best[0]), 100 * best[3] / best[0]);
+  fflush(stdout);
+  free(tr);
+}
 
 static void bench_scene(const char *name, scene *s) {
   valo_error err;
@@ -175,8 +225,9 @@ static void bench_scene(const char *name, scene *s) {
   long n, ns;
   ray *sh;
   ray *rays = make_rays(s, acc[1], &n, &sh, &ns);
-  if (g_classes) {
-    class_table(name, acc, rays, n);
+  if (g_classes || g_bound) {
+    if (g_classes) class_table(name, acc, rays, n);
+    else { bound_row(name, "closest hit", acc, rays, n, 0); bound_row(name, "shadow", acc, sh, ns, 1); }
     free(rays); free(sh);
     accel_destroy(acc[0]); accel_destroy(acc[1]);
     return;
@@ -207,10 +258,16 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--no-build-table")) build_table = 0;
     else if (!strcmp(argv[i], "--classes")) g_classes = 1, build_table = 0;
+    else if (!strcmp(argv[i], "--bound")) g_bound = 1, build_table = 0;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|sponza|cornell] [--no-build-table] [--classes]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|sponza|cornell] [--no-build-table] [--classes] [--bound]\n"); return 2; }
   }
-  if (g_classes) {
+  if (g_bound) {
+    printf("## The kd-tree's node walk alone, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
+    printf("| scene | rays | count | nodes per ray | box nodes per ray | descent nodes per ray | leaves per ray | groups of 4 per ray | kd Mrays/s "
+           "| walk alone Mrays/s | Embree Mrays/s | kd/Embree | walk alone/Embree | kd without its descent/Embree | leaves' share of kd time "
+           "| descent's share |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  } else if (g_classes) {
     printf("## Closest-hit rays by class, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
     printf("| scene | rays | count | kd Mrays/s | Embree Mrays/s | kd/Embree |\n|---|---|---|---|---|---|\n");
   } else {

@@ -9,7 +9,7 @@
  * starting exactly on a surface, kd-tree against brute force exactly (except where a ray
  * grazes brute force's triangle so closely that its t's error bound covers the kd-tree's
  * farther hit) and Embree within tolerance (nearly axis-aligned walls fell out of cells
- * they reach). */
+ * they reach). walk_matches_trace checks the instruments of bench_raykernel --bound. */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"
@@ -562,12 +562,61 @@ static int synthetic_threads(void) {
   return 0;
 }
 
+/* bench_raykernel --bound's instruments: a traced query finds what the query finds; the
+ * walk with no triangle tested visits the very nodes and leaves the trace counted and
+ * ends as it did; the descent ends at a leaf exactly when the trace reached one. */
+static int walk_matches_trace(void) {
+  const char *path = shared_file("scenes/models/suzanne.obj");
+  if (!path) return TEST_SKIP;
+  scene *s = scene_new(path);
+  valo_error err;
+  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  accel *a;
+  CHECK(kdtree_create(s->pos, s->idx, s->ntris, 1, NULL, &a, &err) == VALO_OK, "%s", err.message);
+  enum { N = 20000 };
+  ray *rays = malloc(N * sizeof *rays);
+  float *stmax = malloc(N * sizeof *stmax);
+  make_rays(s, rays, stmax, N, 7, 0);
+  int bad = 0, hits = 0, blocked = 0;
+  uint64_t groups = 0, nodes = 0;
+  for (int i = 0; i < N; i++)
+    for (int any = 0; any < 2; any++) {
+      ray r = rays[i];
+      if (any) r.tmax = stmax[i];
+      hit h;
+      kd_trace tr, w;
+      int f = any ? accel_occluded(a, &r) : accel_intersect(a, &r, &h);
+      int ft = kdtree_trace(a, &r, any, &tr);
+      w = tr;
+      int fw = kdtree_walk(a, &r, any, &w, 1);
+      int fd = kdtree_walk(a, &r, any, &tr, -1);
+      int ok = ft == f && fw == f && w.nodes == tr.nodes && w.leaves == tr.leaves && w.boxes == tr.boxes && tr.descent <= tr.nodes &&
+               fd == (tr.leaves > 0) && (!f || tr.end_leaf != UINT32_MAX) && (any || !f || tr.t == h.t);
+      if (!ok && bad++ < 5)
+        fprintf(stderr, "ray %d any=%d: query %d trace %d walk %d descent %d; nodes %u/%u leaves %u/%u boxes %u/%u descent %u\n", i, any, f, ft,
+                fw, fd, tr.nodes, w.nodes, tr.leaves, w.leaves, tr.boxes, w.boxes, tr.descent);
+      hits += !any && f;
+      blocked += any && f;
+      groups += tr.groups;
+      nodes += tr.nodes;
+    }
+  fprintf(stderr, "%d rays: %d hits, %d blocked, %.1f nodes and %.2f groups per query, %d mismatches\n", N, hits, blocked,
+          (double)nodes / (2 * N), (double)groups / (2 * N), bad);
+  accel_destroy(a);
+  free(rays); free(stmax);
+  scene_free(s);
+  CHECK(hits > N / 10 && blocked > N / 20 && groups > 0, "the rays do not test the tree (%d hits, %d blocked)", hits, blocked);
+  CHECK(bad == 0, "%d queries where the walk or the trace differ from the query", bad);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"bunny_kdtree", bunny_kdtree}, {"cornell_kdtree", cornell_kdtree},
                                     {"cornell_sphere_kdtree", cornell_sphere_kdtree}, {"suzanne_kdtree", suzanne_kdtree},
                                     {"axis_rays_kdtree", axis_rays_kdtree}, {"camera_rays_kdtree", camera_rays_kdtree},
                                     {"bunny_embree", bunny_embree}, {"cornell_embree", cornell_embree},
                                     {"large_triangles_corner", large_triangles_corner}, {"alpha_filtered", alpha_filtered},
-                                    {"synthetic_threads", synthetic_threads}, {NULL, NULL}};
+                                    {"synthetic_threads", synthetic_threads}, {"walk_matches_trace", walk_matches_trace}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -8,7 +8,12 @@
 #include <stdint.h>
 
 #define KD_TRAVERSE_COST 1.0f
+#ifndef KD_ISECT_COST /* overridable, like KD_DEPTH_FACTOR, for bench_raykernel --bound's tree-shape sweep */
 #define KD_ISECT_COST 80.0f
+#endif
+#ifndef KD_DEPTH_FACTOR
+#define KD_DEPTH_FACTOR 1.2f /* depth limit 8 + KD_DEPTH_FACTOR log2 N */
+#endif
 #define KD_EMPTY_BONUS 0.5f
 #define KD_LEAF 3u
 #define KD_BELOW_EMPTY 4u /* interior: the child below the plane is an empty leaf, not stored */

@@ -272,7 +272,7 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
    * on the bunny at pbrt's 1.3 log2 N, 3.7 at 1.5). Triangle data is where incoherent
    * rays miss the cache, so 1.2 log2 N: 25 % less memory and 4-10 % faster on bounce
    * rays than 1.3 (A/B in one process; docs/performance.md). */
-  int max_depth = (int)lroundf(8 + 1.2f * log2f((float)(ntris > 1 ? ntris : 1)));
+  int max_depth = (int)lroundf(8 + KD_DEPTH_FACTOR * log2f((float)(ntris > 1 ? ntris : 1)));
   if (max_depth > 60) max_depth = 60;
   /* A tiny mesh is one leaf: testing its triangles four at a time beats any traversal
    * (the SAH prices a triangle test at 80 traversal steps, not a quarter of an SSE group

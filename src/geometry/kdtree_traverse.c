@@ -1,7 +1,8 @@
 /* kdtree_traverse.c — owns the kd-tree's ray queries (layout: kdtree_internal.h):
  * pbrt's stack-based front-to-back traversal with early exit over 8-byte nodes and box
  * nodes, and the watertight test of four leaf triangles at a time (SSE). Closest hit and
- * any hit (shadow rays) share one loop. */
+ * any hit (shadow rays) share one loop; bench_raykernel --bound instruments it
+ * (kdtree_trace, kdtree_walk: accel.h). */
 #include "geometry/kdtree_internal.h"
 #include <stdlib.h>
 #include <string.h>
@@ -31,7 +32,7 @@ static inline int slab_clip(const float f[6], const int fin[3], const int fout[3
  * same operation order, so every lane's t and barycentrics equal the scalar test's bit
  * for bit. A lane whose edge function is exactly zero sends the group to the scalar
  * test (which then re-evaluates in double precision). Returns the nearest hit. */
-static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, uint32_t nvalid, float tmax, float *t_out, float *b1_out,
+static inline __attribute__((always_inline)) int tri4_intersect(const ray_shear *s, const kd_tri4 *g, uint32_t nvalid, float tmax, float *t_out, float *b1_out,
                                  float *b2_out, int *lane_out) {
   const float o[3] = {s->o.x, s->o.y, s->o.z};
   const int kx = s->kx, ky = s->ky, kz = s->kz;
@@ -119,7 +120,13 @@ static inline int tri4_intersect(const ray_shear *s, const kd_tri4 *g, uint32_t 
 typedef struct kd_todo { uint32_t node; float tmin, tmax; } kd_todo;
 
 
-static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
+/* mode: KD_QUERY (the ray queries), KD_TRACE (the query, counting what it visits into tr
+ * and recording the leaf where it ends), KD_WALK (the trace's walk again with no triangle
+ * tested: reaching the trace's end leaf gives its hit), KD_WALK_COUNT (KD_WALK, counting),
+ * KD_DESCENT (the walk's start alone: it ends at the first leaf). mode and any are
+ * constants in each caller, so each gets its own loop. */
+enum { KD_QUERY, KD_TRACE, KD_WALK, KD_WALK_COUNT, KD_DESCENT };
+static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, const ray *r, hit *h, int any, int mode, kd_trace *tr) {
   vec3 inv = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
   float tmin = 0, tmax = r->tmax;
   float o[3] = {r->o.x, r->o.y, r->o.z}, id[3] = {inv.x, inv.y, inv.z};
@@ -142,9 +149,11 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
     if (best < tmin) goto pop;
     const kd_node *n = &nodes[ni];
     uint32_t axis = n->flags & 3;
+    if (mode == KD_TRACE || mode == KD_WALK_COUNT) tr->nodes++;
     if (axis != KD_LEAF) {
       uint32_t fl = n->flags;
       if ((fl & KD_BOX) == KD_BOX) {
+        if (mode == KD_TRACE || mode == KD_WALK_COUNT) tr->boxes++;
         /* Clip [tmin, tmax] to the box, exactly as its chain of cuts would have (a NaN,
          * ray in a face's plane, passes as the cut would have let it through). */
         float f[6];
@@ -173,11 +182,23 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
       continue;
     }
     uint32_t cnt = n->flags >> 2;
+    if (mode == KD_TRACE && tr->leaves == 0) tr->descent = tr->nodes;
+    if (mode == KD_TRACE || mode == KD_WALK_COUNT) tr->leaves++;
+    if (mode == KD_DESCENT) return 1;
+    if (mode == KD_WALK || mode == KD_WALK_COUNT) {
+      if (ni == tr->end_leaf) {
+        if (any) return 1;
+        best = tr->t;
+        found = 1;
+      }
+      goto pop;
+    }
     uint32_t gi = n->prim_offset;
     const kd_tri4 *g = &kd->prims[gi];
     for (uint32_t i = 0; i < cnt; i += 4, g++, gi++) {
       float t = 0, b1 = 0, b2 = 0;
       int lane;
+      if (mode == KD_TRACE) tr->groups++;
       if (kd->has_filter && kd->gfilt[gi]) {
         /* Alpha-tested triangles: lane by lane, each hit through the filter. */
         const uint32_t *gid = &kd->ids[4 * (size_t)gi];
@@ -188,6 +209,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
             for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
           if (!tri_intersect(&sh, tv, best, &t, &b1, &b2)) continue;
           if (((kd->gfilt[gi] >> k) & 1) && !kd->filter.pass(kd->filter.user, gid[k], b1, b2)) continue;
+          if (mode == KD_TRACE) tr->end_leaf = ni, tr->t = t;
           if (any) return 1;
           best = t;
           found = 1;
@@ -196,6 +218,7 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
         continue;
       }
       if (tri4_intersect(&sh, g, cnt - i, best, &t, &b1, &b2, &lane)) {
+        if (mode == KD_TRACE) tr->end_leaf = ni, tr->t = t;
         if (any) return 1;
         best = t;
         found = 1;
@@ -210,8 +233,28 @@ static inline int kd_query(const kdtree *kd, const ray *r, hit *h, int any) {
   return found;
 }
 
-static int kd_intersect(const accel *a, const ray *r, hit *h) { return kd_query((const kdtree *)a, r, h, 0); }
-static int kd_occluded(const accel *a, const ray *r) { hit h; return kd_query((const kdtree *)a, r, &h, 1); }
+/* One loop for both queries, any decided at run time: separate closest-hit and any-hit
+ * copies were measured slower (docs/performance.md). */
+static __attribute__((noinline)) int kd_ray_query(const kdtree *kd, const ray *r, hit *h, int any) { return kd_query(kd, r, h, any, KD_QUERY, NULL); }
+static int kd_intersect(const accel *a, const ray *r, hit *h) { return kd_ray_query((const kdtree *)a, r, h, 0); }
+static int kd_occluded(const accel *a, const ray *r) { hit h; return kd_ray_query((const kdtree *)a, r, &h, 1); }
+int kdtree_trace(const accel *a, const ray *r, int any, kd_trace *tr) {
+  hit h;
+  memset(tr, 0, sizeof *tr);
+  tr->end_leaf = UINT32_MAX;
+  int found = any ? kd_query((const kdtree *)a, r, &h, 1, KD_TRACE, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_TRACE, tr);
+  if (tr->leaves == 0) tr->descent = tr->nodes;
+  return found;
+}
+int kdtree_walk(const accel *a, const ray *r, int any, kd_trace *tr, int count) {
+  hit h;
+  if (count < 0) return kd_query((const kdtree *)a, r, &h, 1, KD_DESCENT, tr);
+  if (count) {
+    tr->nodes = tr->boxes = tr->leaves = 0;
+    return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK_COUNT, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK_COUNT, tr);
+  }
+  return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK, tr);
+}
 void kdtree_free(kdtree *kd) {
   if (!kd) return;
   free(kd->tv); free(kd->nodes); free(kd->prims); free(kd->ids); free(kd->gfilt); free(kd);
