@@ -6,7 +6,8 @@
  * threads) with the tree's bytes and the build's peak resident bytes per triangle.
  * Prints Markdown tables; scenes come from ../shared/scenes (or VALO_SHARED). --classes
  * instead times camera misses, camera hits and bounce rays apart; --bound times the
- * kd-tree's node walk alone (its leaves free) against the real queries and Embree.
+ * kd-tree's node walk alone (its leaves free) against the real queries and Embree, and
+ * the share of triangle groups a query tests again (what mailboxing could skip).
  * Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] [--classes] [--bound] */
 #include "bench_util.h"
 #include "scene/scene.h"
@@ -163,12 +164,13 @@ static int g_classes, g_bound;
 static void bound_row(const char *name, const char *kind, accel *const acc[2], const ray *rays, long n, int any) {
   kd_trace *tr = malloc(sizeof *tr * (size_t)n);
   if (!tr) return;
-  double sum[5] = {0, 0, 0, 0, 0};
+  double sum[6] = {0, 0, 0, 0, 0, 0};
   long found = 0, wfound = 0, wnodes = 0, wleaves = 0;
   for (long i = 0; i < n; i++) {
     found += kdtree_trace(acc[0], &rays[i], any, &tr[i]);
     sum[0] += tr[i].nodes; sum[1] += tr[i].boxes; sum[2] += tr[i].leaves; sum[3] += tr[i].groups;
     sum[4] += tr[i].descent;
+    sum[5] += tr[i].dup_groups;
   }
 
   for (long i = 0; i < n; i++) {
@@ -198,9 +200,9 @@ static void bound_row(const char *name, const char *kind, accel *const acc[2], c
   (void)sink;
   double m[3];
   for (int k = 0; k < 3; k++) m[k] = n / best[k] * 1e-6;
-  printf("| %s | %s | %ld | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.0f %% |\n", name, kind, n,
+  printf("| %s | %s | %ld | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f %% | %.0f %% | %.1f %% |\n", name, kind, n,
          sum[0] / n, sum[1] / n, sum[4] / n, sum[2] / n, sum[3] / n, m[0], m[1], m[2], m[0] / m[2], m[1] / m[2], best[2] / (best[0] - best[3]),
-         100 * (1 - best[1] / best[0]), 100 * best[3] / best[0]);
+         100 * (1 - best[1] / best[0]), 100 * best[3] / best[0], 100 * sum[5] / (sum[3] > 0 ? sum[3] : 1));
   fflush(stdout);
   free(tr);
 }
@@ -266,7 +268,7 @@ int main(int argc, char **argv) {
     printf("## The kd-tree's node walk alone, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
     printf("| scene | rays | count | nodes per ray | box nodes per ray | descent nodes per ray | leaves per ray | groups of 4 per ray | kd Mrays/s "
            "| walk alone Mrays/s | Embree Mrays/s | kd/Embree | walk alone/Embree | kd without its descent/Embree | leaves' share of kd time "
-           "| descent's share |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+           "| descent's share | groups tested again |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   } else if (g_classes) {
     printf("## Closest-hit rays by class, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
     printf("| scene | rays | count | kd Mrays/s | Embree Mrays/s | kd/Embree |\n|---|---|---|---|---|---|\n");

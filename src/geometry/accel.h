@@ -59,7 +59,9 @@ void kdtree_stats(const accel *a, kd_stats *st);
  * from tr when it reaches that leaf (count > 0: recounting nodes, boxes and leaves into
  * tr; count < 0: only the descent to the first leaf the ray reaches, which a traversal
  * starting at the leaf of the ray's origin would skip). */
-typedef struct kd_trace { uint32_t nodes, boxes, leaves, groups, descent, end_leaf; float t; } kd_trace; /* descent: nodes up to the first leaf, it included (all when none) */
+/* descent: nodes up to the first leaf, it included (all when none); dup_groups: groups
+ * whose every triangle the query had tested in an earlier leaf (mailboxing's most). */
+typedef struct kd_trace { uint32_t nodes, boxes, leaves, groups, dup_groups, descent, end_leaf; float t; } kd_trace;
 int kdtree_trace(const accel *a, const ray *r, int any, kd_trace *tr);
 int kdtree_walk(const accel *a, const ray *r, int any, kd_trace *tr, int count);
 #endif

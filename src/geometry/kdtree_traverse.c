@@ -126,7 +126,25 @@ typedef struct kd_todo { uint32_t node; float tmin, tmax; } kd_todo;
  * KD_DESCENT (the walk's start alone: it ends at the first leaf). mode and any are
  * constants in each caller, so each gets its own loop. */
 enum { KD_QUERY, KD_TRACE, KD_WALK, KD_WALK_COUNT, KD_DESCENT };
-static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, const ray *r, hit *h, int any, int mode, kd_trace *tr) {
+/* KD_TRACE: the triangles a query has tested so far, to count the groups it tests again
+ * (all their triangles already tested in an earlier leaf: what mailboxing could skip). */
+#define KD_SEEN_MAX 2048u
+typedef struct kd_seen { uint32_t n, id[KD_SEEN_MAX]; } kd_seen;
+static void trace_group(const kdtree *kd, uint32_t gi, uint32_t nvalid, kd_trace *tr, kd_seen *seen) {
+  int all = 1;
+  tr->groups++;
+  for (uint32_t k = 0; k < 4 && k < nvalid; k++) {
+    uint32_t t = kd->ids[4 * (size_t)gi + k], q = 0;
+    while (q < seen->n && seen->id[q] != t) q++;
+    if (q < seen->n) continue;
+    all = 0;
+    if (seen->n < KD_SEEN_MAX) seen->id[seen->n++] = t;
+  }
+  tr->dup_groups += (uint32_t)all;
+}
+
+static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, const ray *r, hit *h, int any, int mode, kd_trace *tr,
+                                                          kd_seen *seen) {
   vec3 inv = v3(1.0f / r->d.x, 1.0f / r->d.y, 1.0f / r->d.z);
   float tmin = 0, tmax = r->tmax;
   float o[3] = {r->o.x, r->o.y, r->o.z}, id[3] = {inv.x, inv.y, inv.z};
@@ -198,7 +216,7 @@ static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, cons
     for (uint32_t i = 0; i < cnt; i += 4, g++, gi++) {
       float t = 0, b1 = 0, b2 = 0;
       int lane;
-      if (mode == KD_TRACE) tr->groups++;
+      if (mode == KD_TRACE) trace_group(kd, gi, cnt - i, tr, seen);
       if (kd->has_filter && kd->gfilt[gi]) {
         /* Alpha-tested triangles: lane by lane, each hit through the filter. */
         const uint32_t *gid = &kd->ids[4 * (size_t)gi];
@@ -235,25 +253,27 @@ static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, cons
 
 /* One loop for both queries, any decided at run time: separate closest-hit and any-hit
  * copies were measured slower (docs/performance.md). */
-static __attribute__((noinline)) int kd_ray_query(const kdtree *kd, const ray *r, hit *h, int any) { return kd_query(kd, r, h, any, KD_QUERY, NULL); }
+static __attribute__((noinline)) int kd_ray_query(const kdtree *kd, const ray *r, hit *h, int any) { return kd_query(kd, r, h, any, KD_QUERY, NULL, NULL); }
 static int kd_intersect(const accel *a, const ray *r, hit *h) { return kd_ray_query((const kdtree *)a, r, h, 0); }
 static int kd_occluded(const accel *a, const ray *r) { hit h; return kd_ray_query((const kdtree *)a, r, &h, 1); }
 int kdtree_trace(const accel *a, const ray *r, int any, kd_trace *tr) {
   hit h;
   memset(tr, 0, sizeof *tr);
   tr->end_leaf = UINT32_MAX;
-  int found = any ? kd_query((const kdtree *)a, r, &h, 1, KD_TRACE, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_TRACE, tr);
+  kd_seen seen;
+  seen.n = 0;
+  int found = any ? kd_query((const kdtree *)a, r, &h, 1, KD_TRACE, tr, &seen) : kd_query((const kdtree *)a, r, &h, 0, KD_TRACE, tr, &seen);
   if (tr->leaves == 0) tr->descent = tr->nodes;
   return found;
 }
 int kdtree_walk(const accel *a, const ray *r, int any, kd_trace *tr, int count) {
   hit h;
-  if (count < 0) return kd_query((const kdtree *)a, r, &h, 1, KD_DESCENT, tr);
+  if (count < 0) return kd_query((const kdtree *)a, r, &h, 1, KD_DESCENT, tr, NULL);
   if (count) {
     tr->nodes = tr->boxes = tr->leaves = 0;
-    return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK_COUNT, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK_COUNT, tr);
+    return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK_COUNT, tr, NULL) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK_COUNT, tr, NULL);
   }
-  return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK, tr) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK, tr);
+  return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK, tr, NULL) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK, tr, NULL);
 }
 void kdtree_free(kdtree *kd) {
   if (!kd) return;
