@@ -123,8 +123,8 @@ typedef struct kd_todo { uint32_t node; float tmin, tmax; } kd_todo;
 /* mode: KD_QUERY (the ray queries), KD_TRACE (the query, counting what it visits into tr
  * and recording the leaf where it ends), KD_WALK (the trace's walk again with no triangle
  * tested: reaching the trace's end leaf gives its hit), KD_WALK_COUNT (KD_WALK, counting),
- * KD_DESCENT (the walk's start alone: it ends at the first leaf). mode and any are
- * constants in each caller, so each gets its own loop. */
+ * KD_DESCENT (the walk's start alone: it ends at the first leaf). mode is a constant in
+ * each caller, so each mode gets its own loop; any is one too, except in kd_ray_query. */
 enum { KD_QUERY, KD_TRACE, KD_WALK, KD_WALK_COUNT, KD_DESCENT };
 /* KD_TRACE: the triangles a query has tested so far, to count the groups it tests again
  * (all their triangles already tested in an earlier leaf: what mailboxing could skip). */
