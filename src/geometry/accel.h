@@ -52,14 +52,13 @@ int embree_available(void);
 /* Statistics of a built kd-tree (for benchmarks and tests). */
 typedef struct kd_stats { uint32_t nodes, leaves, empty_leaves, max_depth; uint64_t refs; size_t bytes; } kd_stats;
 void kdtree_stats(const accel *a, kd_stats *st);
-/* For bench_raykernel's bound on what faster leaves could give: kdtree_trace runs a
- * query (any: any hit) counting the nodes (box nodes among them), leaves and triangle
- * groups it visits, and the nodes of its descent and recording the leaf node where it ended (its hit found or its
- * blocker) with t; kdtree_walk repeats the walk with no triangle tested, taking the hit
- * from tr when it reaches that leaf (count > 0: recounting nodes, boxes and leaves into
- * tr; count < 0: only the descent to the first leaf the ray reaches, which a traversal
- * starting at the leaf of the ray's origin would skip). */
-/* descent: nodes up to the first leaf, it included (all when none); dup_groups: groups
+/* For bench_raykernel's bound on what faster leaves could give. kdtree_trace runs a
+ * query (any: any hit), counting into tr what it visits, and records the leaf node where
+ * it ended (its hit or its blocker found there) with that t. kdtree_walk repeats the
+ * walk with no triangle tested, taking the hit from tr when it reaches that leaf; with
+ * count > 0 it recounts nodes, boxes and leaves into tr, with count < 0 it walks only
+ * the descent to the first leaf (what a traversal starting at the origin's leaf skips).
+ * descent: nodes up to the first leaf, it included (all when none); dup_groups: groups
  * whose every triangle the query had tested in an earlier leaf (mailboxing's most). */
 typedef struct kd_trace { uint32_t nodes, boxes, leaves, groups, dup_groups, descent, end_leaf; float t; } kd_trace;
 int kdtree_trace(const accel *a, const ray *r, int any, kd_trace *tr);

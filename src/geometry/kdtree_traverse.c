@@ -124,7 +124,8 @@ typedef struct kd_todo { uint32_t node; float tmin, tmax; } kd_todo;
  * and recording the leaf where it ends), KD_WALK (the trace's walk again with no triangle
  * tested: reaching the trace's end leaf gives its hit), KD_WALK_COUNT (KD_WALK, counting),
  * KD_DESCENT (the walk's start alone: it ends at the first leaf). mode is a constant in
- * each caller, so each mode gets its own loop; any is one too, except in kd_ray_query. */
+ * each caller, so each mode gets its own loop; any is decided at run time in all of them,
+ * so the timed walks have the ray queries' loop shape. */
 enum { KD_QUERY, KD_TRACE, KD_WALK, KD_WALK_COUNT, KD_DESCENT };
 /* KD_TRACE: the triangles a query has tested so far, to count the groups it tests again
  * (all their triangles already tested in an earlier leaf: what mailboxing could skip). */
@@ -262,18 +263,17 @@ int kdtree_trace(const accel *a, const ray *r, int any, kd_trace *tr) {
   tr->end_leaf = UINT32_MAX;
   kd_seen seen;
   seen.n = 0;
-  int found = any ? kd_query((const kdtree *)a, r, &h, 1, KD_TRACE, tr, &seen) : kd_query((const kdtree *)a, r, &h, 0, KD_TRACE, tr, &seen);
+  int found = kd_query((const kdtree *)a, r, &h, any, KD_TRACE, tr, &seen);
   if (tr->leaves == 0) tr->descent = tr->nodes;
   return found;
 }
 int kdtree_walk(const accel *a, const ray *r, int any, kd_trace *tr, int count) {
   hit h;
-  if (count < 0) return kd_query((const kdtree *)a, r, &h, 1, KD_DESCENT, tr, NULL);
-  if (count) {
-    tr->nodes = tr->boxes = tr->leaves = 0;
-    return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK_COUNT, tr, NULL) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK_COUNT, tr, NULL);
-  }
-  return any ? kd_query((const kdtree *)a, r, &h, 1, KD_WALK, tr, NULL) : kd_query((const kdtree *)a, r, &h, 0, KD_WALK, tr, NULL);
+  const kdtree *kd = (const kdtree *)a;
+  if (count < 0) return kd_query(kd, r, &h, any, KD_DESCENT, tr, NULL);
+  if (count == 0) return kd_query(kd, r, &h, any, KD_WALK, tr, NULL);
+  tr->nodes = tr->boxes = tr->leaves = 0;
+  return kd_query(kd, r, &h, any, KD_WALK_COUNT, tr, NULL);
 }
 void kdtree_free(kdtree *kd) {
   if (!kd) return;
