@@ -5,8 +5,8 @@
  * list splitting and exact clipping of straddling triangles to the child voxels — and
  * the leaves: triangles in leaf order in SSE groups of four, tested four at a time
  * (1.3-1.5x faster than one by one; docs/performance.md). Also the clipping both build
- * phases use, and the box nodes made once the tree is joined. SAH constants from digest
- * 000: traversal cost 1, intersection cost 80, empty bonus 0.5. */
+ * phases use, and the box nodes made once the tree is joined. SAH costs: digest 000's
+ * formula with leaves priced by groups of four (kdtree_internal.h), empty bonus 0.5. */
 #include "geometry/kdtree_internal.h"
 #include "core/error.h"
 #include <math.h>
@@ -250,7 +250,7 @@ static kd_event *merge(kd_event *a, uint32_t na, kd_event *b, uint32_t nb, uint3
   return o;
 }
 
-static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, int bad_refines) {
+static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) {
   kdtree *kd = b->kd;
   uint32_t N = l->ntris;
   if ((uint32_t)(kd->max_depth_seen) < (uint32_t)depth) kd->max_depth_seen = (uint32_t)depth;
@@ -282,7 +282,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
         for (int planar_left = 0; planar_left < 1 + (np > 0); planar_left++) {
           uint32_t cl = nl + (planar_left ? np : 0), cr = nr + (planar_left ? 0 : np);
           float eb = (cl == 0 || cr == 0) ? KD_EMPTY_BONUS : 0.0f;
-          float cost = KD_TRAVERSE_COST + KD_ISECT_COST * (1.0f - eb) * (pl * (float)cl + pr * (float)cr);
+          float cost = KD_TRAVERSE_COST + (1.0f - eb) * (pl * kd_leaf_cost(cl) + pr * kd_leaf_cost(cr));
           if (cost < best_cost) { best_cost = cost; best_pos = p; best_axis = k; best_planar_left = planar_left; }
         }
       }
@@ -290,9 +290,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
       np = 0;
     }
   }
-  float leaf_cost = KD_ISECT_COST * (float)N;
-  if (best_cost > leaf_cost) bad_refines++;
-  if (best_axis < 0 || (best_cost > 4 * leaf_cost && N < 16) || bad_refines >= 3) {
+  if (best_axis < 0 || best_cost >= kd_leaf_cost(N)) {
     make_leaf(b, node, l); evlist_free(l); return;
   }
 
@@ -371,14 +369,14 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth, 
   else {
     uint32_t below = push_node(b);
     if (below == UINT32_MAX) { evlist_free(&L); evlist_free(&R); return; }
-    build(b, below, lbox, &L, depth - 1, bad_refines);
+    build(b, below, lbox, &L, depth - 1);
   }
   if (rcount == 0) { fl |= KD_ABOVE_EMPTY; evlist_free(&R); }
   else {
     uint32_t above = push_node(b);
     if (above == UINT32_MAX) { evlist_free(&R); return; }
     fl |= above << 4;
-    build(b, above, rbox, &R, depth - 1, bad_refines);
+    build(b, above, rbox, &R, depth - 1);
   }
   kd->nodes[node].flags = fl;
 }
@@ -465,7 +463,7 @@ void kdtree_stats(const accel *a, kd_stats *st) {
  * events) into part, whose tv, filter and has_filter are set and whose arrays start
  * empty. side: a byte per triangle of the whole mesh; straddle: n entries. Returns 0,
  * or -1 when out of memory. */
-int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth, int bad) {
+int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth) {
   kd_builder b = {part, side, straddle, 0};
   evlist l = {{0}, {0}, n};
   kd_event *tmp = malloc(((size_t)n * 2 + 1) * sizeof *tmp);
@@ -482,7 +480,7 @@ int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, con
   free(tmp);
   uint32_t root = push_node(&b);
   if (root == UINT32_MAX) { evlist_free(&l); return -1; }
-  build(&b, root, box, &l, depth, bad);
+  build(&b, root, box, &l, depth);
   return b.oom ? -1 : 0;
 }
 

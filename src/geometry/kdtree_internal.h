@@ -7,19 +7,24 @@
 #include "geometry/triangle.h"
 #include <stdint.h>
 
+/* The SAH's costs, in units of one node step. Leaves are tested four triangles at a
+ * time, so a leaf of n triangles costs KD_GROUP_COST per group of four, ceil(n / 4): the
+ * seed's per-triangle form with a measured group cost in place of pbrt's 80 per
+ * triangle (docs/performance.md). A node becomes a leaf when no split is cheaper.
+ * KD_GROUP_COST and KD_DEPTH_FACTOR are overridable (-D) for bench_raykernel sweeps. */
 #define KD_TRAVERSE_COST 1.0f
-#ifndef KD_ISECT_COST /* overridable, like KD_DEPTH_FACTOR, for bench_raykernel --bound's tree-shape sweep */
-#define KD_ISECT_COST 80.0f
+#ifndef KD_GROUP_COST
+#define KD_GROUP_COST 2.0f
 #endif
 #ifndef KD_DEPTH_FACTOR
 #define KD_DEPTH_FACTOR 1.2f /* depth limit 8 + KD_DEPTH_FACTOR log2 N */
 #endif
 #define KD_EMPTY_BONUS 0.5f
+static inline float kd_leaf_cost(uint32_t n) { return KD_GROUP_COST * (float)((n + 3) / 4); }
 #define KD_LEAF 3u
 #define KD_BELOW_EMPTY 4u /* interior: the child below the plane is an empty leaf, not stored */
 #define KD_ABOVE_EMPTY 8u /* interior: the child above the plane is an empty leaf, not stored */
 #define KD_MAX_NODES (1u << 28)
-#define KD_FLAT_MAX 64u /* meshes up to this many triangles: one leaf */
 
 /* 8 bytes: split position or leaf primitive offset; low 2 bits of flags: axis or leaf.
  * Leaf: upper 30 bits = primitive count. Interior: bits 2-3 = KD_BELOW_EMPTY and
@@ -75,7 +80,7 @@ typedef struct kd_ref { float lo[3], hi[3]; uint32_t tri; } kd_ref;
 int kd_clip_bounds(const float *v, bbox box, bbox *out);
 /* Appends a node to a growing array; UINT32_MAX when out of memory or nodes. */
 uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap);
-int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth, int bad);
+int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth);
 int kd_box_nodes(kdtree *kd);
 
 /* The kd-tree's accelerator operations (kdtree_traverse.c). */

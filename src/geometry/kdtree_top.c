@@ -19,7 +19,7 @@
 #define KD_BUILD_THREADS_MAX 16
 
 /* A subtree left to the exact sweep: its references and, once built, its part. */
-typedef struct kd_task { bbox box; kd_ref *refs; uint32_t n; int depth, bad; kdtree part; } kd_task;
+typedef struct kd_task { bbox box; kd_ref *refs; uint32_t n; int depth; kdtree part; } kd_task;
 
 typedef struct kd_top {
   kdtree *kd;
@@ -38,7 +38,7 @@ static uint32_t top_push(kd_top *t) {
 }
 
 /* Leaves the node to the exact sweep; takes ownership of refs. */
-static void top_task(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t n, int depth, int bad) {
+static void top_task(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t n, int depth) {
   if (t->ntasks == t->cap_tasks) {
     uint32_t nc = t->cap_tasks ? t->cap_tasks * 2 : 64;
     kd_task *k = realloc(t->tasks, (size_t)nc * sizeof *k);
@@ -47,13 +47,13 @@ static void top_task(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t 
   }
   kd_task *k = &t->tasks[t->ntasks];
   memset(k, 0, sizeof *k);
-  k->box = box; k->refs = refs; k->n = n; k->depth = depth; k->bad = bad;
+  k->box = box; k->refs = refs; k->n = n; k->depth = depth;
   t->nodes[node].prim_offset = t->ntasks++;
   t->nodes[node].flags = KD_LEAF;
 }
 
 /* The cheapest split of n references by SAH over KD_BINS planes per axis, with the
- * sweep's costs (traversal 1, intersection 80, empty bonus 0.5). Returns the axis, or
+ * sweep's costs (kdtree_internal.h). Returns the axis, or
  * -1 when no plane lies inside the box. */
 static int bin_split(const kd_ref *r, uint32_t n, bbox box, float *pos, float *cost) {
   uint32_t start[3][KD_BINS], end[3][KD_BINS];
@@ -86,7 +86,7 @@ static int bin_split(const kd_ref *r, uint32_t n, bbox box, float *pos, float *c
       float p = side ? gmax[k] : gmin[k];
       if (!(p > lo[k] && p < hi[k])) continue;
       float pa = 2.0f * (a_perp + (side ? p - lo[k] : hi[k] - p) * a_side) * inv_total;
-      float c = KD_TRAVERSE_COST + KD_ISECT_COST * (1.0f - KD_EMPTY_BONUS) * pa * (float)n;
+      float c = KD_TRAVERSE_COST + (1.0f - KD_EMPTY_BONUS) * pa * kd_leaf_cost(n);
       if (c < *cost) { *cost = c; *pos = p; best = k; }
     }
     uint32_t nl = 0, nr = n;
@@ -97,22 +97,21 @@ static int bin_split(const kd_ref *r, uint32_t n, bbox box, float *pos, float *c
       if (!(p > lo[k] && p < hi[k])) continue;
       float pl = 2.0f * (a_perp + (p - lo[k]) * a_side) * inv_total, pr = 2.0f * (a_perp + (hi[k] - p) * a_side) * inv_total;
       float eb = (nl == 0 || nr == 0) ? KD_EMPTY_BONUS : 0.0f;
-      float c = KD_TRAVERSE_COST + KD_ISECT_COST * (1.0f - eb) * (pl * (float)nl + pr * (float)nr);
+      float c = KD_TRAVERSE_COST + (1.0f - eb) * (pl * kd_leaf_cost(nl) + pr * kd_leaf_cost(nr));
       if (c < *cost) { *cost = c; *pos = p; best = k; }
     }
   }
   return best;
 }
 
-static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t n, int depth, int bad) {
-  if (n <= t->limit || depth <= 0 || t->oom) { top_task(t, node, box, refs, n, depth, bad); return; }
+static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t n, int depth) {
+  if (n <= t->limit || depth <= 0 || t->oom) { top_task(t, node, box, refs, n, depth); return; }
   float pos = 0, cost;
   int k = bin_split(refs, n, box, &pos, &cost);
-  if (cost > KD_ISECT_COST * (float)n) bad++;
-  if (k < 0 || bad >= 3) { top_task(t, node, box, refs, n, depth, bad); return; }
+  if (k < 0 || cost >= kd_leaf_cost(n)) { top_task(t, node, box, refs, n, depth); return; }
   /* Left: below the plane or in it; right: above it; straddlers clipped to each side. */
   kd_ref *L = malloc((size_t)n * sizeof *L), *R = malloc((size_t)n * sizeof *R);
-  if (!L || !R) { free(L); free(R); t->oom = 1; top_task(t, node, box, refs, n, depth, bad); return; }
+  if (!L || !R) { free(L); free(R); t->oom = 1; top_task(t, node, box, refs, n, depth); return; }
   bbox lbox = box, rbox = box;
   v3_set(&lbox.hi, k, pos);
   v3_set(&rbox.lo, k, pos);
@@ -135,14 +134,14 @@ static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t
   else {
     uint32_t below = top_push(t);
     if (below == UINT32_MAX) { free(L); free(R); return; }
-    top_build(t, below, lbox, L, nl, depth - 1, bad);
+    top_build(t, below, lbox, L, nl, depth - 1);
   }
   if (nr == 0) { fl |= KD_ABOVE_EMPTY; free(R); }
   else {
     uint32_t above = top_push(t);
     if (above == UINT32_MAX) { free(R); return; }
     fl |= above << 4;
-    top_build(t, above, rbox, R, nr, depth - 1, bad);
+    top_build(t, above, rbox, R, nr, depth - 1);
   }
   t->nodes[node].flags = fl;
 }
@@ -214,13 +213,13 @@ static int build_subtree(kdtree *out, uint8_t *side, uint32_t *straddle, kd_task
   kd_top sub = {out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0};
   uint32_t root = top_push(&sub);
   if (root == UINT32_MAX) return -1;
-  top_build(&sub, root, k->box, k->refs, k->n, k->depth, k->bad);
+  top_build(&sub, root, k->box, k->refs, k->n, k->depth);
   k->refs = NULL;
   int fail = sub.oom;
   for (uint32_t i = 0; i < sub.ntasks && !fail; i++) {
     kd_task *f = &sub.tasks[i];
     part_init(&f->part, out);
-    fail = kd_build_part(&f->part, side, straddle, f->box, f->refs, f->n, f->depth, f->bad);
+    fail = kd_build_part(&f->part, side, straddle, f->box, f->refs, f->n, f->depth);
     free(f->refs);
     f->refs = NULL;
   }
@@ -267,17 +266,12 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
     kd->bounds = bbox_union(kd->bounds, tb);
     refs[i] = (kd_ref){{tb.lo.x, tb.lo.y, tb.lo.z}, {tb.hi.x, tb.hi.y, tb.hi.z}, i};
   }
-  /* The depth limit ends these trees rather than the SAH (other SAH costs gave the same
-   * trees), and each level of it multiplies the duplicated references (2.5 per triangle
-   * on the bunny at pbrt's 1.3 log2 N, 3.7 at 1.5). Triangle data is where incoherent
-   * rays miss the cache, so 1.2 log2 N: 25 % less memory and 4-10 % faster on bounce
-   * rays than 1.3 (A/B in one process; docs/performance.md). */
+  /* On meshes the depth limit, not the SAH, ends most leaves (the bunny's: 92 % of its
+   * references), and each level of it multiplies the duplicated references. Triangle
+   * data is where incoherent rays miss the cache, so 1.2 log2 N: deeper trees (1.4, or
+   * empty-space cuts not counted) were 5-20 % slower (docs/performance.md). */
   int max_depth = (int)lroundf(8 + KD_DEPTH_FACTOR * log2f((float)(ntris > 1 ? ntris : 1)));
   if (max_depth > 60) max_depth = 60;
-  /* A tiny mesh is one leaf: testing its triangles four at a time beats any traversal
-   * (the SAH prices a triangle test at 80 traversal steps, not a quarter of an SSE group
-   * test). CornellBox-Original (36 triangles): 12 % faster renders (docs/performance.md). */
-  if (ntris <= KD_FLAT_MAX) max_depth = 0;
   kd->max_depth_seen = (uint32_t)max_depth;
   if (ntris == 0) { free(refs); free(kd->tv); kd->tv = NULL; *out = &kd->base; return VALO_OK; }
   /* The top levels run on one thread down to nodes of N / 64 references; the tree does
@@ -285,7 +279,7 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   t.limit = ntris / 64 > KD_BIN_MIN ? ntris / 64 : KD_BIN_MIN;
   uint32_t root = top_push(&t);
   if (root == UINT32_MAX) { free(refs); goto oom; }
-  top_build(&t, root, kd->bounds, refs, ntris, max_depth, 0);
+  top_build(&t, root, kd->bounds, refs, ntris, max_depth);
   if (t.oom) goto oom;
 
   int nth = threads > 0 ? threads : threads_available();
