@@ -23,9 +23,35 @@ enum { SIDE_BOTH = 0, SIDE_LEFT = 1, SIDE_RIGHT = 2 };
 typedef struct kd_builder {
   kdtree *kd;
   uint8_t *side;
-  uint32_t *straddle;
+  kd_arena *arena;
   int oom;
 } kd_builder;
+
+/* ---------------------------------------------------------------- arena */
+
+/* Event lists live on a per-thread stack of blocks: a node's lists are taken above its
+ * parent's and given back when its subtree is done, so the build calls malloc only when
+ * a block is first needed (blocks are kept for the thread's next subtree). */
+static void *arena_alloc(kd_arena *a, size_t bytes) {
+  bytes = (bytes + 15) & ~(size_t)15;
+  while (a->cur < a->nblk && a->off + bytes > a->cap[a->cur]) { a->cur++; a->off = 0; }
+  if (a->cur == a->nblk) {
+    if (a->nblk == KD_ARENA_BLOCKS) return NULL;
+    size_t c = a->nblk ? 2 * a->cap[a->nblk - 1] : (size_t)1 << 18;
+    while (c < bytes) c *= 2;
+    if (!(a->blk[a->nblk] = malloc(c))) return NULL;
+    a->cap[a->nblk++] = c;
+    a->off = 0;
+  }
+  void *p = a->blk[a->cur] + a->off;
+  a->off += bytes;
+  return p;
+}
+
+void kd_arena_free(kd_arena *a) {
+  for (int i = 0; i < a->nblk; i++) free(a->blk[i]);
+  memset(a, 0, sizeof *a);
+}
 
 static inline int ev_less(const kd_event *a, const kd_event *b) {
   return a->pos < b->pos || (a->pos == b->pos && (a->v & 3) < (b->v & 3));
@@ -104,7 +130,6 @@ static void ev_sort(kd_event *e, uint32_t n, kd_event *tmp) {
   if (src != e) memcpy(e, src, (size_t)n * sizeof *e);
 }
 
-static void evlist_free(evlist *l) { for (int k = 0; k < 3; k++) { free(l->e[k]); l->e[k] = NULL; } }
 
 uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap) {
   if (*n >= KD_MAX_NODES) return UINT32_MAX;
@@ -240,21 +265,22 @@ static void add_events(kd_event *dst, uint32_t *n, uint32_t tri, bbox b, int k) 
   }
 }
 
-/* Merges two sorted event arrays into a new array (a and b are freed). */
-static kd_event *merge(kd_event *a, uint32_t na, kd_event *b, uint32_t nb, uint32_t *nout) {
-  kd_event *o = malloc(((size_t)na + nb + 1) * sizeof *o);
-  if (!o) { free(a); free(b); return NULL; }
-  ev_merge(o, a, na, b, nb);
-  free(a); free(b);
-  *nout = na + nb;
-  return o;
+/* Merges sorted b (nb entries) into sorted a, whose first na entries are used and which
+ * has room for na + nb, from the back, in the order ev_merge gives (on equal events a's
+ * first). */
+static void ev_merge_into(kd_event *a, uint32_t na, const kd_event *b, uint32_t nb) {
+  uint32_t i = na, j = nb, m = na + nb;
+  while (j > 0) {
+    if (i > 0 && ev_less(&b[j - 1], &a[i - 1])) a[--m] = a[--i];
+    else a[--m] = b[--j];
+  }
 }
 
 static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) {
   kdtree *kd = b->kd;
   uint32_t N = l->ntris;
   if ((uint32_t)(kd->max_depth_seen) < (uint32_t)depth) kd->max_depth_seen = (uint32_t)depth;
-  if (N <= 1 || depth <= 0 || b->oom) { make_leaf(b, node, l); evlist_free(l); return; }
+  if (N <= 1 || depth <= 0 || b->oom) { make_leaf(b, node, l); return; }
 
   /* Sweep every axis for the cheapest SAH split (Wald & Havran, Alg. 4). */
   float total = bbox_area(box), inv_total = total > 0 ? 1.0f / total : 0;
@@ -290,95 +316,108 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
       np = 0;
     }
   }
-  if (best_axis < 0 || best_cost >= kd_leaf_cost(N)) {
-    make_leaf(b, node, l); evlist_free(l); return;
-  }
+  if (best_axis < 0 || best_cost >= kd_leaf_cost(N)) { make_leaf(b, node, l); return; }
 
-  /* Classify triangles (Alg. 5). */
+  /* Classify triangles (Alg. 5). Everything below is taken from the arena and given
+   * back when this subtree is done. */
+  kd_arena *ar = b->arena;
+  int mark_cur = ar->cur;
+  size_t mark_off = ar->off;
   int k = best_axis;
   const kd_event *e = l->e[k];
-  for (uint32_t i = 0; i < l->n[k]; i++) b->side[e[i].v >> 2] = SIDE_BOTH;
+  /* Without a branch per event (the sides are data): a triangle is left when it ends at
+   * or below the plane, right when it starts at or above it, and a planar one by its
+   * position; no triangle can be both, so the bits are or-ed. */
+  uint8_t *side = b->side;
+  for (uint32_t i = 0; i < l->n[k]; i++) side[e[i].v >> 2] = SIDE_BOTH;
   for (uint32_t i = 0; i < l->n[k]; i++) {
     uint32_t t = e[i].v >> 2, type = e[i].v & 3;
-    if (type == EV_END && e[i].pos <= best_pos) b->side[t] = SIDE_LEFT;
-    else if (type == EV_START && e[i].pos >= best_pos) b->side[t] = SIDE_RIGHT;
-    else if (type == EV_PLANAR) {
-      if (e[i].pos < best_pos || (e[i].pos == best_pos && best_planar_left)) b->side[t] = SIDE_LEFT;
-      else b->side[t] = SIDE_RIGHT;
-    }
+    float p = e[i].pos;
+    int planar_left = p < best_pos || (p == best_pos && best_planar_left);
+    uint32_t left = (type == EV_END && p <= best_pos) | (type == EV_PLANAR && planar_left);
+    uint32_t right = (type == EV_START && p >= best_pos) | (type == EV_PLANAR && !planar_left);
+    side[t] |= (uint8_t)(left * SIDE_LEFT | right * SIDE_RIGHT);
   }
+  uint32_t *straddle = arena_alloc(ar, (size_t)N * sizeof *straddle + 1);
+  if (!straddle) { b->oom = 1; make_leaf(b, node, l); return; }
   uint32_t nboth = 0, nleft_only = 0, nright_only = 0;
-  for (uint32_t i = 0; i < l->n[k]; i++) {
-    uint32_t t = e[i].v >> 2, type = e[i].v & 3;
-    if (type == EV_END) continue; /* count each triangle once: at START or PLANAR */
-    if (b->side[t] == SIDE_BOTH) b->straddle[nboth++] = t;
-    else if (b->side[t] == SIDE_LEFT) nleft_only++;
-    else nright_only++;
+  for (uint32_t i = 0; i < l->n[k]; i++) { /* each triangle once: at START or PLANAR */
+    uint32_t t = e[i].v >> 2, first = (e[i].v & 3) != EV_END, sd = side[t];
+    straddle[nboth] = t;
+    nboth += first & (sd == SIDE_BOTH);
+    nleft_only += first & (sd == SIDE_LEFT);
+    nright_only += first & (sd == SIDE_RIGHT);
   }
   bbox lbox = box, rbox = box;
   v3_set(&lbox.hi, k, best_pos);
   v3_set(&rbox.lo, k, best_pos);
 
-  /* Split the lists, preserving order, then add clipped straddlers (Alg. 6). */
+  /* Split the lists, preserving order, then add clipped straddlers (Alg. 6): each
+   * child's list has room for its straddlers' events, which are sorted and merged in
+   * from the back. */
   evlist L = {{0}, {0}, 0}, R = {{0}, {0}, 0};
-  kd_event *nl_ev[3] = {0}, *nr_ev[3] = {0};
+  kd_event *nl_ev[3], *nr_ev[3];
   uint32_t nnl[3] = {0}, nnr[3] = {0};
-  int fail = 0;
+  kd_event *tmp = arena_alloc(ar, ((size_t)nboth * 2 + 1) * sizeof *tmp);
+  int fail = !tmp;
   for (int j = 0; j < 3 && !fail; j++) {
-    L.e[j] = malloc(((size_t)l->n[j] + 1) * sizeof(kd_event));
-    R.e[j] = malloc(((size_t)l->n[j] + 1) * sizeof(kd_event));
-    nl_ev[j] = malloc(((size_t)nboth * 2 + 1) * sizeof(kd_event));
-    nr_ev[j] = malloc(((size_t)nboth * 2 + 1) * sizeof(kd_event));
+    size_t room = (size_t)l->n[j] + 2 * (size_t)nboth + 1;
+    L.e[j] = arena_alloc(ar, room * sizeof(kd_event));
+    R.e[j] = arena_alloc(ar, room * sizeof(kd_event));
+    nl_ev[j] = arena_alloc(ar, ((size_t)nboth * 2 + 1) * sizeof(kd_event));
+    nr_ev[j] = arena_alloc(ar, ((size_t)nboth * 2 + 1) * sizeof(kd_event));
     if (!L.e[j] || !R.e[j] || !nl_ev[j] || !nr_ev[j]) { fail = 1; break; }
-    for (uint32_t i = 0; i < l->n[j]; i++) {
-      uint8_t s = b->side[l->e[j][i].v >> 2];
-      if (s == SIDE_LEFT) L.e[j][L.n[j]++] = l->e[j][i];
-      else if (s == SIDE_RIGHT) R.e[j][R.n[j]++] = l->e[j][i];
+    kd_event *le = L.e[j], *re = R.e[j];
+    uint32_t nl = 0, nr = 0;
+    for (uint32_t i = 0; i < l->n[j]; i++) { /* both written, one kept: no branch on the side */
+      kd_event ev = l->e[j][i];
+      uint32_t sd = side[ev.v >> 2];
+      le[nl] = ev;
+      re[nr] = ev;
+      nl += sd == SIDE_LEFT;
+      nr += sd == SIDE_RIGHT;
     }
+    L.n[j] = nl;
+    R.n[j] = nr;
   }
-  evlist_free(l);
+  if (fail) { b->oom = 1; make_leaf(b, node, l); ar->cur = mark_cur; ar->off = mark_off; return; }
   uint32_t lcount = nleft_only, rcount = nright_only;
-  if (!fail) {
-    for (uint32_t i = 0; i < nboth; i++) {
-      uint32_t t = b->straddle[i];
-      const float *v = &kd->tv[9 * (size_t)t];
-      bbox cb;
-      if (kd_clip_bounds(v, lbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cb, j); lcount++; }
-      if (kd_clip_bounds(v, rbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cb, j); rcount++; }
-    }
-    kd_event *tmp = malloc(((size_t)nboth * 2 + 1) * sizeof *tmp);
-    if (!tmp) fail = 1;
-    for (int j = 0; j < 3 && tmp; j++) {
-      ev_sort(nl_ev[j], nnl[j], tmp);
-      ev_sort(nr_ev[j], nnr[j], tmp);
-      L.e[j] = merge(L.e[j], L.n[j], nl_ev[j], nnl[j], &L.n[j]);
-      R.e[j] = merge(R.e[j], R.n[j], nr_ev[j], nnr[j], &R.n[j]);
-      nl_ev[j] = nr_ev[j] = NULL;
-      if (!L.e[j] || !R.e[j]) fail = 1;
-    }
-    free(tmp);
+  for (uint32_t i = 0; i < nboth; i++) {
+    uint32_t t = straddle[i];
+    const float *v = &kd->tv[9 * (size_t)t];
+    bbox cb;
+    if (kd_clip_bounds(v, lbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cb, j); lcount++; }
+    if (kd_clip_bounds(v, rbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cb, j); rcount++; }
   }
-  for (int j = 0; j < 3; j++) { free(nl_ev[j]); free(nr_ev[j]); }
-  if (fail) { b->oom = 1; evlist_free(&L); evlist_free(&R); kd->nodes[node].flags = KD_LEAF; kd->nodes[node].prim_offset = 0; return; }
+  for (int j = 0; j < 3; j++) {
+    ev_sort(nl_ev[j], nnl[j], tmp);
+    ev_sort(nr_ev[j], nnr[j], tmp);
+    ev_merge_into(L.e[j], L.n[j], nl_ev[j], nnl[j]);
+    ev_merge_into(R.e[j], R.n[j], nr_ev[j], nnr[j]);
+    L.n[j] += nnl[j];
+    R.n[j] += nnr[j];
+  }
   L.ntris = lcount;
   R.ntris = rcount;
 
   kd->nodes[node].split = best_pos;
   uint32_t fl = (uint32_t)k; /* the node's flags are written once its children are placed */
-  if (lcount == 0) { fl |= KD_BELOW_EMPTY; evlist_free(&L); }
+  if (lcount == 0) fl |= KD_BELOW_EMPTY;
   else {
     uint32_t below = push_node(b);
-    if (below == UINT32_MAX) { evlist_free(&L); evlist_free(&R); return; }
-    build(b, below, lbox, &L, depth - 1);
+    if (below != UINT32_MAX) build(b, below, lbox, &L, depth - 1);
   }
-  if (rcount == 0) { fl |= KD_ABOVE_EMPTY; evlist_free(&R); }
+  if (rcount == 0) fl |= KD_ABOVE_EMPTY;
   else {
     uint32_t above = push_node(b);
-    if (above == UINT32_MAX) { evlist_free(&R); return; }
-    fl |= above << 4;
-    build(b, above, rbox, &R, depth - 1);
+    if (above != UINT32_MAX) {
+      fl |= above << 4;
+      build(b, above, rbox, &R, depth - 1);
+    }
   }
   kd->nodes[node].flags = fl;
+  ar->cur = mark_cur;
+  ar->off = mark_off;
 }
 
 /* ------------------------------------------------------------- box nodes */
@@ -463,25 +502,26 @@ void kdtree_stats(const accel *a, kd_stats *st) {
  * events) into part, whose tv, filter and has_filter are set and whose arrays start
  * empty. side: a byte per triangle of the whole mesh; straddle: n entries. Returns 0,
  * or -1 when out of memory. */
-int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth) {
-  kd_builder b = {part, side, straddle, 0};
+int kd_build_part(kdtree *part, uint8_t *side, kd_arena *arena, bbox box, const kd_ref *refs, uint32_t n, int depth) {
+  kd_builder b = {part, side, arena, 0};
+  int mark_cur = arena->cur;
+  size_t mark_off = arena->off;
   evlist l = {{0}, {0}, n};
-  kd_event *tmp = malloc(((size_t)n * 2 + 1) * sizeof *tmp);
-  if (!tmp) return -1;
-  for (int k = 0; k < 3; k++) {
-    l.e[k] = malloc(((size_t)n * 2 + 1) * sizeof(kd_event));
-    if (!l.e[k]) { evlist_free(&l); free(tmp); return -1; }
+  kd_event *tmp = arena_alloc(arena, ((size_t)n * 2 + 1) * sizeof *tmp);
+  for (int k = 0; k < 3 && tmp; k++) {
+    l.e[k] = arena_alloc(arena, ((size_t)n * 2 + 1) * sizeof(kd_event));
+    if (!l.e[k]) { tmp = NULL; break; }
     for (uint32_t i = 0; i < n; i++) {
       bbox rb = {v3(refs[i].lo[0], refs[i].lo[1], refs[i].lo[2]), v3(refs[i].hi[0], refs[i].hi[1], refs[i].hi[2])};
       add_events(l.e[k], &l.n[k], refs[i].tri, rb, k);
     }
     ev_sort(l.e[k], l.n[k], tmp);
   }
-  free(tmp);
-  uint32_t root = push_node(&b);
-  if (root == UINT32_MAX) { evlist_free(&l); return -1; }
-  build(&b, root, box, &l, depth);
-  return b.oom ? -1 : 0;
+  uint32_t root = tmp ? push_node(&b) : UINT32_MAX;
+  if (root != UINT32_MAX) build(&b, root, box, &l, depth);
+  arena->cur = mark_cur;
+  arena->off = mark_off;
+  return root == UINT32_MAX || b.oom ? -1 : 0;
 }
 
 /* Statistics of the tree as built, then each chain of empty cuts becomes a box node.

@@ -80,7 +80,11 @@ typedef struct kd_ref { float lo[3], hi[3]; uint32_t tri; } kd_ref;
 int kd_clip_bounds(const float *v, bbox box, bbox *out);
 /* Appends a node to a growing array; UINT32_MAX when out of memory or nodes. */
 uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap);
-int kd_build_part(kdtree *part, uint8_t *side, uint32_t *straddle, bbox box, const kd_ref *refs, uint32_t n, int depth);
+/* A build thread's stack of scratch blocks (kdtree_build.c). */
+#define KD_ARENA_BLOCKS 40
+typedef struct kd_arena { char *blk[KD_ARENA_BLOCKS]; size_t cap[KD_ARENA_BLOCKS], off; int nblk, cur; } kd_arena;
+void kd_arena_free(kd_arena *a);
+int kd_build_part(kdtree *part, uint8_t *side, kd_arena *arena, bbox box, const kd_ref *refs, uint32_t n, int depth);
 int kd_box_nodes(kdtree *kd);
 
 /* The kd-tree's accelerator operations (kdtree_traverse.c). */

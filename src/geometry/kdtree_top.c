@@ -209,7 +209,7 @@ static int join_all(kdtree *out, const kd_top *t) {
 
 /* Builds the subtree of a node into out (tv and filter set, arrays empty): binned
  * levels down to KD_BIN_MIN references, then the exact sweep of each, joined. */
-static int build_subtree(kdtree *out, uint8_t *side, uint32_t *straddle, kd_task *k) {
+static int build_subtree(kdtree *out, uint8_t *side, kd_arena *arena, kd_task *k) {
   kd_top sub = {out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0};
   uint32_t root = top_push(&sub);
   if (root == UINT32_MAX) return -1;
@@ -219,7 +219,7 @@ static int build_subtree(kdtree *out, uint8_t *side, uint32_t *straddle, kd_task
   for (uint32_t i = 0; i < sub.ntasks && !fail; i++) {
     kd_task *f = &sub.tasks[i];
     part_init(&f->part, out);
-    fail = kd_build_part(&f->part, side, straddle, f->box, f->refs, f->n, f->depth);
+    fail = kd_build_part(&f->part, side, arena, f->box, f->refs, f->n, f->depth);
     free(f->refs);
     f->refs = NULL;
   }
@@ -229,12 +229,12 @@ static int build_subtree(kdtree *out, uint8_t *side, uint32_t *straddle, kd_task
 }
 
 /* The subtrees below the top levels, on the thread pool: each thread has its own scratch. */
-typedef struct kd_run { kd_top *t; uint8_t *side[KD_BUILD_THREADS_MAX]; uint32_t *straddle[KD_BUILD_THREADS_MAX]; int oom[KD_BUILD_THREADS_MAX]; } kd_run;
+typedef struct kd_run { kd_top *t; uint8_t *side[KD_BUILD_THREADS_MAX]; kd_arena arena[KD_BUILD_THREADS_MAX]; int oom[KD_BUILD_THREADS_MAX]; } kd_run;
 static void run_task(void *user, int64_t i, int th) {
   kd_run *run = user;
   kd_task *k = &run->t->tasks[i];
   part_init(&k->part, run->t->kd);
-  if (run->oom[th] || build_subtree(&k->part, run->side[th], run->straddle[th], k)) run->oom[th] = 1;
+  if (run->oom[th] || build_subtree(&k->part, run->side[th], &run->arena[th], k)) run->oom[th] = 1;
   free(k->refs);
   k->refs = NULL;
 }
@@ -285,26 +285,21 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   int nth = threads > 0 ? threads : threads_available();
   if (nth > KD_BUILD_THREADS_MAX) nth = KD_BUILD_THREADS_MAX;
   if ((uint32_t)nth > t.ntasks) nth = (int)t.ntasks;
-  uint32_t max_n = 1;
-  for (uint32_t i = 0; i < t.ntasks; i++) max_n = t.tasks[i].n > max_n ? t.tasks[i].n : max_n;
   run.t = &t;
-  for (int i = 0; i < nth; i++) {
-    run.side[i] = malloc((size_t)ntris + 1);
-    run.straddle[i] = malloc((size_t)max_n * sizeof(uint32_t));
-    if (!run.side[i] || !run.straddle[i]) goto oom;
-  }
+  for (int i = 0; i < nth; i++)
+    if (!(run.side[i] = malloc((size_t)ntris + 1))) goto oom;
   parallel_for(nth, t.ntasks, run_task, &run);
   for (int i = 0; i < nth; i++) if (run.oom[i]) goto oom;
 
   if (join_all(kd, &t) || kd_box_nodes(kd)) goto oom;
-  for (int i = 0; i < nth; i++) { free(run.side[i]); free(run.straddle[i]); }
+  for (int i = 0; i < nth; i++) { free(run.side[i]); kd_arena_free(&run.arena[i]); }
   top_free(&t);
   free(kd->tv);
   kd->tv = NULL;
   *out = &kd->base;
   return VALO_OK;
 oom:
-  for (int i = 0; i < KD_BUILD_THREADS_MAX; i++) { free(run.side[i]); free(run.straddle[i]); }
+  for (int i = 0; i < KD_BUILD_THREADS_MAX; i++) { free(run.side[i]); kd_arena_free(&run.arena[i]); }
   top_free(&t);
   kdtree_free(kd);
   return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory while building");
