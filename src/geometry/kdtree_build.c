@@ -338,7 +338,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
     uint32_t right = (type == EV_START && p >= best_pos) | (type == EV_PLANAR && !planar_left);
     side[t] |= (uint8_t)(left * SIDE_LEFT | right * SIDE_RIGHT);
   }
-  uint32_t *straddle = arena_alloc(ar, (size_t)N * sizeof *straddle + 1);
+  uint32_t *straddle = arena_alloc(ar, ((size_t)N + 1) * sizeof *straddle); /* the loop writes one past the last straddler */
   if (!straddle) { b->oom = 1; make_leaf(b, node, l); return; }
   uint32_t nboth = 0, nleft_only = 0, nright_only = 0;
   for (uint32_t i = 0; i < l->n[k]; i++) { /* each triangle once: at START or PLANAR */
@@ -500,8 +500,8 @@ void kdtree_stats(const accel *a, kd_stats *st) {
 
 /* Builds a subtree by the exact sweep from references (their clipped bounds give its
  * events) into part, whose tv, filter and has_filter are set and whose arrays start
- * empty. side: a byte per triangle of the whole mesh; straddle: n entries. Returns 0,
- * or -1 when out of memory. */
+ * empty. side: a byte per triangle of the whole mesh; arena: the calling thread's, given
+ * back as it was. Returns 0, or -1 when out of memory. */
 int kd_build_part(kdtree *part, uint8_t *side, kd_arena *arena, bbox box, const kd_ref *refs, uint32_t n, int depth) {
   kd_builder b = {part, side, arena, 0};
   int mark_cur = arena->cur;
