@@ -268,8 +268,9 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   }
   /* On meshes the depth limit, not the SAH, ends most leaves (the bunny's: 92 % of its
    * references), and each level of it multiplies the duplicated references. Triangle
-   * data is where incoherent rays miss the cache, so 1.2 log2 N: deeper trees (1.4, or
-   * empty-space cuts not counted) were 5-20 % slower (docs/performance.md). */
+   * data is where incoherent rays miss the cache, so 1.2 log2 N: deeper trees (1.5, or
+   * empty-space cuts not counted) traced the meshes' rays 5-15 % slower, shallower ones
+   * up to 36 % (docs/performance.md). */
   int max_depth = (int)lroundf(8 + KD_DEPTH_FACTOR * log2f((float)(ntris > 1 ? ntris : 1)));
   if (max_depth > 60) max_depth = 60;
   kd->max_depth_seen = (uint32_t)max_depth;
