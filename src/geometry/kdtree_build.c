@@ -48,6 +48,11 @@ static void *arena_alloc(kd_arena *a, size_t bytes) {
   return p;
 }
 
+/* Where the stack stands, and going back there: everything taken since is given back. */
+typedef struct arena_mark { int cur; size_t off; } arena_mark;
+static arena_mark arena_top(const kd_arena *a) { return (arena_mark){a->cur, a->off}; }
+static void arena_release(kd_arena *a, arena_mark m) { a->cur = m.cur; a->off = m.off; }
+
 void kd_arena_free(kd_arena *a) {
   for (int i = 0; i < a->nblk; i++) free(a->blk[i]);
   memset(a, 0, sizeof *a);
@@ -321,8 +326,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
   /* Classify triangles (Alg. 5). Everything below is taken from the arena and given
    * back when this subtree is done. */
   kd_arena *ar = b->arena;
-  int mark_cur = ar->cur;
-  size_t mark_off = ar->off;
+  arena_mark mark = arena_top(ar);
   int k = best_axis;
   const kd_event *e = l->e[k];
   /* Without a branch per event (the sides are data): a triangle is left when it ends at
@@ -339,7 +343,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
     side[t] |= (uint8_t)(left * SIDE_LEFT | right * SIDE_RIGHT);
   }
   uint32_t *straddle = arena_alloc(ar, ((size_t)N + 1) * sizeof *straddle); /* the loop writes one past the last straddler */
-  if (!straddle) { b->oom = 1; make_leaf(b, node, l); return; }
+  if (!straddle) { b->oom = 1; make_leaf(b, node, l); arena_release(ar, mark); return; }
   uint32_t nboth = 0, nleft_only = 0, nright_only = 0;
   for (uint32_t i = 0; i < l->n[k]; i++) { /* each triangle once: at START or PLANAR */
     uint32_t t = e[i].v >> 2, first = (e[i].v & 3) != EV_END, sd = side[t];
@@ -380,7 +384,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
     L.n[j] = nl;
     R.n[j] = nr;
   }
-  if (fail) { b->oom = 1; make_leaf(b, node, l); ar->cur = mark_cur; ar->off = mark_off; return; }
+  if (fail) { b->oom = 1; make_leaf(b, node, l); arena_release(ar, mark); return; }
   uint32_t lcount = nleft_only, rcount = nright_only;
   for (uint32_t i = 0; i < nboth; i++) {
     uint32_t t = straddle[i];
@@ -416,8 +420,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
     }
   }
   kd->nodes[node].flags = fl;
-  ar->cur = mark_cur;
-  ar->off = mark_off;
+  arena_release(ar, mark);
 }
 
 /* ------------------------------------------------------------- box nodes */
@@ -504,23 +507,22 @@ void kdtree_stats(const accel *a, kd_stats *st) {
  * back as it was. Returns 0, or -1 when out of memory. */
 int kd_build_part(kdtree *part, uint8_t *side, kd_arena *arena, bbox box, const kd_ref *refs, uint32_t n, int depth) {
   kd_builder b = {part, side, arena, 0};
-  int mark_cur = arena->cur;
-  size_t mark_off = arena->off;
+  arena_mark mark = arena_top(arena);
   evlist l = {{0}, {0}, n};
   kd_event *tmp = arena_alloc(arena, ((size_t)n * 2 + 1) * sizeof *tmp);
-  for (int k = 0; k < 3 && tmp; k++) {
+  int ok = tmp != NULL;
+  for (int k = 0; k < 3 && ok; k++) {
     l.e[k] = arena_alloc(arena, ((size_t)n * 2 + 1) * sizeof(kd_event));
-    if (!l.e[k]) { tmp = NULL; break; }
+    if (!(ok = l.e[k] != NULL)) break;
     for (uint32_t i = 0; i < n; i++) {
       bbox rb = {v3(refs[i].lo[0], refs[i].lo[1], refs[i].lo[2]), v3(refs[i].hi[0], refs[i].hi[1], refs[i].hi[2])};
       add_events(l.e[k], &l.n[k], refs[i].tri, rb, k);
     }
     ev_sort(l.e[k], l.n[k], tmp);
   }
-  uint32_t root = tmp ? push_node(&b) : UINT32_MAX;
+  uint32_t root = ok ? push_node(&b) : UINT32_MAX;
   if (root != UINT32_MAX) build(&b, root, box, &l, depth);
-  arena->cur = mark_cur;
-  arena->off = mark_off;
+  arena_release(arena, mark);
   return root == UINT32_MAX || b.oom ? -1 : 0;
 }
 

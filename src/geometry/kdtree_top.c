@@ -53,8 +53,8 @@ static void top_task(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t 
 }
 
 /* The cheapest split of n references by SAH over KD_BINS planes per axis, with the
- * sweep's costs (kdtree_internal.h). Returns the axis, or
- * -1 when no plane lies inside the box. */
+ * sweep's costs (kdtree_internal.h). Returns the axis, or -1 when no plane lies inside
+ * the box. */
 static int bin_split(const kd_ref *r, uint32_t n, bbox box, float *pos, float *cost) {
   uint32_t start[3][KD_BINS], end[3][KD_BINS];
   memset(start, 0, sizeof start);
