@@ -468,29 +468,28 @@ static int large_triangles_corner(void) {
 }
 
 
+/* Adds t to the m triangles of set unless there or full (5); returns the new count. */
+static int set_add(uint32_t set[5], int m, uint32_t t) {
+  for (int j = 0; j < m; j++)
+    if (set[j] == t) return m;
+  if (m < 5) set[m++] = t;
+  return m;
+}
+
 /* The distinct triangles of the subtree at ni, into set (at most 5 kept; returns how
  * many); counts into *small the splits of subtrees of at most four triangles. */
 static int subtree_tris(const kdtree *kd, uint32_t ni, uint32_t set[5], int *small) {
   const kd_node *n = &kd->nodes[ni];
   int m = 0;
   if ((n->flags & 3) == KD_LEAF) {
-    uint32_t cnt = n->flags >> 2;
-    for (uint32_t i = 0; i < cnt && m < 5; i++) {
-      uint32_t t = kd->ids[4 * (size_t)n->prim_offset + i], dup = 0;
-      for (int j = 0; j < m; j++) dup |= set[j] == t;
-      if (!dup) set[m++] = t;
-    }
+    for (uint32_t i = 0; i < n->flags >> 2; i++) m = set_add(set, m, kd->ids[4 * (size_t)n->prim_offset + i]);
     return m;
   }
   if ((n->flags & KD_BOX) == KD_BOX) return subtree_tris(kd, ni + KD_BOX_SLOTS, set, small);
   uint32_t other[5];
   m = subtree_tris(kd, ni + 1, set, small);
   int mo = subtree_tris(kd, n->flags >> 4, other, small);
-  for (int i = 0; i < mo && m < 5; i++) {
-    uint32_t dup = 0;
-    for (int j = 0; j < m; j++) dup |= set[j] == other[i];
-    if (!dup) set[m++] = other[i];
-  }
+  for (int i = 0; i < mo; i++) m = set_add(set, m, other[i]);
   if (m <= 4) (*small)++;
   return m;
 }
