@@ -2,7 +2,7 @@
  * binned top levels (kdtree_top.c; layout: kdtree_internal.h): Wald & Havran, "On
  * building fast kd-trees for ray tracing, and on doing that in O(N log N)" (2006) —
  * per-axis event lists sorted once per subtree, a linear sweep per node, order-preserving
- * list splitting and exact clipping of straddling triangles to the child voxels — and
+ * list splitting and exact clipping of straddling triangles to the child voxels (kd_clip_split) — and
  * the leaves: triangles in leaf order in SSE groups of four, tested four at a time
  * (1.3-1.5x faster than one by one; docs/performance.md). Also the clipping both build
  * phases use, and the box nodes made once the tree is joined. SAH costs: digest 000's
@@ -204,52 +204,69 @@ static float round_out(double x, int exact, int up) {
   return f;
 }
 
-/* Clips triangle v to box and returns conservative bounds of the clipped polygon (0 if
- * empty). Clipping runs in double; a polygon vertex's coordinate is exact when it is an
- * input vertex's, the clipping plane's, or shared by both ends of the clipped edge. */
-int kd_clip_bounds(const float *v, bbox box, bbox *out) {
-  double poly[2][12][3];
-  uint8_t exact[2][12];
-  int n = 3, cur = 0;
-  for (int i = 0; i < 3; i++) {
-    exact[0][i] = 7;
-    for (int k = 0; k < 3; k++) poly[0][i][k] = v[3 * i + k];
-  }
-  for (int axis = 0; axis < 3 && n > 0; axis++) {
-    for (int sidei = 0; sidei < 2 && n > 0; sidei++) {
-      double plane = sidei == 0 ? v3_get(box.lo, axis) : v3_get(box.hi, axis);
-      double sgn = sidei == 0 ? 1.0 : -1.0; /* inside: sgn*(x - plane) >= 0 */
-      int inside = 1; /* the polygon wholly inside this plane (most are): nothing to clip */
-      for (int i = 0; i < n && inside; i++) inside = sgn * (poly[cur][i][axis] - plane) >= 0;
-      if (inside) continue;
-      int m = 0, nxt = 1 - cur;
-      for (int i = 0; i < n; i++) {
-        int ic = (i + 1) % n;
-        const double *a = poly[cur][i], *c = poly[cur][ic];
-        double da = sgn * (a[axis] - plane), dc = sgn * (c[axis] - plane);
-        if (da >= 0 && m < 12) { memcpy(poly[nxt][m], a, sizeof(double) * 3); exact[nxt][m++] = exact[cur][i]; }
-        if ((da >= 0) != (dc >= 0) && m < 12) {
-          double t = da / (da - dc);
-          uint8_t ex = (uint8_t)(1u << axis);
-          for (int k = 0; k < 3; k++) {
-            poly[nxt][m][k] = a[k] + t * (c[k] - a[k]);
-            if (a[k] == c[k] && (exact[cur][i] & exact[cur][ic] & (1u << k))) ex |= (uint8_t)(1u << k);
-          }
-          poly[nxt][m][axis] = plane;
-          exact[nxt][m] = ex;
-          m++;
-        }
+/* A polygon being clipped, in double: a vertex's coordinate is exact (its bit set) when
+ * it is an input vertex's, the clipping plane's, or shared by both ends of the clipped
+ * edge. */
+typedef struct clip_poly { double p[12][3]; uint8_t exact[12]; int n; } clip_poly;
+
+/* Keeps the part of a with sgn*(x[axis] - plane) >= 0, into o (o != a). */
+static void clip_plane(const clip_poly *a, int axis, double plane, double sgn, clip_poly *o) {
+  int m = 0;
+  for (int i = 0; i < a->n; i++) {
+    int ic = (i + 1) % a->n;
+    const double *x = a->p[i], *c = a->p[ic];
+    double da = sgn * (x[axis] - plane), dc = sgn * (c[axis] - plane);
+    if (da >= 0 && m < 12) { memcpy(o->p[m], x, sizeof(double) * 3); o->exact[m++] = a->exact[i]; }
+    if ((da >= 0) != (dc >= 0) && m < 12) {
+      double t = da / (da - dc);
+      uint8_t ex = (uint8_t)(1u << axis);
+      for (int k = 0; k < 3; k++) {
+        o->p[m][k] = x[k] + t * (c[k] - x[k]);
+        if (x[k] == c[k] && (a->exact[i] & a->exact[ic] & (1u << k))) ex |= (uint8_t)(1u << k);
       }
-      n = m;
-      cur = nxt;
+      o->p[m][axis] = plane;
+      o->exact[m] = ex;
+      m++;
     }
   }
-  if (n == 0) return 0;
+  o->n = m;
+}
+
+/* Whether every vertex of a lies on the kept side of the plane (most do: nothing to clip). */
+static int clip_inside(const clip_poly *a, int axis, double plane, double sgn) {
+  for (int i = 0; i < a->n; i++) if (!(sgn * (a->p[i][axis] - plane) >= 0)) return 0;
+  return 1;
+}
+
+/* Clips buf[0] to box's six planes, through buf[1]; returns the buffer holding the result. */
+static const clip_poly *clip_box(clip_poly buf[2], bbox box) {
+  int cur = 0;
+  for (int axis = 0; axis < 3; axis++)
+    for (int sidei = 0; sidei < 2 && buf[cur].n > 0; sidei++) {
+      double plane = sidei == 0 ? v3_get(box.lo, axis) : v3_get(box.hi, axis), sgn = sidei == 0 ? 1.0 : -1.0;
+      if (clip_inside(&buf[cur], axis, plane, sgn)) continue;
+      clip_plane(&buf[cur], axis, plane, sgn, &buf[1 - cur]);
+      cur = 1 - cur;
+    }
+  return &buf[cur];
+}
+
+static void clip_start(const float *v, clip_poly *a) {
+  a->n = 3;
+  for (int i = 0; i < 3; i++) {
+    a->exact[i] = 7;
+    for (int k = 0; k < 3; k++) a->p[i][k] = v[3 * i + k];
+  }
+}
+
+/* Conservative float bounds of polygon a, limited to box; 0 when empty. */
+static int clip_bounds(const clip_poly *a, bbox box, bbox *out) {
+  if (a->n == 0) return 0;
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int i = 0; i < n; i++)
+  for (int i = 0; i < a->n; i++)
     for (int k = 0; k < 3; k++) {
-      int ex = (exact[cur][i] >> k) & 1;
-      float l = round_out(poly[cur][i][k], ex, 0), h = round_out(poly[cur][i][k], ex, 1);
+      int ex = (a->exact[i] >> k) & 1;
+      float l = round_out(a->p[i][k], ex, 0), h = round_out(a->p[i][k], ex, 1);
       lo[k] = l < lo[k] ? l : lo[k];
       hi[k] = h > hi[k] ? h : hi[k];
     }
@@ -259,6 +276,22 @@ int kd_clip_bounds(const float *v, bbox box, bbox *out) {
   if (r.lo.x > r.hi.x || r.lo.y > r.hi.y || r.lo.z > r.hi.z) return 0;
   *out = r;
   return 1;
+}
+
+/* A triangle that straddles the plane axis = pos inside box: clipped to box once, then
+ * cut by the plane; the bounds of the parts below and above (lbox and rbox, box's two
+ * halves) in *l and *r. Returns a mask: 1 when the part below is not empty, 2 above. */
+int kd_clip_split(const float *v, bbox box, int axis, float pos, bbox lbox, bbox rbox, bbox *l, bbox *r) {
+  clip_poly buf[2], part;
+  clip_start(v, &buf[0]);
+  const clip_poly *c = clip_box(buf, box);
+  if (c->n == 0) return 0;
+  int mask = 0;
+  clip_plane(c, axis, pos, -1.0, &part);
+  if (clip_bounds(&part, lbox, l)) mask |= 1;
+  clip_plane(c, axis, pos, 1.0, &part);
+  if (clip_bounds(&part, rbox, r)) mask |= 2;
+  return mask;
 }
 
 static void add_events(kd_event *dst, uint32_t *n, uint32_t tri, bbox b, int k) {
@@ -389,9 +422,10 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
   for (uint32_t i = 0; i < nboth; i++) {
     uint32_t t = straddle[i];
     const float *v = &kd->tv[9 * (size_t)t];
-    bbox cb;
-    if (kd_clip_bounds(v, lbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cb, j); lcount++; }
-    if (kd_clip_bounds(v, rbox, &cb)) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cb, j); rcount++; }
+    bbox cl, cr;
+    int mask = kd_clip_split(v, box, k, best_pos, lbox, rbox, &cl, &cr);
+    if (mask & 1) { for (int j = 0; j < 3; j++) add_events(nl_ev[j], &nnl[j], t, cl, j); lcount++; }
+    if (mask & 2) { for (int j = 0; j < 3; j++) add_events(nr_ev[j], &nnr[j], t, cr, j); rcount++; }
   }
   for (int j = 0; j < 3; j++) {
     ev_sort(nl_ev[j], nnl[j], tmp);

@@ -77,7 +77,7 @@ typedef struct kdtree {
 typedef struct kd_ref { float lo[3], hi[3]; uint32_t tri; } kd_ref;
 
 /* The exact sweep (kdtree_build.c), used by the whole build (kdtree_top.c). */
-int kd_clip_bounds(const float *v, bbox box, bbox *out);
+int kd_clip_split(const float *v, bbox box, int axis, float pos, bbox lbox, bbox rbox, bbox *l, bbox *r);
 /* Appends a node to a growing array; UINT32_MAX when out of memory or nodes. */
 uint32_t kd_node_push(kd_node **nodes, uint32_t *n, uint32_t *cap);
 /* A build thread's stack of scratch blocks (kdtree_build.c). */

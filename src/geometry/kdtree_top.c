@@ -122,9 +122,10 @@ static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t
     else if (r->lo[k] >= pos) R[nr++] = *r;
     else {
       const float *v = &t->kd->tv[9 * (size_t)r->tri];
-      bbox cb;
-      if (kd_clip_bounds(v, lbox, &cb)) L[nl++] = (kd_ref){{cb.lo.x, cb.lo.y, cb.lo.z}, {cb.hi.x, cb.hi.y, cb.hi.z}, r->tri};
-      if (kd_clip_bounds(v, rbox, &cb)) R[nr++] = (kd_ref){{cb.lo.x, cb.lo.y, cb.lo.z}, {cb.hi.x, cb.hi.y, cb.hi.z}, r->tri};
+      bbox cl, cr;
+      int mask = kd_clip_split(v, box, k, pos, lbox, rbox, &cl, &cr);
+      if (mask & 1) L[nl++] = (kd_ref){{cl.lo.x, cl.lo.y, cl.lo.z}, {cl.hi.x, cl.hi.y, cl.hi.z}, r->tri};
+      if (mask & 2) R[nr++] = (kd_ref){{cr.lo.x, cr.lo.y, cr.lo.z}, {cr.hi.x, cr.hi.y, cr.hi.z}, r->tri};
     }
   }
   free(refs);
