@@ -2,7 +2,8 @@
  * binned top levels (kdtree_top.c; layout: kdtree_internal.h): Wald & Havran, "On
  * building fast kd-trees for ray tracing, and on doing that in O(N log N)" (2006) —
  * per-axis event lists sorted once per subtree, a linear sweep per node, order-preserving
- * list splitting and exact clipping of straddling triangles to the child voxels (kd_clip_split) — and
+ * list splitting (an empty-space cut's child takes its parent's lists as they are) and
+ * exact clipping of straddling triangles to the child voxels (kd_clip_split) — and
  * the leaves: triangles in leaf order in SSE groups of four, tested four at a time
  * (1.3-1.5x faster than one by one; docs/performance.md). Also the clipping both build
  * phases use, and the box nodes made once the tree is joined. SAH costs: digest 000's
@@ -325,6 +326,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
   vec3 d = v3_sub(box.hi, box.lo);
   float best_cost = INFINITY, best_pos = 0;
   int best_axis = -1, best_planar_left = 0;
+  uint32_t best_cl = 0, best_cr = 0;
   for (int k = 0; k < 3; k++) {
     const kd_event *e = l->e[k];
     uint32_t n = l->n[k], i = 0, nl = 0, np = 0, nr = N;
@@ -347,7 +349,7 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
           uint32_t cl = nl + (planar_left ? np : 0), cr = nr + (planar_left ? 0 : np);
           float eb = (cl == 0 || cr == 0) ? KD_EMPTY_BONUS : 0.0f;
           float cost = KD_TRAVERSE_COST + (1.0f - eb) * (pl * kd_leaf_cost(cl) + pr * kd_leaf_cost(cr));
-          if (cost < best_cost) { best_cost = cost; best_pos = p; best_axis = k; best_planar_left = planar_left; }
+          if (cost < best_cost) { best_cost = cost; best_pos = p; best_axis = k; best_planar_left = planar_left; best_cl = cl; best_cr = cr; }
         }
       }
       nl += ps + pp;
@@ -355,6 +357,20 @@ static void build(kd_builder *b, uint32_t node, bbox box, evlist *l, int depth) 
     }
   }
   if (best_axis < 0 || best_cost >= kd_leaf_cost(N)) { make_leaf(b, node, l); return; }
+  if (best_cl == 0 || best_cr == 0) {
+    /* An empty-space cut: every triangle lies on one side, so that child's event lists
+     * are this node's, in the same order (no classifying, splitting or clipping). */
+    int below_empty = best_cl == 0;
+    bbox cbox = box;
+    if (below_empty) v3_set(&cbox.lo, best_axis, best_pos);
+    else v3_set(&cbox.hi, best_axis, best_pos);
+    kd->nodes[node].split = best_pos;
+    uint32_t child = push_node(b);
+    uint32_t fl = (uint32_t)best_axis | (below_empty ? KD_BELOW_EMPTY | (child << 4) : KD_ABOVE_EMPTY);
+    if (child != UINT32_MAX) build(b, child, cbox, l, depth - 1);
+    kd->nodes[node].flags = fl;
+    return;
+  }
 
   /* Classify triangles (Alg. 5). Everything below is taken from the arena and given
    * back when this subtree is done. */
