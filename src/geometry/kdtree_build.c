@@ -260,17 +260,32 @@ static void clip_start(const float *v, clip_poly *a) {
   }
 }
 
-/* Conservative float bounds of polygon a, limited to box; 0 when empty. */
-static int clip_bounds(const clip_poly *a, bbox box, bbox *out) {
-  if (a->n == 0) return 0;
+/* The extremes of a set of polygon vertices, kept apart for exact and inexact
+ * coordinates: round_out is monotonic for a given exactness, so only they are rounded. */
+typedef struct clip_ext { double mn[2][3], mx[2][3]; uint8_t any[2][3]; } clip_ext;
+
+static void ext_add(clip_ext *e, const double *x, uint8_t exact) {
+  for (int k = 0; k < 3; k++) {
+    int ex = (exact >> k) & 1;
+    if (!e->any[ex][k]) { e->mn[ex][k] = e->mx[ex][k] = x[k]; e->any[ex][k] = 1; }
+    e->mn[ex][k] = x[k] < e->mn[ex][k] ? x[k] : e->mn[ex][k];
+    e->mx[ex][k] = x[k] > e->mx[ex][k] ? x[k] : e->mx[ex][k];
+  }
+}
+
+/* Conservative float bounds of the vertices in e, limited to box; 0 when empty. */
+static int ext_bounds(const clip_ext *e, bbox box, bbox *out) {
   float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  for (int i = 0; i < a->n; i++)
+  int any = 0;
+  for (int ex = 0; ex < 2; ex++)
     for (int k = 0; k < 3; k++) {
-      int ex = (a->exact[i] >> k) & 1;
-      float l = round_out(a->p[i][k], ex, 0), h = round_out(a->p[i][k], ex, 1);
+      if (!e->any[ex][k]) continue;
+      any = 1;
+      float l = round_out(e->mn[ex][k], ex, 0), h = round_out(e->mx[ex][k], ex, 1);
       lo[k] = l < lo[k] ? l : lo[k];
       hi[k] = h > hi[k] ? h : hi[k];
     }
+  if (!any) return 0;
   bbox r = {v3(lo[0], lo[1], lo[2]), v3(hi[0], hi[1], hi[2])};
   r.lo = v3_max(r.lo, box.lo);
   r.hi = v3_min(r.hi, box.hi);
@@ -281,18 +296,37 @@ static int clip_bounds(const clip_poly *a, bbox box, bbox *out) {
 
 /* A triangle that straddles the plane axis = pos inside box: clipped to box once, then
  * cut by the plane; the bounds of the parts below and above (lbox and rbox, box's two
- * halves) in *l and *r. Returns a mask: 1 when the part below is not empty, 2 above. */
+ * halves) in *l and *r. The cut is clip_plane's arithmetic for each side, with an edge's
+ * crossing point computed once for both (it is the same number from either side).
+ * Returns a mask: 1 when the part below is not empty, 2 above. */
 int kd_clip_split(const float *v, bbox box, int axis, float pos, bbox lbox, bbox rbox, bbox *l, bbox *r) {
-  clip_poly buf[2], part;
+  clip_poly buf[2];
   clip_start(v, &buf[0]);
   const clip_poly *c = clip_box(buf, box);
   if (c->n == 0) return 0;
-  int mask = 0;
-  clip_plane(c, axis, pos, -1.0, &part);
-  if (clip_bounds(&part, lbox, l)) mask |= 1;
-  clip_plane(c, axis, pos, 1.0, &part);
-  if (clip_bounds(&part, rbox, r)) mask |= 2;
-  return mask;
+  clip_ext el, er;
+  memset(el.any, 0, sizeof el.any);
+  memset(er.any, 0, sizeof er.any);
+  for (int i = 0; i < c->n; i++) {
+    int ic = (i + 1) % c->n;
+    const double *x = c->p[i], *y = c->p[ic];
+    double da = -(x[axis] - pos), dc = -(y[axis] - pos); /* below: da >= 0; above: -da >= 0 */
+    int in_l = da >= 0, in_r = -da >= 0, cross_l = in_l != (dc >= 0), cross_r = in_r != (-dc >= 0);
+    if (in_l) ext_add(&el, x, c->exact[i]);
+    if (in_r) ext_add(&er, x, c->exact[i]);
+    if (cross_l || cross_r) {
+      double t = da / (da - dc), q[3];
+      uint8_t ex = (uint8_t)(1u << axis);
+      for (int k = 0; k < 3; k++) {
+        q[k] = x[k] + t * (y[k] - x[k]);
+        if (x[k] == y[k] && (c->exact[i] & c->exact[ic] & (1u << k))) ex |= (uint8_t)(1u << k);
+      }
+      q[axis] = pos;
+      if (cross_l) ext_add(&el, q, ex);
+      if (cross_r) ext_add(&er, q, ex);
+    }
+  }
+  return ext_bounds(&el, lbox, l) | ext_bounds(&er, rbox, r) << 1;
 }
 
 static void add_events(kd_event *dst, uint32_t *n, uint32_t tri, bbox b, int k) {
