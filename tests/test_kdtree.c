@@ -494,14 +494,15 @@ static int subtree_tris(const kdtree *kd, uint32_t ni, uint32_t set[5], int *sma
   return m;
 }
 
-/* A mesh of 9 546 triangles (a tessellated sphere, a soup of small random
+/* A mesh of 21 834 triangles (a tessellated sphere, a soup of small random
  * triangles, a large floor and triangles lying in axis planes), so the build's binned
- * top levels, its parallel subtrees and the join all run without ../shared: the tree
+ * top levels (the root's passes in chunks on the thread pool), its parallel subtrees and
+ * the join all run without ../shared: the tree
  * must be byte-identical for 1, 2 and 3 build threads (nodes, groups, ids, alpha lanes),
  * and its closest hits and shadow queries equal brute force on 10 000 rays. */
 static int filter_odd(const void *user, uint32_t tri, float b1, float b2) { (void)user; return tri % 3 != 0 || b1 < 0.5f + 0.3f * b2; }
 static int synthetic_threads(void) {
-  enum { SU = 48, SV = 64, SOUP = 3000, PLANAR = 400 };
+  enum { SU = 96, SV = 96, SOUP = 3000, PLANAR = 400 };
   uint32_t nt = 2 * SU * SV + SOUP + 2 + PLANAR, nv = (SU + 1) * (SV + 1) + 3 * SOUP + 4 + 3 * PLANAR;
   vec3 *pos = malloc(nv * sizeof *pos);
   uint32_t *idx = malloc(3 * (size_t)nt * sizeof *idx), v = 0, t = 0;
