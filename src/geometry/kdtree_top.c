@@ -158,7 +158,7 @@ static int ref_side(const kd_pass *p, const kd_ref *r) { return r->hi[p->k] <= p
 
 /* A straddler's parts below and above the plane (tri UINT32_MAX where a part is empty). */
 static void ref_cut(const kd_pass *p, const kd_ref *r, kd_ref o[2]) {
-  bbox cl, cr;
+  bbox cl = p->lbox, cr = p->rbox; /* kept as they are for an empty part */
   int mask = kd_clip_split(&p->t->kd->tv[9 * (size_t)r->tri], p->box, p->k, p->pos, p->lbox, p->rbox, &cl, &cr);
   o[0] = (kd_ref){{cl.lo.x, cl.lo.y, cl.lo.z}, {cl.hi.x, cl.hi.y, cl.hi.z}, mask & 1 ? r->tri : UINT32_MAX};
   o[1] = (kd_ref){{cr.lo.x, cr.lo.y, cr.lo.z}, {cr.hi.x, cr.hi.y, cr.hi.z}, mask & 2 ? r->tri : UINT32_MAX};
