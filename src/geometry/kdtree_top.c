@@ -3,12 +3,14 @@
  * clipped triangle references (one pass over a node's references per level, no sorted
  * event lists; a large node's passes run in chunks on the thread pool); nodes of at most
  * KD_BIN_MIN references become subtrees built by the exact sweep of kdtree_build.c, in
- * parallel on the thread pool, then joined in depth-first order (the parts copied in
- * parallel). The top levels and every subtree depend on the mesh alone, so the tree and
- * its memory layout are the same for any thread count. */
+ * parallel on the thread pool (while one thread still builds the smaller top levels:
+ * kd_run), then joined in depth-first order (the parts copied in parallel). The top
+ * levels and every subtree depend on the mesh alone, so the tree and its memory layout
+ * are the same for any thread count. */
 #include "geometry/kdtree_internal.h"
 #include "core/error.h"
 #include "core/threadpool.h"
+#include <pthread.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,10 +21,14 @@
 #define KD_BINS 32
 #define KD_BUILD_THREADS_MAX 16
 
-/* A subtree left to the exact sweep: its references and, once built, its part. */
+/* A subtree left to the exact sweep: its references and, once built, its part. A
+ * frontier task (front) is a subtree of the top levels instead, built later into sub. */
+struct kd_top;
 typedef struct kd_task {
   bbox box; kd_ref *refs; uint32_t n; int depth; kdtree part;
   uint32_t at_node; uint64_t at_prim; /* where the join places the part */
+  int front;
+  struct kd_top *sub;
 } kd_task;
 
 typedef struct kd_top {
@@ -34,6 +40,7 @@ typedef struct kd_top {
   uint32_t limit;           /* nodes of at most this many references become tasks */
   int oom;
   int threads;              /* for the passes over a large node's references */
+  uint32_t front_min;       /* nodes of fewer references (and more than limit) become frontier tasks */
 } kd_top;
 
 static uint32_t top_push(kd_top *t) {
@@ -250,6 +257,11 @@ static int partition(kd_pass *p, int threads, uint32_t nchunks, uint32_t *nl, ui
 
 static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t n, int depth) {
   if (n <= t->limit || depth <= 0 || t->oom) { top_task(t, node, box, refs, n, depth); return; }
+  if (n < t->front_min) {
+    top_task(t, node, box, refs, n, depth);
+    if (!t->oom) t->tasks[t->ntasks - 1].front = 1;
+    return;
+  }
   int threads = n >= KD_PAR_MIN ? t->threads : 1;
   uint32_t chunk = threads > 1 ? KD_PAR_CHUNK : n, nchunks = (n + chunk - 1) / chunk;
   kd_chunk *ch = calloc(nchunks, sizeof *ch);
@@ -293,10 +305,14 @@ static void top_build(kd_top *t, uint32_t node, bbox box, kd_ref *refs, uint32_t
 /* Lays out the top subtree at si in kd in depth-first order, each task's part in place
  * of its leaf (the layout a single depth-first build would have made): writes the top
  * nodes and records where each part goes (copied by place_part). */
-static int join(kdtree *kd, kd_top *t, uint32_t si) {
+typedef struct kd_placing { kdtree *kd; kd_task **list; uint32_t n; } kd_placing;
+static int join(kd_placing *w, kd_top *t, uint32_t si) {
+  kdtree *kd = w->kd;
   kd_node n = t->nodes[si];
   if ((n.flags & 3) == KD_LEAF) {
     kd_task *k = &t->tasks[n.prim_offset];
+    if (k->sub) return join(w, k->sub, 0);
+    w->list[w->n++] = k;
     if (kd->nprims + k->part.nprims > 0xFFFFFFFFu || (uint64_t)kd->nnodes + k->part.nnodes > KD_MAX_NODES) return -1;
     k->at_node = kd->nnodes;
     k->at_prim = kd->nprims;
@@ -306,21 +322,21 @@ static int join(kdtree *kd, kd_top *t, uint32_t si) {
   }
   uint32_t d = kd->nnodes++;
   kd->nodes[d] = n;
-  if (!(n.flags & KD_BELOW_EMPTY) && join(kd, t, si + 1)) return -1;
+  if (!(n.flags & KD_BELOW_EMPTY) && join(w, t, si + 1)) return -1;
   if (!(n.flags & KD_ABOVE_EMPTY)) {
     uint32_t above = kd->nnodes;
-    if (join(kd, t, n.flags >> 4)) return -1;
+    if (join(w, t, n.flags >> 4)) return -1;
     kd->nodes[d].flags = (n.flags & 15u) | above << 4;
   }
   return 0;
 }
 
-/* Copies task i's part to where join placed it, its node links and leaf offsets moved. */
-typedef struct kd_placing { kdtree *kd; const kd_top *t; } kd_placing;
+/* Copies the part of the join's task i to where join placed it, its node links and leaf
+ * offsets moved. */
 static void place_part(void *user, int64_t i, int th) {
   (void)th;
   kd_placing *w = user;
-  const kd_task *k = &w->t->tasks[i];
+  const kd_task *k = w->list[i];
   const kdtree *p = &k->part;
   kdtree *kd = w->kd;
   uint32_t nb = k->at_node;
@@ -340,8 +356,19 @@ static void top_free(kd_top *t) {
   for (uint32_t i = 0; i < t->ntasks; i++) {
     kd_task *k = &t->tasks[i];
     free(k->refs); free(k->part.nodes); free(k->part.prims); free(k->part.ids); free(k->part.gfilt);
+    if (k->sub) { top_free(k->sub); free(k->sub); }
   }
   free(t->tasks); free(t->nodes);
+}
+
+/* The nodes, triangle groups and parts of t with its frontier subtrees. */
+static void top_size(const kd_top *t, uint64_t *nn, uint64_t *np, uint32_t *nparts) {
+  *nn += t->nnodes;
+  for (uint32_t i = 0; i < t->ntasks; i++) {
+    const kd_task *k = &t->tasks[i];
+    if (k->sub) top_size(k->sub, nn, np, nparts);
+    else { *nn += k->part.nnodes; *np += k->part.nprims; (*nparts)++; }
+  }
 }
 
 /* A part shares the tree's triangles and hit filter; its arrays start empty. */
@@ -352,8 +379,9 @@ static void part_init(kdtree *part, const kdtree *kd) {
 /* Allocates out's arrays for the top nodes of t and all its tasks' parts, then joins them
  * depth-first. Returns 0, or -1 when out of memory or past the layout's limits. */
 static int join_all(kdtree *out, kd_top *t) {
-  uint64_t nn = t->nnodes, np = 0;
-  for (uint32_t i = 0; i < t->ntasks; i++) { nn += t->tasks[i].part.nnodes; np += t->tasks[i].part.nprims; }
+  uint64_t nn = 0, np = 0;
+  uint32_t nparts = 0;
+  top_size(t, &nn, &np, &nparts);
   if (nn > KD_MAX_NODES || np > 0xFFFFFFFFu) return -1;
   out->nodes = malloc((size_t)nn * sizeof *out->nodes);
   out->prims = malloc((size_t)(np + 1) * sizeof *out->prims);
@@ -361,16 +389,17 @@ static int join_all(kdtree *out, kd_top *t) {
   out->gfilt = malloc((size_t)np + 1);
   if (!out->nodes || !out->prims || !out->ids || !out->gfilt) return -1;
   out->cap_nodes = (uint32_t)nn; out->cap_prims = np;
-  if (join(out, t, 0)) return -1;
-  kd_placing w = {out, t};
-  parallel_for(t->threads, t->ntasks, place_part, &w);
-  return 0;
+  kd_placing w = {out, malloc(((size_t)nparts + 1) * sizeof *w.list), 0};
+  int fail = !w.list || join(&w, t, 0);
+  if (!fail) parallel_for(t->threads, w.n, place_part, &w);
+  free(w.list);
+  return fail ? -1 : 0;
 }
 
 /* Builds the subtree of a node into out (tv and filter set, arrays empty): binned
  * levels down to KD_BIN_MIN references, then the exact sweep of each, joined. */
 static int build_subtree(kdtree *out, uint8_t *side, kd_arena *arena, kd_task *k) {
-  kd_top sub = {out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0, 1};
+  kd_top sub = {out, NULL, 0, 0, NULL, 0, 0, KD_BIN_MIN, 0, 1, 0};
   uint32_t root = top_push(&sub);
   if (root == UINT32_MAX) return -1;
   top_build(&sub, root, k->box, k->refs, k->n, k->depth);
@@ -388,17 +417,76 @@ static int build_subtree(kdtree *out, uint8_t *side, kd_arena *arena, kd_task *k
   return fail ? -1 : 0;
 }
 
-/* The subtrees below the top levels, on the thread pool: each thread has its own scratch. */
-typedef struct kd_run { kd_top *t; uint8_t *side[KD_BUILD_THREADS_MAX]; kd_arena arena[KD_BUILD_THREADS_MAX]; int oom[KD_BUILD_THREADS_MAX]; } kd_run;
-static void run_task(void *user, int64_t i, int th) {
-  kd_run *run = user;
-  kd_task *k = &run->t->tasks[i];
-  part_init(&k->part, run->t->kd);
-  if (run->oom[th] || build_subtree(&k->part, run->side[th], &run->arena[th], k)) run->oom[th] = 1;
-  free(k->refs);
-  k->refs = NULL;
+/* The rest of the build, on the thread pool: one thread builds the frontier subtrees'
+ * top levels, in order, and queues each one's tasks as soon as they exist, while every
+ * thread (that one too, once done) takes tasks from the queue and builds their subtrees
+ * with its own scratch. Which thread builds what does not change any result. */
+typedef struct kd_run {
+  kd_top *t;
+  uint8_t *side[KD_BUILD_THREADS_MAX];
+  kd_arena arena[KD_BUILD_THREADS_MAX];
+  int oom[KD_BUILD_THREADS_MAX];
+  pthread_mutex_t m;
+  pthread_cond_t cv;
+  kd_task **q;              /* the queue: tasks ready to build */
+  uint32_t qn, qcap, qnext;
+  int done;                 /* no more tasks will be queued */
+} kd_run;
+
+/* Queues t's tasks (not its frontier ones); 0, or -1 when out of memory. */
+static int run_queue(kd_run *r, kd_top *t) {
+  int fail = 0;
+  pthread_mutex_lock(&r->m);
+  for (uint32_t i = 0; i < t->ntasks && !fail; i++) {
+    if (t->tasks[i].front) continue;
+    if (r->qn == r->qcap) {
+      uint32_t nc = r->qcap ? 2 * r->qcap : 256;
+      kd_task **g = realloc(r->q, (size_t)nc * sizeof *g);
+      if (!g) { fail = 1; break; }
+      r->q = g; r->qcap = nc;
+    }
+    r->q[r->qn++] = &t->tasks[i];
+  }
+  pthread_cond_broadcast(&r->cv);
+  pthread_mutex_unlock(&r->m);
+  return fail ? -1 : 0;
 }
 
+static void run_item(void *user, int64_t i, int th) {
+  kd_run *r = user;
+  if (i == 0) {
+    kd_top *t = r->t;
+    if (run_queue(r, t)) r->oom[th] = 1;
+    for (uint32_t j = 0; j < t->ntasks && !r->oom[th]; j++) {
+      kd_task *f = &t->tasks[j];
+      if (!f->front) continue;
+      kd_top *sub = calloc(1, sizeof *sub);
+      if (!sub) { r->oom[th] = 1; break; }
+      *sub = (kd_top){t->kd, NULL, 0, 0, NULL, 0, 0, t->limit, 0, 1, 0};
+      f->sub = sub;
+      uint32_t root = top_push(sub);
+      if (root == UINT32_MAX) { r->oom[th] = 1; break; }
+      top_build(sub, root, f->box, f->refs, f->n, f->depth);
+      f->refs = NULL;
+      if (sub->oom || run_queue(r, sub)) r->oom[th] = 1;
+    }
+    pthread_mutex_lock(&r->m);
+    r->done = 1;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->m);
+  }
+  for (;;) {
+    pthread_mutex_lock(&r->m);
+    while (r->qnext == r->qn && !r->done) pthread_cond_wait(&r->cv, &r->m);
+    kd_task *k = r->qnext < r->qn ? r->q[r->qnext++] : NULL;
+    pthread_mutex_unlock(&r->m);
+    if (!k) break;
+    part_init(&k->part, r->t->kd);
+    if (r->oom[th] || build_subtree(&k->part, r->side[th], &r->arena[th], k)) r->oom[th] = 1;
+    free(k->refs);
+    k->refs = NULL;
+  }
+}
 
 valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads, const accel_filter *filter, accel **out,
                           valo_error *err) {
@@ -410,9 +498,11 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   kd->ntris = ntris;
   if (filter && filter->pass && filter->tri_flags) { kd->filter = *filter; kd->has_filter = 1; }
   kd->bounds = bbox_empty();
-  kd_top t = {kd, NULL, 0, 0, NULL, 0, 0, 0, 0, 1};
+  kd_top t = {kd, NULL, 0, 0, NULL, 0, 0, 0, 0, 1, 0};
   kd_run run;
   memset(&run, 0, sizeof run);
+  pthread_mutex_init(&run.m, NULL);
+  pthread_cond_init(&run.cv, NULL);
   kd->tv = malloc(((size_t)ntris * 9 + 1) * sizeof(float));
   kd_ref *refs = malloc(((size_t)ntris + 1) * sizeof *refs);
   if (!kd->tv || !refs) { free(refs); goto oom; }
@@ -434,27 +524,37 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   int max_depth = (int)lroundf(8 + KD_DEPTH_FACTOR * log2f((float)(ntris > 1 ? ntris : 1)));
   if (max_depth > 60) max_depth = 60;
   kd->max_depth_seen = (uint32_t)max_depth;
-  if (ntris == 0) { free(refs); free(kd->tv); kd->tv = NULL; *out = &kd->base; return VALO_OK; }
-  /* The top levels down to nodes of N / 64 references, their large nodes' passes on
-   * the thread pool; the tree depends neither on where that stops nor on the threads. */
+  if (ntris == 0) {
+    free(refs); free(kd->tv); kd->tv = NULL;
+    pthread_mutex_destroy(&run.m); pthread_cond_destroy(&run.cv);
+    *out = &kd->base;
+    return VALO_OK;
+  }
+  /* The top levels down to nodes of N / 64 references: first those of KD_PAR_MIN
+   * references or more, their passes on the thread pool; then the frontier below them
+   * while the tasks are built (kd_run). The tree depends neither on where either
+   * stops nor on the threads. */
   int nth = threads > 0 ? threads : threads_available();
   if (nth > KD_BUILD_THREADS_MAX) nth = KD_BUILD_THREADS_MAX;
   t.threads = nth;
   t.limit = ntris / 64 > KD_BIN_MIN ? ntris / 64 : KD_BIN_MIN;
+  t.front_min = KD_PAR_MIN;
   uint32_t root = top_push(&t);
   if (root == UINT32_MAX) { free(refs); goto oom; }
   top_build(&t, root, kd->bounds, refs, ntris, max_depth);
   if (t.oom) goto oom;
 
-  if ((uint32_t)nth > t.ntasks) nth = (int)t.ntasks;
   run.t = &t;
   for (int i = 0; i < nth; i++)
     if (!(run.side[i] = malloc((size_t)ntris + 1))) goto oom;
-  parallel_for(nth, t.ntasks, run_task, &run);
+  parallel_for(nth, nth, run_item, &run);
   for (int i = 0; i < nth; i++) if (run.oom[i]) goto oom;
 
   if (join_all(kd, &t) || kd_box_nodes(kd)) goto oom;
   for (int i = 0; i < nth; i++) { free(run.side[i]); kd_arena_free(&run.arena[i]); }
+  free(run.q);
+  pthread_mutex_destroy(&run.m);
+  pthread_cond_destroy(&run.cv);
   top_free(&t);
   free(kd->tv);
   kd->tv = NULL;
@@ -462,6 +562,9 @@ valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   return VALO_OK;
 oom:
   for (int i = 0; i < KD_BUILD_THREADS_MAX; i++) { free(run.side[i]); kd_arena_free(&run.arena[i]); }
+  free(run.q);
+  pthread_mutex_destroy(&run.m);
+  pthread_cond_destroy(&run.cv);
   top_free(&t);
   kdtree_free(kd);
   return err_set(err, VALO_ERR_NOMEM, "kd-tree: out of memory while building");
