@@ -253,7 +253,7 @@ static int ply_valid_forms(void) {
   }
   buf b = {0};
   ply_header(&b, "ascii", 4, 2, "uchar");
-  puts_(&b, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n4 0 1 2 3\r\n\n");
+  puts_(&b, "-1.0e0 -1 0\n+1 -1. 0\n1 1 -.0\n-1 1E+0 0\n3 0 1 2\n4 0 1 2 3\r\n\n"); /* the number forms valo and Assimp share */
   const char *p = write_bytes("quad_ascii.ply", b.d, b.n);
   free(b.d);
   const char *a[] = MESH_ARGS(p);
@@ -273,6 +273,11 @@ static int ply_ascii_damaged(void) {
       {"a_count_over_line.ply", "missing", 4, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n9 0 2 3\n"},
       {"a_extra_values.ply", "more values", 4, 2, "-1 -1 0 7\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
       {"a_not_number.ply", "not a number", 4, 2, "-1 -1 0\n1 x -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
+      {"a_blank_line.ply", ":12: a blank line in the data (element 'vertex' 2 of 4)", 4, 2, "-1 -1 0\n\n\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
+      {"a_space_line.ply", ":16: a blank line in the data (element 'face' 2 of 2)", 4, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n \r\n3 0 2 3\n"},
+      {"a_plus_count.ply", ":16: list", 4, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n+3 0 2 3\n"},
+      {"a_hex_float.ply", ":12: ", 4, 2, "-1 -1 0\n1 0x1p0 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
+      {"a_count_over_type.ply", ":15: list", 4, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n259 0 1 2\n3 0 2 3\n"},
       {"a_trailing.ply", "after the last element", 4, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n3 0 1 3\n"},
       {"a_absurd_count.ply", "more than the file", 4000000000L, 2, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
       {"a_absurd_faces.ply", "more than the file", 4, 3000000000L, "-1 -1 0\n1 -1 0\n1 1 0\n-1 1 0\n3 0 1 2\n3 0 2 3\n"},
@@ -296,6 +301,17 @@ static int ply_ascii_damaged(void) {
       {"a_no_xyz.ply", "no x, y and z", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n"},
       {"a_strips.ply", "strips", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                                  "element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+      {"a_two_formats.ply", ":3: a second format line", "ply\nformat ascii 1.0\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+                                                   "property float y\nproperty float z\nend_header\n0 0 0\n"},
+      {"a_two_vertex_elements.ply", ":7: a second 'vertex' element",
+       "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nelement vertex 1\nproperty float x\n"
+       "property float y\nproperty float z\nproperty uchar red\nend_header\n0 0 0\n1 0 0 9\n"},
+      {"a_blank_header_line.ply", ":6: a blank line in the PLY header", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\nproperty float z\nend_header\n0 0 0\n"},
+      {"a_obj_info_in_props.ply", ":6: a property after an obj_info", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nobj_info made by hand\nproperty float y\nproperty float z\nend_header\n0 0 0\n"},
+      {"a_unknown_element.ply", ":3: element 'vertices' is not one", "ply\nformat ascii 1.0\nelement vertices 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"},
+      {"a_two_face_elements.ply", ":9: a second 'face' element",
+       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+       "property list uchar int vertex_indices\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"},
   };
   for (size_t i = 0; i < sizeof heads / sizeof heads[0]; i++) {
     const char *p = write_bytes(heads[i].name, heads[i].text, strlen(heads[i].text));

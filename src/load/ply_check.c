@@ -62,6 +62,16 @@ static size_t type_size(ply_type t) {
   return 0;
 }
 static int type_is_int(ply_type t) { return t != T_F32 && t != T_F64 && t != T_BAD; }
+static void int_range(ply_type t, double *lo, double *hi) {
+  switch (t) {
+  case T_I8: *lo = INT8_MIN; *hi = INT8_MAX; break;
+  case T_U8: *lo = 0; *hi = UINT8_MAX; break;
+  case T_I16: *lo = INT16_MIN; *hi = INT16_MAX; break;
+  case T_U16: *lo = 0; *hi = UINT16_MAX; break;
+  case T_I32: *lo = INT32_MIN; *hi = INT32_MAX; break;
+  case T_U32: case T_F32: case T_F64: case T_BAD: *lo = 0; *hi = UINT32_MAX; break;
+  }
+}
 
 int ply_is_ply(const unsigned char *d, size_t len) {
   return len >= 4 && d[0] == 'p' && d[1] == 'l' && d[2] == 'y' && (d[3] == '\n' || d[3] == '\r');
@@ -99,13 +109,39 @@ static int ascii_token(ply_reader *r, const unsigned char **tok, size_t *len) {
   *len = (size_t)(r->p - *tok);
   return 1;
 }
+/* The number forms both valo and Assimp's ASCII PLY reader read whole and alike: digits
+ * for unsigned types, a sign and digits for signed ones, and for reals a sign, digits with
+ * an optional point and exponent, or nan / inf / infinity. Anything else Assimp would read
+ * in part ("+3" as an unsigned count is 0 there) and then read the rest of the line as
+ * further values, handing on faces that disagree with valo's check. */
+static size_t digits(const unsigned char *s, size_t i, size_t n) {
+  while (i < n && s[i] >= '0' && s[i] <= '9') i++;
+  return i;
+}
+static int ascii_form_ok(const unsigned char *s, size_t n, ply_type t) {
+  size_t i = 0;
+  int sign = n && (s[0] == '-' || s[0] == '+');
+  if (t == T_U8 || t == T_U16 || t == T_U32) return n && digits(s, 0, n) == n;
+  if (type_is_int(t)) return n > (size_t)sign && digits(s, (size_t)sign, n) == n;
+  i = (size_t)sign;
+  size_t rest = n - i;
+  if ((rest == 3 && (!strncasecmp((const char *)s + i, "nan", 3) || !strncasecmp((const char *)s + i, "inf", 3))) ||
+      (rest == 8 && !strncasecmp((const char *)s + i, "infinity", 8)))
+    return 1;
+  size_t a = digits(s, i, n), b = a;
+  if (b < n && s[b] == '.') b = digits(s, b + 1, n);
+  if (a == i && b <= a + 1) return 0; /* no digit before or after the point */
+  if (b < n && (s[b] == 'e' || s[b] == 'E')) {
+    size_t e = b + 1 + (b + 1 < n && (s[b + 1] == '-' || s[b + 1] == '+'));
+    b = digits(s, e, n);
+    if (b == e) return 0;
+  }
+  return b == n;
+}
 static int ascii_read(ply_reader *r, ply_type t, double *out) {
   const unsigned char *tok;
   size_t len;
-  if (!ascii_token(r, &tok, &len) || len > 63) return 0;
-  /* a control byte (a NUL would end the number early here, not in Assimp's reader) */
-  for (size_t k = 0; k < len; k++)
-    if (tok[k] < 32 || tok[k] == 127) return 0;
+  if (!ascii_token(r, &tok, &len) || len > 63 || !ascii_form_ok(tok, len, t)) return 0;
   char buf[64];
   memcpy(buf, tok, len);
   buf[len] = 0;
@@ -113,7 +149,9 @@ static int ascii_read(ply_reader *r, ply_type t, double *out) {
   errno = 0;
   if (type_is_int(t)) {
     long long v = strtoll(buf, &e, 10);
-    if (*e || errno) return 0;
+    double lo = 0, hi = 0;
+    int_range(t, &lo, &hi);
+    if (*e || errno || (double)v < lo || (double)v > hi) return 0; /* Assimp would wrap it */
     *out = (double)v;
   } else {
     double v = strtod(buf, &e);
@@ -128,6 +166,11 @@ static int ascii_end_line(ply_reader *r) {
   if (r->p < r->end && *r->p == '\r') r->p++;
   if (r->p < r->end && *r->p == '\n') { r->p++; r->line++; return 1; }
   return r->p >= r->end; /* the last line may lack its newline */
+}
+static int ascii_line_blank(const ply_reader *r) {
+  const unsigned char *q = r->p;
+  while (q < r->end && (*q == ' ' || *q == '\t' || *q == '\r')) q++;
+  return q >= r->end || *q == '\n';
 }
 static void ascii_skip_blank_lines(ply_reader *r) {
   for (;;) {
@@ -161,8 +204,12 @@ static valo_status bad_at(ply_reader *r, const char *what, const ply_elem *e, ui
                  (unsigned long long)i + 1, (unsigned long long)e->count, (unsigned long long)(r->p - r->data));
 }
 
-static int is_vertex_elem(const char *n) { return !strcmp(n, "vertex") || !strcmp(n, "vertices"); }
-static int is_face_elem(const char *n) { return !strcmp(n, "face") || !strcmp(n, "faces"); }
+/* The element names Assimp's PLY reader knows (as whole words, case and all). It reads any
+ * other element ("vertices", "range_grid") as having no instances, and so would read its
+ * data as the next element's. */
+static int is_vertex_elem(const char *n) { return !strcmp(n, "vertex"); }
+static int is_face_elem(const char *n) { return !strcmp(n, "face"); }
+static int assimp_counts_elem(const char *n) { return is_vertex_elem(n) || is_face_elem(n) || !strcmp(n, "edge") || !strcmp(n, "material"); }
 static int is_index_list(const char *n) { return !strcmp(n, "vertex_indices") || !strcmp(n, "vertex_index"); }
 
 static valo_status check_body(ply_reader *r, const ply_elem *el, int nel, uint64_t nverts) {
@@ -170,7 +217,14 @@ static valo_status check_body(ply_reader *r, const ply_elem *el, int nel, uint64
     const ply_elem *e = &el[k];
     int face = is_face_elem(e->name);
     for (uint64_t i = 0; i < e->count; i++) {
-      if (r->fmt == F_ASCII) ascii_skip_blank_lines(r);
+      /* Assimp reads each line as one element, so a blank line would shift every one after
+       * it (and a face short of its indices aborts the process) */
+      if (r->fmt == F_ASCII && r->p < r->end && ascii_line_blank(r)) {
+        const unsigned char *q = r->p;
+        size_t line = r->line;
+        ascii_skip_blank_lines(r);
+        if (r->p < r->end) { r->p = q; r->line = line; return bad_at(r, "a blank line in the data", e, i); }
+      }
       if (r->p >= r->end) {
         if (r->fmt == F_ASCII)
           return err_set(r->err, VALO_ERR_PARSE, "%s:%zu: the file ends after %llu of %llu '%s' elements", r->path, r->line,
@@ -243,7 +297,7 @@ valo_status ply_check(const char *path, const unsigned char *data, size_t len, v
   ply_elem *elems = calloc(PLY_MAX_ELEMENTS, sizeof *elems);
   if (!elems) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path);
   valo_status st = VALO_OK;
-  int nel = 0, have_format = 0, done = 0;
+  int nel = 0, have_format = 0, done = 0, in_props = 0;
   size_t line = 0;
   const unsigned char *p = data, *end = data + (len < PLY_MAX_HEADER ? len : PLY_MAX_HEADER);
   while (!done) {
@@ -267,8 +321,18 @@ valo_status ply_check(const char *path, const unsigned char *data, size_t len, v
       if (strcmp(w0, "ply") || nw != 1) { st = err_set(err, VALO_ERR_PARSE, "%s:1: not a PLY file (no 'ply' line)", path); goto out; }
       continue;
     }
-    if (nw <= 0 || !strcmp(w0, "comment") || !strcmp(w0, "obj_info")) continue;
+    /* Assimp ends an element's properties at the first line that is neither a property
+     * nor a comment, and skips the properties after it: a blank line or an obj_info
+     * there would give it a different layout (fuzz/regressions/scene_ply) */
+    if (nw <= 0) { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: a blank line in the PLY header", path, line); goto out; }
+    if (!strcmp(w0, "comment")) continue;
+    if (!strcmp(w0, "obj_info")) { in_props = 0; continue; }
+    if (!strcmp(w0, "property") && nel && !in_props) {
+      st = err_set(err, VALO_ERR_PARSE, "%s:%zu: a property after an obj_info line: put obj_info lines before the first element", path, line);
+      goto out;
+    }
     if (!strcmp(w0, "format")) {
+      if (have_format) { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: a second format line", path, line); goto out; }
       if (nw != 3 || strcmp(w2, "1.0")) { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: bad format line (want 'format ascii|binary_little_endian|binary_big_endian 1.0')", path, line); goto out; }
       if (!strcmp(w1, "ascii")) r.fmt = F_ASCII;
       else if (!strcmp(w1, "binary_little_endian")) r.fmt = F_LE;
@@ -280,14 +344,26 @@ valo_status ply_check(const char *path, const unsigned char *data, size_t len, v
       char *e;
       errno = 0;
       unsigned long long c = strtoull(w2, &e, 10);
-      if (nw != 3 || *e || errno || w2[0] == '-') { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: bad element line (want 'element NAME COUNT')", path, line); goto out; }
+      if (nw != 3 || *e || errno || !isdigit((unsigned char)w2[0])) { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: bad element line (want 'element NAME COUNT')", path, line); goto out; }
       if (!strcmp(w1, "tristrips")) {
         st = err_set(err, VALO_ERR_UNSUPPORTED, "%s: PLY triangle strips (element tristrips) are not supported; convert the mesh to faces", path);
+        goto out;
+      }
+      /* Assimp reads every vertex (face) element into the one mesh, with arrays sized by
+       * one of them: two of either corrupt its heap (fuzz/regressions/scene_ply) */
+      for (int k = 0; k < nel; k++)
+        if ((is_vertex_elem(w1) && is_vertex_elem(elems[k].name)) || (is_face_elem(w1) && is_face_elem(elems[k].name))) {
+          st = err_set(err, VALO_ERR_UNSUPPORTED, "%s:%zu: a second '%s' element (valo reads one vertex and one face element per PLY)", path, line, w1);
+          goto out;
+        }
+      if (c && !assimp_counts_elem(w1)) {
+        st = err_set(err, VALO_ERR_UNSUPPORTED, "%s:%zu: element '%s' is not one the PLY reader knows (vertex, face, edge, material); remove it or rename it", path, line, w1);
         goto out;
       }
       snprintf(elems[nel].name, sizeof elems[nel].name, "%s", w1);
       elems[nel].count = c;
       nel++;
+      in_props = 1;
     } else if (!strcmp(w0, "property")) {
       if (!nel) { st = err_set(err, VALO_ERR_PARSE, "%s:%zu: a property before any element", path, line); goto out; }
       ply_elem *e = &elems[nel - 1];

@@ -3,8 +3,13 @@
  * the file's size, ASCII numbers and line lengths, binary lengths), and every face's vertex
  * count and indices. Assimp 5.2.5 (Debian 12, libassimp5 5.2.5~ds0-1+b1) keeps its
  * assertions, and its PLY reader hands faces that disagree with the header to
- * TriangulateProcess, which aborts the process (`numOut != pMesh->mNumFaces`); so a PLY
- * reaches Assimp only once every face is known to be a polygon of valid indices. */
+ * TriangulateProcess, which aborts the process (`numOut != pMesh->mNumFaces`); it reads two
+ * vertex (or face) elements into one mesh whose arrays disagree, freeing what it never
+ * allocated; it reads an element whose name it does not know as empty, a blank line as an
+ * element, and "+3" as an unsigned 0. So a PLY reaches Assimp only when both would read it
+ * alike: one format line, one vertex and one face element, no other elements with
+ * instances but edge and material, numbers in the forms both read whole, no blank lines
+ * within the data, and every face a polygon of valid indices. */
 #ifndef VALO_PLY_CHECK_H
 #define VALO_PLY_CHECK_H
 #include "valo/valo.h"
