@@ -309,6 +309,7 @@ static int ply_ascii_damaged(void) {
       {"a_blank_header_line.ply", ":6: a blank line in the PLY header", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\nproperty float z\nend_header\n0 0 0\n"},
       {"a_obj_info_in_props.ply", ":6: a property after an obj_info", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nobj_info made by hand\nproperty float y\nproperty float z\nend_header\n0 0 0\n"},
       {"a_unknown_element.ply", ":3: element 'vertices' is not one", "ply\nformat ascii 1.0\nelement vertices 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"},
+      {"a_digit_element.ply", ":3: element '12' is not one", "ply\nformat ascii 1.0\nelement 12 0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"},
       {"a_two_face_elements.ply", ":9: a second 'face' element",
        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
        "property list uchar int vertex_indices\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"},

@@ -125,6 +125,43 @@ static int gltf_and_ply_load(void) {
   return 0;
 }
 
+/* A binary PLY whose data begins with a line feed (x of the first vertex is the float
+ * 0xbf80000a, about -1, written little-endian): Assimp skips that byte after a header ending
+ * "\n", so the loader hands it the header ending "\r\n"; the quad must load as written. */
+static int ply_data_starting_with_line_feed(void) {
+  static const uint32_t v[4][3] = {{0xbf80000au, 0xbf800000u, 0}, {0x3f800000u, 0xbf800000u, 0}, {0x3f800000u, 0x3f800000u, 0}, {0xbf800000u, 0x3f800000u, 0}};
+  static const char head[] = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                             "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  unsigned char d[sizeof head + 48 + 26];
+  size_t n = sizeof head - 1;
+  memcpy(d, head, n);
+  for (int i = 0; i < 4; i++)
+    for (int k = 0; k < 3; k++)
+      for (int b = 0; b < 4; b++) d[n++] = (unsigned char)(v[i][k] >> (8 * b));
+  static const int f[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  for (int i = 0; i < 2; i++) {
+    d[n++] = 3;
+    for (int k = 0; k < 3; k++)
+      for (int b = 0; b < 4; b++) d[n++] = (unsigned char)((uint32_t)f[i][k] >> (8 * b));
+  }
+  CHECK(d[sizeof head - 1] == '\n', "the data must start with a line feed");
+  char path[1200];
+  snprintf(path, sizeof path, "%s/lf_first.ply", scratch_dir());
+  FILE *fp = fopen(path, "wb");
+  CHECK(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0, "cannot write %s", path);
+  scene *s = scene_new(path);
+  valo_error err;
+  CHECK(load_mesh(s, path, NULL, UINT32_MAX, 1, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->ntris == 2 && s->nverts >= 4, "%u triangles, %u vertices (expected the quad's 2 and 4)", s->ntris, s->nverts);
+  for (uint32_t t = 0; t < s->ntris; t++)
+    for (int k = 0; k < 3; k++) {
+      vec3 q = s->pos[s->idx[3 * t + k]];
+      CHECK(fabsf(fabsf(q.x) - 1) < 1e-5f && fabsf(fabsf(q.y) - 1) < 1e-5f && q.z == 0, "triangle %u corner %d at (%g %g %g)", t, k, q.x, q.y, q.z);
+    }
+  scene_free(s);
+  return 0;
+}
+
 /* glTF KHR_lights_punctual: a point light at (0,2,0) of colour (1,.5,.25) x 5, a spot at
  * (1,1,1) turned to point down with cones 0.2/0.5 rad, a directional light pointing down. */
 static const char *LIGHTS_GLTF = "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"color\": [1, 0.5, 0.25], \"intensity\": 5}, {\"type\": \"spot\", \"intensity\": 2, \"spot\": {\"innerConeAngle\": 0.2, \"outerConeAngle\": 0.5}}, {\"type\": \"directional\", \"intensity\": 3}]}}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1, 2, 3]}], \"nodes\": [{\"mesh\": 0}, {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}, {\"translation\": [1, 1, 1], \"rotation\": [-0.7071068, 0, 0, 0.7071068], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 1}}}, {\"rotation\": [-0.7071068, 0, 0, 0.7071068], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 2}}}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1}]}], \"buffers\": [{\"byteLength\": 44, \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA=\"}], \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 36}, {\"buffer\": 0, \"byteOffset\": 36, \"byteLength\": 6}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}, {\"bufferView\": 1, \"componentType\": 5123, \"count\": 3, \"type\": \"SCALAR\"}]}";
@@ -309,6 +346,6 @@ static int fallback_warnings(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
-                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
+                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -450,7 +450,9 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   /* A PLY (by its magic, whatever its name) is checked by valo first: Assimp aborts the
    * process on faces that disagree with the header (ply_check.h), and reads a PLY of
    * triangle strips as one bogus polygon without an error. */
-  valo_status pst = ply_check_file(path, err);
+  char *ply_fixed = NULL;
+  size_t ply_fixed_len = 0;
+  valo_status pst = ply_check_file(path, &ply_fixed, &ply_fixed_len, err);
   if (pst) return pst;
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
   const char *ext = strrchr(path, '.');
@@ -464,8 +466,14 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     valo_status cst = obj_check_read(path, &oc, err);
     if (cst) return cst;
     obj_check_fileio(&oc, &io);
+  } else if (ply_fixed) { /* the PLY as Assimp must read it, served like a repaired OBJ */
+    snprintf(oc.files[0].path, sizeof oc.files[0].path, "%s", path);
+    oc.files[0].text = ply_fixed;
+    oc.files[0].len = ply_fixed_len;
+    oc.nfiles = 1;
+    obj_check_fileio(&oc, &io);
   }
-  const struct aiScene *ai = obj ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
+  const struct aiScene *ai = obj || ply_fixed ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
   if (!ai) {
     const char *msg = aiGetErrorString();
     obj_check_free(&oc);

@@ -292,7 +292,8 @@ static valo_status check_body(ply_reader *r, const ply_elem *el, int nel, uint64
   return VALO_OK;
 }
 
-valo_status ply_check(const char *path, const unsigned char *data, size_t len, valo_error *err) {
+valo_status ply_check(const char *path, const unsigned char *data, size_t len, size_t *cr_at, valo_error *err) {
+  if (cr_at) *cr_at = 0;
   ply_reader r = {path, data, data, data + len, F_ASCII, 1, err};
   ply_elem *elems = calloc(PLY_MAX_ELEMENTS, sizeof *elems);
   if (!elems) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path);
@@ -356,7 +357,8 @@ valo_status ply_check(const char *path, const unsigned char *data, size_t len, v
           st = err_set(err, VALO_ERR_UNSUPPORTED, "%s:%zu: a second '%s' element (valo reads one vertex and one face element per PLY)", path, line, w1);
           goto out;
         }
-      if (c && !assimp_counts_elem(w1)) {
+      /* (and it takes the count of one from the digits its name starts with) */
+      if ((c || isdigit((unsigned char)w1[0])) && !assimp_counts_elem(w1)) {
         st = err_set(err, VALO_ERR_UNSUPPORTED, "%s:%zu: element '%s' is not one the PLY reader knows (vertex, face, edge, material); remove it or rename it", path, line, w1);
         goto out;
       }
@@ -427,12 +429,17 @@ valo_status ply_check(const char *path, const unsigned char *data, size_t len, v
   r.p = p;
   r.line = line + 1;
   st = check_body(&r, elems, nel, nverts);
+  /* Assimp skips a line feed that starts the binary data after a header ending "\n" (not
+   * after one ending "\r\n"): the first vertex would lose its first byte */
+  if (!st && cr_at && r.fmt != F_ASCII && p < data + len && *p == '\n' && p[-2] != '\r') *cr_at = (size_t)(p - 1 - data);
 out:
   free(elems);
   return st;
 }
 
-valo_status ply_check_file(const char *path, valo_error *err) {
+valo_status ply_check_file(const char *path, char **fixed, size_t *fixed_len, valo_error *err) {
+  *fixed = NULL;
+  *fixed_len = 0;
   FILE *f = fopen(path, "rb");
   if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
   unsigned char magic[4];
@@ -453,7 +460,17 @@ valo_status ply_check_file(const char *path, valo_error *err) {
   if (!buf) { fclose(f); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, len); }
   size_t n = fread(buf, 1, len, f);
   fclose(f);
-  valo_status st = n == len ? ply_check(path, buf, len, err) : err_set(err, VALO_ERR_IO, "%s: cannot read", path);
+  size_t cr_at = 0;
+  valo_status st = n == len ? ply_check(path, buf, len, &cr_at, err) : err_set(err, VALO_ERR_IO, "%s: cannot read", path);
+  if (!st && cr_at) { /* the same file with its header ending "\r\n" */
+    char *f2 = malloc(len + 1);
+    if (!f2) { free(buf); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory (%zu bytes)", path, len + 1); }
+    memcpy(f2, buf, cr_at);
+    f2[cr_at] = '\r';
+    memcpy(f2 + cr_at + 1, buf + cr_at, len - cr_at);
+    *fixed = f2;
+    *fixed_len = len + 1;
+  }
   free(buf);
   return st;
 }

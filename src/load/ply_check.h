@@ -19,8 +19,11 @@
 int ply_is_ply(const unsigned char *data, size_t len);
 /* Checks the PLY held in data (len bytes, read from path, named in messages). Returns
  * VALO_OK or an error "path: what is wrong" (with the line for header and ASCII faults). */
-valo_status ply_check(const char *path, const unsigned char *data, size_t len, valo_error *err);
+valo_status ply_check(const char *path, const unsigned char *data, size_t len, size_t *cr_at, valo_error *err);
 /* Reads path and checks it; VALO_OK for a file that is not a PLY (a name ending in .ply
- * must be one). */
-valo_status ply_check_file(const char *path, valo_error *err);
+ * must be one). *fixed (malloc'd, *fixed_len bytes) is NULL, or the file as Assimp must be
+ * given it: a binary PLY whose data starts with a line feed, its header ending in "\r\n"
+ * (Assimp would skip that byte after a plain "\n"; with ply_check, *cr_at is where the
+ * '\r' goes, or 0). */
+valo_status ply_check_file(const char *path, char **fixed, size_t *fixed_len, valo_error *err);
 #endif
