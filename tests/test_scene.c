@@ -241,6 +241,23 @@ static int mtl_pbr_extension(void) {
   return 0;
 }
 
+/* MTL statements before the first newmtl belong to no material: valo drops them (Assimp
+ * 5.2 writes a texture statement there through a null material and crashes), and the
+ * material after them loads as written. */
+static int mtl_before_newmtl(void) {
+  scratch_file("orphan.mtl", "# a texture before any material\nmap_Kd tex.png\nbump b.png\nKd 1 0 0\nnewmtl m\nKd 0 1 0\n");
+  const char *obj = scratch_file("orphan.obj", "mtllib orphan.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n");
+  scene *s = scene_new(obj);
+  valo_error err;
+  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+  int m = mat_by_name(s, "m");
+  CHECK(m >= 0 && s->ntris == 1, "material m %d, %u triangles", m, s->ntris);
+  CHECK(s->mats[m].kd.g == 1 && s->mats[m].kd.r == 0 && s->mats[m].tex_kd < 0, "m: Kd (%g %g), texture %d", s->mats[m].kd.r,
+        s->mats[m].kd.g, s->mats[m].tex_kd);
+  scene_free(s);
+  return 0;
+}
+
 /* OBJ text Assimp 5.2 misreads or hides: numbers with a leading dot or a zero
  * in the exponent load with their values; faces with fewer than three vertices are
  * dropped, not fatal. */
@@ -345,6 +362,7 @@ static int fallback_warnings(void) {
 
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
+                                    {"mtl_before_newmtl", mtl_before_newmtl},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
                                     {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
   return test_main(argc, argv, cases);

@@ -163,6 +163,7 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
   int line = 0;
   mtl_pbr *cur = NULL;
   char ignored[128] = "";
+  int orphans = 0, orphan_line = 0;
   for (; s < end; s = next) {
     const char *e = line_end(s, end, &next);
     line++;
@@ -181,16 +182,20 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
       ob_put(&o, s, (size_t)(next - s));
       continue;
     }
+    if (!cur) { /* Assimp writes a texture statement here through a null material */
+      if (!orphans++) orphan_line = line;
+      continue;
+    }
     double v;
     if ((tok_is(tb[0], te[0], "Pr") || tok_is(tb[0], te[0], "Pm")) && nt >= 2 && tok_number(tb[1], te[1], &v)) {
-      if (cur && isfinite(v)) {
+      if (isfinite(v)) {
         if (tb[0][1] == 'r') { cur->has_pr = 1; cur->pr = (float)v; }
         else { cur->has_pm = 1; cur->pm = (float)v; }
       }
       continue; /* valo reads these itself */
     }
     if ((tok_is(tb[0], te[0], "map_Pr") || tok_is(tb[0], te[0], "map_Pm")) && nt >= 2) {
-      if (cur) snprintf(tb[0][5] == 'r' ? cur->map_pr : cur->map_pm, sizeof cur->map_pr, "%.*s", (int)(te[nt < 8 ? nt - 1 : 7] - tb[nt < 8 ? nt - 1 : 7]), tb[nt < 8 ? nt - 1 : 7]);
+      snprintf(tb[0][5] == 'r' ? cur->map_pr : cur->map_pm, sizeof cur->map_pr, "%.*s", (int)(te[nt < 8 ? nt - 1 : 7] - tb[nt < 8 ? nt - 1 : 7]), tb[nt < 8 ? nt - 1 : 7]);
       continue;
     }
     const char *ign[] = {"Ps", "Pc", "Pcr", "aniso", "anisor", "map_Ps", "map_Pc", "map_Pcr", NULL};
@@ -211,6 +216,9 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
   }
   free(txt);
   if (o.oom) { free(o.p); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  if (orphans)
+    log_warning("%s:%d: %d statement%s before the first newmtl belong%s to no material and %s ignored", path, orphan_line, orphans,
+                orphans > 1 ? "s" : "", orphans > 1 ? "" : "s", orphans > 1 ? "are" : "is");
   if (ignored[0]) log_warning("%s: %s (sheen, clearcoat, anisotropy) are not modelled by valo and are ignored", path, ignored);
   obj_text *f = &oc->files[oc->nfiles++];
   snprintf(f->path, sizeof f->path, "%s", path);

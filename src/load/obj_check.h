@@ -4,7 +4,9 @@
  * would otherwise vanish (faces with fewer than three vertices, line and point elements,
  * lines it does not understand, usemtl names no MTL defines, unreadable mtllib files),
  * repairs of valid text Assimp 5.2 misreads (numbers with a leading dot such as .8e-1;
- * MTL lines such as `aniso` that stop its MTL parser), and the PBR extension of MTL
+ * MTL lines such as `aniso` that stop its MTL parser; MTL statements before the first
+ * newmtl, dropped with a warning, since Assimp writes a texture there through a null
+ * material), and the PBR extension of MTL
  * (Pr, Pm, map_Pr, map_Pm; Ps, Pc, Pcr, aniso noted as ignored), which valo reads itself.
  * The repaired texts are served to Assimp through its file-system callbacks. */
 #ifndef VALO_OBJ_CHECK_H
