@@ -243,9 +243,12 @@ static int mtl_pbr_extension(void) {
 
 /* MTL statements before the first newmtl belong to no material: valo drops them (Assimp
  * 5.2 writes a texture statement there through a null material and crashes), and the
- * material after them loads as written. */
+ * material after them loads as written. A comment is one line to the end, though Assimp
+ * ends a line at a lone carriage return or a form feed too (the statements hidden after
+ * them crashed it, or changed a colour). */
 static int mtl_before_newmtl(void) {
-  scratch_file("orphan.mtl", "# a texture before any material\nmap_Kd tex.png\nbump b.png\nKd 1 0 0\nnewmtl m\nKd 0 1 0\n");
+  scratch_file("orphan.mtl", "# a texture before any material\nmap_Kd tex.png\nbump b.png\nKd 1 0 0\n# c\rmap_Kd cr.png\n"
+                             "# c\fbump ff.png\nnewmtl m\nKd 0 1 0\n# c\rKd 1 0 0\n# c\fmap_Kd hidden.png\n");
   const char *obj = scratch_file("orphan.obj", "mtllib orphan.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n");
   scene *s = scene_new(obj);
   valo_error err;
@@ -254,6 +257,22 @@ static int mtl_before_newmtl(void) {
   CHECK(m >= 0 && s->ntris == 1, "material m %d, %u triangles", m, s->ntris);
   CHECK(s->mats[m].kd.g == 1 && s->mats[m].kd.r == 0 && s->mats[m].tex_kd < 0, "m: Kd (%g %g), texture %d", s->mats[m].kd.r,
         s->mats[m].kd.g, s->mats[m].tex_kd);
+  scene_free(s);
+  return 0;
+}
+
+/* Indented lines, which Assimp 5.2 skips whole in OBJ text and as an MTL's first line (a
+ * vertex lost shifted every index after it; an indented first newmtl left the statements
+ * after it to a null material): both load as written. */
+static int obj_mtl_indented(void) {
+  scratch_file("indent.mtl", "  newmtl m\n\tKd 0 1 0\n");
+  const char *obj = scratch_file("indent.obj", "mtllib indent.mtl\nv 0 0 0\n  v 1 0 0\n\tv 0 1 0\n  usemtl m\n f 1 2 3\n");
+  scene *s = scene_new(obj);
+  valo_error err;
+  CHECK(load_mesh(s, obj, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+  int m = mat_by_name(s, "m");
+  CHECK(s->ntris == 1 && m >= 0, "%u triangles, material m %d", s->ntris, m);
+  CHECK(s->mats[m].kd.g == 1 && s->mats[m].kd.r == 0, "m: Kd (%g %g %g)", s->mats[m].kd.r, s->mats[m].kd.g, s->mats[m].kd.b);
   scene_free(s);
   return 0;
 }
@@ -363,6 +382,7 @@ static int fallback_warnings(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"mtl_before_newmtl", mtl_before_newmtl},
+                                    {"obj_mtl_indented", obj_mtl_indented},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
                                     {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
   return test_main(argc, argv, cases);

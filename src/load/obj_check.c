@@ -158,6 +158,13 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
                 strerror(errno));
     return VALO_OK;
   }
+  /* Assimp's MTL reader ends a line at NUL, form feed or a lone carriage return too, so
+   * a comment could hide a statement from valo: such bytes become spaces, which both read
+   * as valo did. */
+  for (size_t i = 0; i < len; i++) {
+    unsigned char c = (unsigned char)txt[i];
+    if (c < 32 && c != '\t' && c != '\n' && !(c == '\r' && i + 1 < len && txt[i + 1] == '\n')) txt[i] = ' ';
+  }
   outbuf o = {0};
   const char *s = txt, *end = txt + len, *next;
   int line = 0;
@@ -179,7 +186,7 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
       /* The name runs to the end of the line, as Assimp reads it. */
       const char *ne = rest_end(tb[1], e);
       snprintf(cur->name, sizeof cur->name, "%.*s", (int)(ne - tb[1]), tb[1]);
-      ob_put(&o, s, (size_t)(next - s));
+      ob_put(&o, tb[0], (size_t)(next - tb[0]));
       continue;
     }
     if (!cur) { /* Assimp writes a texture statement here through a null material */
@@ -211,8 +218,8 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
     if (dropped) continue;
     int numeric = 0;
     for (int k = 0; mtl_number_keys[k]; k++) numeric |= tok_is(tb[0], te[0], mtl_number_keys[k]);
-    if (numeric) { put_fixed(&o, s, e); ob_put(&o, "\n", 1); }
-    else ob_put(&o, s, (size_t)(next - s));
+    if (numeric) { put_fixed(&o, tb[0], e); ob_put(&o, "\n", 1); }
+    else ob_put(&o, tb[0], (size_t)(next - tb[0]));
   }
   free(txt);
   if (o.oom) { free(o.p); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
@@ -317,7 +324,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
     int truncated = last && (e == end) && len > 0 && txt[len - 1] != '\n';
     const char *tb[64], *te[64];
     int nt = tokens(s, e, tb, te, 64);
-    if (nt == 0 || *tb[0] == '#') { ob_put(&o, s, (size_t)(next - s)); continue; }
+    if (nt == 0 || *tb[0] == '#') { ob_put(&o, "\n", 1); continue; } /* a comment may hold a byte Assimp ends a line at */
     if (!line_printable(s, e)) {
       /* control bytes in a vertex or face line: a damaged file (dropping the line would
        * shift every index after it) */
@@ -356,7 +363,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
         goto done;
       }
       sofar[kv ? 0 : kt ? 1 : 2]++;
-      put_fixed(&o, s, e);
+      put_fixed(&o, tb[0], e);
       ob_put(&o, "\n", 1);
       continue;
     }
@@ -374,7 +381,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
         continue;
       }
       kept_faces++;
-      ob_put(&o, s, (size_t)(next - s));
+      ob_put(&o, tb[0], (size_t)(next - tb[0]));
       continue;
     }
     if (tok_is(tb[0], te[0], "l") || tok_is(tb[0], te[0], "p")) { elements++; continue; }
@@ -385,7 +392,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
           log_warning("%s:%d: usemtl %.*s: no material library of this file defines it; those faces are grey diffuse "
                       "(and emit nothing)", path, line, (int)(ne - tb[1]), tb[1]);
       }
-      ob_put(&o, s, (size_t)(next - s));
+      ob_put(&o, tb[0], (size_t)(next - tb[0]));
       continue;
     }
     static const char *known[] = {"g", "o", "s", "mtllib", "vp", "cstype", "deg", "curv", "curv2", "surf", "parm", "trim", "hole",
@@ -393,7 +400,7 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
                                   "d_interp", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap", NULL};
     int ok = 0;
     for (int k = 0; known[k]; k++) ok |= tok_is_ci(tb[0], te[0], known[k]);
-    if (ok) { ob_put(&o, s, (size_t)(next - s)); continue; }
+    if (ok) { ob_put(&o, tb[0], (size_t)(next - tb[0])); continue; }
     if (!not_understood++) first_nu = line;
   }
   if (o.oom) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }

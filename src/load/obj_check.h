@@ -6,7 +6,9 @@
  * repairs of valid text Assimp 5.2 misreads (numbers with a leading dot such as .8e-1;
  * MTL lines such as `aniso` that stop its MTL parser; MTL statements before the first
  * newmtl, dropped with a warning, since Assimp writes a texture there through a null
- * material), and the PBR extension of MTL
+ * material; control bytes in MTL text as spaces and OBJ comments as blank lines, since
+ * Assimp ends a line at NUL, form feed or a lone carriage return; indented lines without
+ * their indent, since Assimp skips indented OBJ lines and a first MTL line whole), and the PBR extension of MTL
  * (Pr, Pm, map_Pr, map_Pm; Ps, Pc, Pcr, aniso noted as ignored), which valo reads itself.
  * The repaired texts are served to Assimp through its file-system callbacks. */
 #ifndef VALO_OBJ_CHECK_H
