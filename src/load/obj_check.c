@@ -150,7 +150,11 @@ static const char *mtl_number_keys[] = {"Ka", "Kd", "Ks", "Ke", "Tf", "Ns", "Ni"
 
 static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_path, int obj_line, valo_error *err) {
   (void)err;
-  if (oc->nfiles >= (int)(sizeof oc->files / sizeof oc->files[0])) return VALO_OK;
+  if (oc->nfiles >= (int)(sizeof oc->files / sizeof oc->files[0])) {
+    log_warning("%s:%d: material library %s is past the %d valo reads: its materials become grey diffuse", obj_path, obj_line,
+                path, (int)(sizeof oc->files / sizeof oc->files[0]) - 1);
+    return VALO_OK;
+  }
   size_t len;
   char *txt = read_whole(path, &len);
   if (!txt) {
@@ -436,7 +440,7 @@ void obj_check_free(obj_check *oc) {
 
 /* ------------------------------------------------- Assimp file callbacks */
 
-typedef struct mem_file { const char *p; size_t len, pos; char *owned; } mem_file;
+typedef struct mem_file { const char *p; size_t len, pos; } mem_file;
 
 static size_t mf_read(struct aiFile *f, char *buf, size_t size, size_t count) {
   mem_file *m = (mem_file *)f->UserData;
@@ -471,15 +475,14 @@ static struct aiFile *fio_open(struct aiFileIO *io, const char *path, const char
     if (oc->files[i].text && !strcmp(oc->files[i].path, path)) hit = &oc->files[i];
   for (int i = 1; i < oc->nfiles && !hit; i++) /* MTL paths as Assimp spells them */
     if (oc->files[i].text && !strcmp(base_name(oc->files[i].path), base_name(path))) hit = &oc->files[i];
+  /* Only the texts valo has read: a file valo did not (an mtllib it found no file for,
+   * past its sixteenth, or one Assimp names by another path) is not opened at all. */
+  if (!hit) return NULL;
   struct aiFile *f = calloc(1, sizeof *f);
   mem_file *m = calloc(1, sizeof *m);
   if (!f || !m) { free(f); free(m); return NULL; }
-  if (hit) { m->p = hit->text; m->len = hit->len; }
-  else {
-    m->owned = read_whole(path, &m->len);
-    if (!m->owned) { free(f); free(m); return NULL; }
-    m->p = m->owned;
-  }
+  m->p = hit->text;
+  m->len = hit->len;
   f->ReadProc = mf_read; f->WriteProc = mf_write; f->TellProc = mf_tell; f->FileSizeProc = mf_size;
   f->SeekProc = mf_seek; f->FlushProc = mf_flush; f->UserData = (aiUserData)m;
   return f;
@@ -487,9 +490,7 @@ static struct aiFile *fio_open(struct aiFileIO *io, const char *path, const char
 static void fio_close(struct aiFileIO *io, struct aiFile *f) {
   (void)io;
   if (!f) return;
-  mem_file *m = (mem_file *)f->UserData;
-  free(m->owned);
-  free(m);
+  free(f->UserData);
   free(f);
 }
 

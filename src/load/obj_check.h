@@ -10,7 +10,8 @@
  * Assimp ends a line at NUL, form feed or a lone carriage return; indented lines without
  * their indent, since Assimp skips indented OBJ lines and a first MTL line whole), and the PBR extension of MTL
  * (Pr, Pm, map_Pr, map_Pm; Ps, Pc, Pcr, aniso noted as ignored), which valo reads itself.
- * The repaired texts are served to Assimp through its file-system callbacks. */
+ * The repaired texts are served to Assimp through its file-system callbacks, which open
+ * no other file. */
 #ifndef VALO_OBJ_CHECK_H
 #define VALO_OBJ_CHECK_H
 #include "valo/valo.h"
