@@ -2,7 +2,9 @@
  * and loaded through the public API (valo_scene_load), which checks it, reads it and
  * commits the scene. FUZZ_NAME (set by the build) picks the file name, and so the path
  * the loader takes: scene.json (the JSON loader), mesh.obj (valo's OBJ/MTL pre-reader,
- * then Assimp) or mesh.ply (valo's PLY check, then Assimp). */
+ * then Assimp) or mesh.ply (valo's PLY check, then Assimp). With FUZZ_MTL the input is
+ * mesh.mtl, the material library of a fixed OBJ that names it (valo's MTL reading, then
+ * Assimp's MTL reader, which a fuzzed OBJ reaches only through a file already on disk). */
 #include "fuzz_util.h"
 
 #ifndef FUZZ_NAME
@@ -12,7 +14,14 @@
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   fuzz_quiet();
+#ifdef FUZZ_MTL
+  static const char obj[] = "mtllib mesh.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\n"
+                            "usemtl m\nf 1/1/1 2/2/1 3/3/1\nusemtl light\nf 1/1/1 3/3/1 2/2/1\n";
+  if (!fuzz_file(FUZZ_NAME, data, size)) return 0;
+  const char *path = fuzz_file("mesh.obj", (const uint8_t *)obj, sizeof obj - 1);
+#else
   const char *path = fuzz_file(FUZZ_NAME, data, size);
+#endif
   if (!path) return 0;
   valo_scene *s = NULL;
   valo_error err;
