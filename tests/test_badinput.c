@@ -1,10 +1,11 @@
 /* test_badinput.c — damaged files never crash or hang valo: Radiance HDR maps (header cut,
  * scanline cut, bad run lengths, absurd sizes), PLY meshes (ASCII and binary: face counts,
- * indices, truncated element lists), PNG/JPEG textures and EXR maps, truncated and
- * corrupted. Each file is made here from a valid one, handed to the real `valo` binary
- * (ASan+UBSan in CI), and must be refused with exit 1, a message naming the file, in well
- * under a second; a run still alive after 10 s is killed and fails the case. Valid files
- * of each kind still load, and valo's HDR decoder gives stb_image's pixels bit for bit. */
+ * indices, truncated element lists), glTF files (.gltf and .glb: references, lengths,
+ * strict JSON; gltf_check.h), PNG/JPEG textures and EXR maps, truncated and corrupted.
+ * Each file is made here from a valid one, handed to the real `valo` binary (ASan+UBSan
+ * in CI), and must be refused with exit 1, a message naming the file, in well under a
+ * second; a run still alive after 10 s is killed and fails the case. Valid files of each
+ * kind still load, and valo's HDR decoder gives stb_image's pixels bit for bit. */
 #include "harness.h"
 #include "image/hdr.h"
 #include "image/image_io.h"
@@ -505,6 +506,130 @@ static int exr_damaged(void) {
   return 0;
 }
 
+/* ---- glTF ---- */
+
+/* A quad: 4 float positions (48 bytes), then 6 unsigned-short indices (12 bytes). */
+#define QUAD_B64 "AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAAABAAIAAAACAAMA"
+#define QUAD_B64_INDEX_4 "AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAAABAAIAAAACAAQA"
+static const char GLTF_QUAD[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1}]}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1,-1,0], \"max\": [1,1,0]},\n"
+    "               {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 12}],\n"
+    " \"buffers\": [{\"byteLength\": 60, \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"}]}\n";
+
+/* The template with its first `find` replaced by `repl` (static storage). */
+static const char *subst(const char *t, const char *find, const char *repl) {
+  static char out[8192];
+  const char *at = strstr(t, find);
+  if (!at) return NULL;
+  snprintf(out, sizeof out, "%.*s%s%s", (int)(at - t), t, repl, at + strlen(find));
+  return out;
+}
+
+/* A .glb holding json and bin (each chunk padded to 4 bytes). */
+static void make_glb(buf *b, const char *json, const unsigned char *bin, size_t nbin) {
+  size_t nj = (strlen(json) + 3) & ~(size_t)3, nb = (nbin + 3) & ~(size_t)3;
+  uint32_t w[5] = {0x46546C67u, 2, (uint32_t)(12 + 8 + nj + (nbin ? 8 + nb : 0)), (uint32_t)nj, 0x4E4F534Au};
+  for (int i = 0; i < 5; i++)
+    for (int k = 0; k < 4; k++) put8(b, w[i] >> (8 * k) & 255);
+  puts_(b, json);
+  for (size_t i = strlen(json); i < nj; i++) put8(b, ' ');
+  if (!nbin) return;
+  uint32_t c[2] = {(uint32_t)nb, 0x004E4942u};
+  for (int i = 0; i < 2; i++)
+    for (int k = 0; k < 4; k++) put8(b, c[i] >> (8 * k) & 255);
+  put(b, bin, nbin);
+  for (size_t i = nbin; i < nb; i++) put8(b, 0);
+}
+
+static int gltf_valid_forms(void) {
+  const char *p = write_bytes("quad.gltf", GLTF_QUAD, strlen(GLTF_QUAD));
+  const char *a[] = MESH_ARGS(p);
+  if (accepted(a, "quad.gltf")) return 1;
+  /* the buffer in a file beside it, and the same in a .glb */
+  static const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char bin[60];
+  memcpy(bin, pos, 48);
+  memcpy(bin + 48, idx, 12);
+  write_bytes("quad.bin", bin, sizeof bin);
+  const char *t = subst(GLTF_QUAD, "data:application/octet-stream;base64," QUAD_B64, "quad.bin");
+  CHECK(t, "template");
+  p = write_bytes("quad_file.gltf", t, strlen(t));
+  const char *b2[] = MESH_ARGS(p);
+  if (accepted(b2, "quad_file.gltf")) return 1;
+  char json[2048];
+  snprintf(json, sizeof json, "%s", subst(GLTF_QUAD, ", \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"", ""));
+  buf g = {0};
+  make_glb(&g, json, bin, sizeof bin);
+  p = write_bytes("quad.glb", g.d, g.n);
+  free(g.d);
+  const char *b3[] = MESH_ARGS(p);
+  return accepted(b3, "quad.glb");
+}
+
+/* Each a glTF Assimp 5.2.5 crashes or hangs on, or reads otherwise than the file says. */
+static int gltf_damaged(void) {
+  char deep[400] = "[";
+  for (int i = 1; i < 100; i++) strcat(deep, "[");
+  for (int i = 0; i < 100; i++) strcat(deep, "]");
+  char deep_extras[512];
+  snprintf(deep_extras, sizeof deep_extras, "\"extras\": %s, \"scene\": 0", deep);
+  struct { const char *name, *what, *find, *repl; } cases[] = {
+      {"g_version.gltf", "version 1.0 is not read", "\"2.0\"", "\"1.0\""},
+      {"g_count.gltf", "accessor 1: 7 elements from byte 0 do not fit in buffer view 1", "\"count\": 6", "\"count\": 7"},
+      {"g_view.gltf", "buffer view 1: bytes 48 to 61 are outside buffer 0", "\"byteLength\": 12", "\"byteLength\": 13"},
+      {"g_buffer_ref.gltf", "buffer view 1: \"buffer\" names no buffer", "\"buffer\": 0, \"byteOffset\": 48", "\"buffer\": 1, \"byteOffset\": 48"},
+      {"g_float_index.gltf", "\"indices\" names no accessor", "\"indices\": 1", "\"indices\": 1.0"},
+      {"g_buffer_len.gltf", "holds 60 bytes, \"byteLength\" says 64", "\"byteLength\": 60", "\"byteLength\": 64"},
+      {"g_cycle.gltf", "form a cycle", "[{\"mesh\": 0}]", "[{\"mesh\": 0, \"children\": [1]}, {\"children\": [0]}]"},
+      {"g_self.gltf", "node 0 is a child of two nodes, or of itself", "[{\"mesh\": 0}]", "[{\"mesh\": 0, \"children\": [0]}]"},
+      {"g_index.gltf", "index 5 is 4, past the 4 vertices", QUAD_B64, QUAD_B64_INDEX_4},
+      {"g_attribute.gltf", "attribute NORMAL has 6 elements, POSITION 4", "\"POSITION\": 0}", "\"POSITION\": 0, \"NORMAL\": 1}"},
+      {"g_comma.gltf", "g_comma.gltf:3: glTF: a member name", "\"max\": [1,1,0]}", "\"max\": [1,1,0],}"},
+      {"g_nan.gltf", ":3: glTF: a value expected", "[-1,-1,0]", "[-1,-1,NaN]"},
+      {"g_huge.gltf", "past the range of a double", "[-1,-1,0]", "[-1,-1,1e999]"},
+      {"g_deep.gltf", "nested more than 64 deep", "\"scene\": 0", deep_extras},
+      {"g_scene.gltf", "\"scene\" names no scene", "\"scene\": 0", "\"scene\": 2"},
+      {"g_surrogate.gltf", "a lone surrogate", "\"asset\"", "\"\\uD800\", \"asset\""},
+      {"g_image_type.gltf", "TYPE/SUBTYPE", "\"scene\": 0", "\"images\": [{\"uri\": \"data:image;base64,AAAA\"}], \"scene\": 0"},
+      {"g_image_view.gltf", "needs a \"mimeType\"", "\"scene\": 0", "\"images\": [{\"bufferView\": 0}], \"scene\": 0"},
+      {"g_sparse.gltf", "sparse accessors are not read", "\"count\": 6,", "\"count\": 6, \"sparse\": {},"},
+      {"g_not_json.gltf", "g_not_json.gltf:1: glTF: a value expected", NULL, "ogeometrynodeff{"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    const char *t = cases[i].find ? subst(GLTF_QUAD, cases[i].find, cases[i].repl) : cases[i].repl;
+    CHECK(t, "%s: the template lacks %s", cases[i].name, cases[i].find);
+    const char *p = write_bytes(cases[i].name, t, strlen(t));
+    const char *a[] = MESH_ARGS(p);
+    if (refused(a, cases[i].name, cases[i].what)) return 1;
+  }
+  /* .glb containers */
+  buf g = {0};
+  make_glb(&g, GLTF_QUAD, NULL, 0);
+  unsigned char *c = malloc(g.n + 8);
+  struct { const char *name, *what; size_t at, len; uint32_t word; } glbs[] = {
+      {"g_length.glb", "the header gives the length", 8, g.n, (uint32_t)g.n + 4},
+      {"g_chunk.glb", "the first chunk must be JSON and fit", 12, g.n, 0xfffffbb7u},
+      {"g_v1.glb", "binary glTF version 1 is not read", 4, g.n, 1},
+      {"g_tail.glb", "are not a chunk", 8, g.n + 4, (uint32_t)g.n + 4},
+      {"g_magic.gltf", "rename it .glb", 8, g.n, (uint32_t)g.n},
+  };
+  for (size_t i = 0; i < sizeof glbs / sizeof glbs[0]; i++) {
+    memcpy(c, g.d, g.n);
+    memset(c + g.n, 0, 8);
+    for (int k = 0; k < 4; k++) c[glbs[i].at + (size_t)k] = (unsigned char)(glbs[i].word >> (8 * k));
+    const char *p = write_bytes(glbs[i].name, c, glbs[i].len);
+    const char *a[] = MESH_ARGS(p);
+    if (refused(a, glbs[i].name, glbs[i].what)) { free(c); free(g.d); return 1; }
+  }
+  free(c);
+  free(g.d);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"hdr_decoder_matches_stb", hdr_decoder_matches_stb},
                                     {"hdr_damaged", hdr_damaged},
@@ -514,6 +639,8 @@ int main(int argc, char **argv) {
                                     {"ply_dragon_mutations", ply_dragon_mutations},
                                     {"png_jpeg_damaged", png_jpeg_damaged},
                                     {"exr_damaged", exr_damaged},
+                                    {"gltf_valid_forms", gltf_valid_forms},
+                                    {"gltf_damaged", gltf_damaged},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

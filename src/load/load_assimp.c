@@ -15,6 +15,7 @@
 #include <assimp/material.h>
 #include <assimp/ObjMaterial.h>
 #include "image/texture.h"
+#include "load/gltf_check.h"
 #include "load/obj_check.h"
 #include "load/ply_check.h"
 #include <assimp/cfileio.h>
@@ -459,12 +460,17 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   /* OBJ files are read by valo first (obj_check.c): checks with line numbers, repairs,
    * the MTL PBR extension; Assimp then parses the repaired text. */
   int obj = ext && !strcasecmp(ext, ".obj");
+  int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
   obj_check oc;
   memset(&oc, 0, sizeof oc);
   struct aiFileIO io;
   if (obj) {
     valo_status cst = obj_check_read(path, &oc, err);
     if (cst) return cst;
+    obj_check_fileio(&oc, &io);
+  } else if (gltf) { /* checked by valo first (gltf_check.h); the file and its buffers served as read */
+    valo_status gst = gltf_check_file(path, !strcasecmp(ext, ".glb"), &oc, err);
+    if (gst) return gst;
     obj_check_fileio(&oc, &io);
   } else if (ply_fixed) { /* the PLY as Assimp must read it, served like a repaired OBJ */
     snprintf(oc.files[0].path, sizeof oc.files[0].path, "%s", path);
@@ -473,14 +479,14 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     oc.nfiles = 1;
     obj_check_fileio(&oc, &io);
   }
-  const struct aiScene *ai = obj || ply_fixed ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
+  const struct aiScene *ai = obj || gltf || ply_fixed ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
   if (!ai) {
     const char *msg = aiGetErrorString();
     obj_check_free(&oc);
     return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
                    ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb")), file};
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, file};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)

@@ -1,0 +1,58 @@
+/* gltf_check_internal.h — owns what the glTF check's two files share (gltf_check.c: the
+ * container, buffers, views, accessors and meshes; gltf_objects.c: nodes, materials and
+ * the other objects): the check's state, the parsed views and accessors, and the helpers
+ * that read members as counts and indices with messages naming the object. */
+#ifndef VALO_GLTF_CHECK_INTERNAL_H
+#define VALO_GLTF_CHECK_INTERNAL_H
+#include "load/gltf_check.h"
+#include "load/gltf_json.h"
+#include <stdint.h>
+
+#define GLTF_MAX_NODE_DEPTH 1024 /* Assimp and valo walk the node tree recursively */
+
+typedef struct gbuf { const unsigned char *data; uint64_t len; } gbuf; /* a buffer's bytes as read */
+typedef struct gview { uint32_t buf; uint64_t off, len, stride; } gview;
+typedef struct gacc { int64_t view; uint64_t off, count, size, stride; int ctype, comps; } gacc;
+
+typedef struct gc {
+  const char *path;
+  valo_error *err;
+  obj_check *oc;
+  jdoc d;
+  uint32_t root;
+  const unsigned char *bin;
+  uint64_t bin_len;
+  int binary, has_bin;
+  uint32_t n_buf, n_view, n_acc, n_mesh, n_node, n_scene, n_mat, n_tex, n_img, n_smp, n_cam, n_skin, n_light;
+  gbuf *bufs;
+  gview *views;
+  gacc *accs;
+  unsigned char *decoded[64];
+  int ndecoded;
+} gc;
+
+static inline const jnode *N(const gc *g, uint32_t i) { return &g->d.nodes[i]; }
+/* Sets the error "path: glTF: message"; returns its status. */
+valo_status gl_bad(gc *g, const char *fmt, ...);
+/* Array member key of o, every entry an object: its count, or -1 (error set). */
+int64_t gl_objects(gc *g, uint32_t o, const char *key, const char *what);
+/* fn(g, entry, its index, "KIND INDEX") for each entry of array arr, until an error. */
+valo_status gl_each(gc *g, uint32_t arr, const char *kind, valo_status (*fn)(gc *, uint32_t, uint32_t, const char *));
+/* Member key of o as a whole number (written as one) up to max: 0 (*v = def when absent;
+ * an error when required and absent), or -1 (error set). */
+int gl_uint(gc *g, uint32_t o, const char *key, uint64_t def, uint64_t max, int required, uint64_t *v, const char *ctx);
+/* Member key of o as an index of `count` objects called `of`: -1 when absent (an error
+ * when required), -2 (error set) when it names none of them. */
+int64_t gl_index(gc *g, uint32_t o, const char *key, uint32_t count, const char *of, int required, const char *ctx);
+/* Every element of array member key of o such an index: 0, or -1 (error set). */
+int gl_index_array(gc *g, uint32_t o, const char *key, uint32_t count, const char *of, const char *ctx);
+int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const char *ctx);
+/* A data URI "data:TYPE/SUBTYPE;base64,DATA" decoded into g->decoded: its length, or -1. */
+int64_t gl_data_uri(gc *g, const char *s, const char *ctx);
+
+/* gltf_objects.c: the nodes (trees of valid references, bounded depth), then scenes,
+ * materials, textures, images, cameras, skins, animations and KHR_lights_punctual lights
+ * (arr: the top-level arrays in gltf_check.c's order; lights: their array or 0). */
+valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights);
+valo_status gl_check_objects(gc *g, const uint32_t *arr, uint32_t lights);
+#endif
