@@ -606,6 +606,14 @@ static int gltf_damaged(void) {
     const char *a[] = MESH_ARGS(p);
     if (refused(a, cases[i].name, cases[i].what)) return 1;
   }
+  /* a triangle strip of 2 indices (Assimp counted 2 - 2 - 1 triangles: an allocation of 2^64 bytes) */
+  char two[8192];
+  snprintf(two, sizeof two, "%s", subst(GLTF_QUAD, "\"count\": 6", "\"count\": 2"));
+  const char *st = subst(two, "\"indices\": 1}", "\"indices\": 1, \"mode\": 5}");
+  CHECK(st, "template");
+  const char *sp = write_bytes("g_strip.gltf", st, strlen(st));
+  const char *sa[] = MESH_ARGS(sp);
+  if (refused(sa, "g_strip.gltf", "2 vertices are too few for its mode 5")) return 1;
   /* .glb containers */
   buf g = {0};
   make_glb(&g, GLTF_QUAD, NULL, 0);

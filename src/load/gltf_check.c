@@ -274,6 +274,10 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   }
   int64_t ix = gl_accessor_ref(g, p, "indices", 0, ctx);
   if (ix == -2) return g->err->status;
+  /* Assimp counts a strip's or a loop's elements as vertices minus 2 or 1, in unsigned arithmetic */
+  static const uint64_t least[7] = {1, 2, 2, 2, 3, 3, 3};
+  uint64_t nv = ix >= 0 ? g->accs[ix].count : pa->count;
+  if (nv < least[mode]) return gl_bad(g, "%s: %llu vertices are too few for its mode %llu", ctx, (unsigned long long)nv, (unsigned long long)mode);
   if (ix >= 0) { /* every index must name a vertex */
     const gacc *a = &g->accs[ix];
     int cs = comp_size(a->ctype);
