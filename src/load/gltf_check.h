@@ -6,11 +6,11 @@
  * fit the file, JSON in strict RFC 8259 syntax (as Assimp's parser reads it, nested at
  * most 64 deep), glTF 2.0 by its asset version, every index it holds naming an existing
  * object, buffers as long as they say, accessors and buffer views inside their buffers,
- * primitive indices inside the vertex count, nodes forming trees, and the values Assimp
- * reads without looking well formed (data URI media types, an embedded image's mimeType,
- * KHR_texture_transform vectors, a skin's inverse bind matrices). The file and its
- * buffer files are then served to Assimp from what valo read (obj_check's file system),
- * so Assimp opens nothing valo has not checked. */
+ * primitive indices inside the vertex count and enough vertices for the primitive's mode,
+ * nodes forming trees, and the values Assimp reads without looking well formed (data URI
+ * media types, an embedded image's mimeType, KHR_texture_transform vectors, a skin's
+ * inverse bind matrices). The file and its buffer files are then served to Assimp from
+ * what valo read (obj_check's file system), so Assimp opens nothing valo has not checked. */
 #ifndef VALO_GLTF_CHECK_H
 #define VALO_GLTF_CHECK_H
 #include "load/obj_check.h"
