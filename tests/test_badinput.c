@@ -560,6 +560,18 @@ static int gltf_valid_forms(void) {
   p = write_bytes("quad_file.gltf", t, strlen(t));
   const char *b2[] = MESH_ARGS(p);
   if (accepted(b2, "quad_file.gltf")) return 1;
+  /* a buffer file named with a URI's escape (Assimp 5.2 opened "quad%20file.bin" as written) */
+  write_bytes("quad file.bin", bin, sizeof bin);
+  t = subst(GLTF_QUAD, "data:application/octet-stream;base64," QUAD_B64, "quad%20file.bin");
+  p = write_bytes("quad_escaped.gltf", t, strlen(t));
+  const char *b4[] = MESH_ARGS(p);
+  if (accepted(b4, "quad_escaped.gltf")) return 1;
+  /* a UTF-8 byte-order mark before the JSON (Assimp 5.2 read no glTF after one) */
+  char bom[4096];
+  snprintf(bom, sizeof bom, "\xef\xbb\xbf%s", GLTF_QUAD);
+  p = write_bytes("quad_bom.gltf", bom, strlen(bom));
+  const char *b5[] = MESH_ARGS(p);
+  if (accepted(b5, "quad_bom.gltf")) return 1;
   char json[2048];
   snprintf(json, sizeof json, "%s", subst(GLTF_QUAD, ", \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"", ""));
   buf g = {0};

@@ -173,6 +173,7 @@ static valo_status read_buffer(gc *g, uint32_t i, uint32_t o) {
     }
     *q = 0;
     t->text = (char *)read_all(t->path, &len);
+    if (t->text) snprintf(t->path, sizeof t->path, "%.*s%s", dl, g->path, s); /* served by the name Assimp asks for */
   }
   if (!t->text) return gl_bad(g, "%s: cannot read %s: %s", ctx, t->path, strerror(errno));
   t->len = len;
@@ -402,6 +403,10 @@ valo_status gltf_check_file(const char *path, int binary, obj_check *oc, valo_er
   valo_status st = VALO_OK;
   if (binary) st = glb_chunks(&g, data, len, &json, &json_len);
   else if (len >= 4 && !memcmp(data, "glTF", 4)) st = gl_bad(&g, "a binary glTF named .gltf (rename it .glb)");
+  else if (len >= 3 && !memcmp(data, "\xef\xbb\xbf", 3)) { /* a UTF-8 byte-order mark: Assimp reads nothing after one */
+    memmove(data, data + 3, len - 2); /* with the terminating NUL */
+    oc->files[0].len = json_len = len - 3;
+  }
   if (!st) st = check_json(&g, json, json_len);
   json_free(&g.d);
   free(g.bufs);

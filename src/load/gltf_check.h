@@ -9,8 +9,10 @@
  * primitive indices inside the vertex count and enough vertices for the primitive's mode,
  * nodes forming trees, and the values Assimp reads without looking well formed (data URI
  * media types, an embedded image's mimeType, KHR_texture_transform vectors, a skin's
- * inverse bind matrices). The file and its buffer files are then served to Assimp from
- * what valo read (obj_check's file system), so Assimp opens nothing valo has not checked. */
+ * inverse bind matrices). A UTF-8 byte-order mark is dropped and a buffer URI's %XX
+ * escapes are decoded, which Assimp does not do. The file and its buffer files are then
+ * served to Assimp from what valo read (obj_check's file system), so Assimp opens nothing
+ * valo has not checked. */
 #ifndef VALO_GLTF_CHECK_H
 #define VALO_GLTF_CHECK_H
 #include "load/obj_check.h"
