@@ -113,8 +113,9 @@ static int64_t b64_decode(const char *s, size_t len, unsigned char *out) {
 
 /* A data URI (buffer or image): "data:", a media type, ";base64," and base64 text,
  * decoded into g->decoded; its length, or -1 (error set). Assimp keeps the offsets of
- * the URI's parts in signed chars, so its header must be short: a longer one sent it
- * reading before the string (fuzz/regressions/scene_gltf). */
+ * the URI's parts in chars (signed here), so a header of 128 bytes or more would point it
+ * before the string, and it decodes base64 through a table indexed by signed chars, so
+ * only a short header and valid base64 pass. */
 int64_t gl_data_uri(gc *g, const char *s, const char *ctx) {
   const char *comma = strchr(s, ',');
   int ok = comma && comma - s >= 12 && comma - s < 100 && !strncmp(comma - 7, ";base64", 7);
