@@ -118,7 +118,6 @@ static int parse_number(jparse *j, jnode *n) {
   memcpy(buf, s, len);
   buf[len] = 0;
   n->num = strtod(buf, NULL);
-  if (*s == '-' && n->num == 0) n->is_int = 0; /* "-0" is a double to Assimp's parser, not an index */
   if (!isfinite(n->num)) return fail(j, "a number (%s) past the range of a double", buf);
   return 0;
 }
