@@ -607,7 +607,7 @@ static int gltf_damaged(void) {
       {"g_scene.gltf", "\"scene\" names no scene", "\"scene\": 0", "\"scene\": 2"},
       {"g_surrogate.gltf", "a lone surrogate", "\"asset\"", "\"\\uD800\", \"asset\""},
       {"g_image_type.gltf", "TYPE/SUBTYPE", "\"scene\": 0", "\"images\": [{\"uri\": \"data:image;base64,AAAA\"}], \"scene\": 0"},
-      {"g_image_view.gltf", "needs a \"mimeType\"", "\"scene\": 0", "\"images\": [{\"bufferView\": 0}], \"scene\": 0"},
+      {"g_image_view.gltf", "needs a \"mimeType\"", "\"scene\": 0", "\"images\": [{\"bufferView\": 0, \"mimeType\": \"png\"}], \"scene\": 0"},
       {"g_sparse.gltf", "sparse accessors are not read", "\"count\": 6,", "\"count\": 6, \"sparse\": {},"},
       {"g_not_json.gltf", "g_not_json.gltf:1: glTF: a value expected", NULL, "ogeometrynodeff{"},
   };

@@ -120,8 +120,9 @@ static valo_status check_image(gc *g, uint32_t o, uint32_t i, const char *ctx) {
     free(g->decoded[--g->ndecoded]); /* only checked: Assimp decodes the image itself */
   }
   uint32_t mt = json_get(&g->d, o, "mimeType");
+  /* Assimp reads through a null pointer when the type has no '/' */
   if (json_get(&g->d, o, "bufferView") && (!mt || N(g, mt)->t != J_STR || !strchr(N(g, mt)->str, '/')))
-    return gl_bad(g, "%s: an image in a buffer view needs a \"mimeType\" such as image/png", ctx); /* Assimp reads past a NULL without one */
+    return gl_bad(g, "%s: an image in a buffer view needs a \"mimeType\" such as image/png", ctx);
   return gl_index(g, o, "bufferView", g->n_view, "buffer view", 0, ctx) == -2 ? g->err->status : VALO_OK;
 }
 
