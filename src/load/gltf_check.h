@@ -1,10 +1,10 @@
 /* gltf_check.h — owns valo's own check of a glTF file (.gltf or .glb) before Assimp reads
  * it. Assimp 5.2.5's glTF 2.0 reader trusts the file: a .glb chunk length is allocated
  * as written (4 GB), and a .gltf it cannot parse is handed to whichever other importer
- * claims its bytes (the OpenGEX reader spins forever on 16 of them). So a glTF reaches
+ * claims its bytes (its OpenGEX reader read past its buffer on 16 of them). So a glTF reaches
  * Assimp only when it is what its name says: a .glb container whose header and chunks
  * fit the file, JSON in strict RFC 8259 syntax (as Assimp's parser reads it, nested at
- * most 64 deep), glTF 2.0 by its asset version, every index it holds naming an existing
+ * most 512 deep), glTF 2.0 by its asset version, every index it holds naming an existing
  * object, buffers as long as they say, accessors and buffer views inside their buffers,
  * primitive indices inside the vertex count and enough vertices for the primitive's mode,
  * nodes forming trees, and the values Assimp reads without looking well formed (data URI

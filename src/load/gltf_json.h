@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#define JSON_MAX_DEPTH 64
+#define JSON_MAX_DEPTH 512 /* glTF nests about 8 deep; this bounds valo's recursion */
 typedef enum { J_NULL, J_FALSE, J_TRUE, J_NUM, J_STR, J_ARR, J_OBJ } jtype;
 typedef struct jnode {
   jtype t;
