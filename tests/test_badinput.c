@@ -572,6 +572,10 @@ static int gltf_valid_forms(void) {
   p = write_bytes("quad_bom.gltf", bom, strlen(bom));
   const char *b5[] = MESH_ARGS(p);
   if (accepted(b5, "quad_bom.gltf")) return 1;
+  /* sparse accessors: a morph target, and POSITION itself */
+  const char *sp1[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-morph-target.gltf");
+  const char *sp2[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-position.gltf");
+  if (accepted(sp1, "sparse-morph-target.gltf") || accepted(sp2, "sparse-position.gltf")) return 1;
   char json[2048];
   snprintf(json, sizeof json, "%s", subst(GLTF_QUAD, ", \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"", ""));
   buf g = {0};
@@ -612,7 +616,7 @@ static int gltf_damaged(void) {
       {"g_surrogate.gltf", "a lone surrogate", "\"asset\"", "\"\\uD800\", \"asset\""},
       {"g_image_type.gltf", "TYPE/SUBTYPE", "\"scene\": 0", "\"images\": [{\"uri\": \"data:image;base64,AAAA\"}], \"scene\": 0"},
       {"g_image_view.gltf", "needs a \"mimeType\"", "\"scene\": 0", "\"images\": [{\"bufferView\": 0, \"mimeType\": \"png\"}], \"scene\": 0"},
-      {"g_sparse.gltf", "sparse accessors are not read", "\"count\": 6,", "\"count\": 6, \"sparse\": {},"},
+      {"g_sparse.gltf", "accessor 1 sparse must be an object with \"indices\" and \"values\"", "\"count\": 6,", "\"count\": 6, \"sparse\": {},"},
       {"g_not_json.gltf", "g_not_json.gltf:1: glTF: a value expected", NULL, "ogeometrynodeff{"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {

@@ -211,6 +211,37 @@ static valo_status check_view(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   return VALO_OK;
 }
 
+/* An accessor's sparse part: count, index and value views that hold them, indices inside
+ * the accessor (Assimp writes each value at its index: a count past the data overflowed
+ * its heap). */
+static valo_status check_sparse(gc *g, uint32_t sp, const gacc *a, const char *acc_ctx) {
+  char ctx[80];
+  snprintf(ctx, sizeof ctx, "%s sparse", acc_ctx);
+  uint32_t ix = json_get(&g->d, sp, "indices"), vx = json_get(&g->d, sp, "values");
+  if (N(g, sp)->t != J_OBJ || !ix || N(g, ix)->t != J_OBJ || !vx || N(g, vx)->t != J_OBJ)
+    return gl_bad(g, "%s must be an object with \"indices\" and \"values\" objects", ctx);
+  uint64_t n, ct, ioff, voff;
+  int64_t iv = gl_index(g, ix, "bufferView", g->n_view, "buffer view", 1, ctx);
+  int64_t vv = iv < 0 ? -2 : gl_index(g, vx, "bufferView", g->n_view, "buffer view", 1, ctx);
+  if (vv < 0 || gl_uint(g, sp, "count", 0, a->count, 1, &n, ctx) || gl_uint(g, ix, "componentType", 0, 6000, 1, &ct, ctx) ||
+      gl_uint(g, ix, "byteOffset", 0, UINT32_MAX, 0, &ioff, ctx) || gl_uint(g, vx, "byteOffset", 0, UINT32_MAX, 0, &voff, ctx))
+    return g->err->status;
+  if (n == 0) return gl_bad(g, "%s: \"count\" must be at least 1", ctx);
+  if (ct != 5121 && ct != 5123 && ct != 5125) return gl_bad(g, "%s: indices must be unsigned bytes, shorts or ints", ctx);
+  uint64_t cs = (uint64_t)comp_size((int)ct);
+  const gview *v = &g->views[iv], *w = &g->views[vv];
+  if ((v->stride && v->stride != cs) || (w->stride && w->stride != a->size)) return gl_bad(g, "%s: its buffer views must not have a stride", ctx);
+  if (ioff + n * cs > v->len || voff + n * a->size > w->len)
+    return gl_bad(g, "%s: %llu elements do not fit in buffer views %lld and %lld", ctx, (unsigned long long)n, (long long)iv, (long long)vv);
+  const unsigned char *d = g->bufs[v->buf].data + v->off + ioff;
+  for (uint64_t k = 0; k < n; k++) {
+    uint32_t x = 0;
+    for (uint64_t b = cs; b-- > 0;) x = x << 8 | d[k * cs + b];
+    if (x >= a->count) return gl_bad(g, "%s: index %llu is %u, past the accessor's %llu elements", ctx, (unsigned long long)k, x, (unsigned long long)a->count);
+  }
+  return VALO_OK;
+}
+
 static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   gacc *a = &g->accs[i];
   uint64_t ct;
@@ -223,12 +254,17 @@ static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx
   if (!comp_size(a->ctype)) return gl_bad(g, "%s: \"componentType\" %d is not one of glTF's", ctx, a->ctype);
   if (!a->comps) return gl_bad(g, "%s: \"type\" must be SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4", ctx);
   if (a->count == 0) return gl_bad(g, "%s: \"count\" must be at least 1", ctx);
-  if (json_get(&g->d, o, "sparse")) return gl_bad(g, "%s: sparse accessors are not read", ctx);
+  uint32_t sp = json_get(&g->d, o, "sparse");
+  a->sparse = sp != 0;
+  a->size = (uint64_t)comp_size(a->ctype) * (uint64_t)a->comps;
   a->view = gl_index(g, o, "bufferView", g->n_view, "buffer view", 0, ctx);
   if (a->view == -2) return g->err->status;
-  if (a->view < 0) return gl_bad(g, "%s has no \"bufferView\" (accessors of zeros are not read)", ctx);
+  if (a->view < 0 && !sp) return gl_bad(g, "%s has no \"bufferView\" and is not sparse (Assimp reads no accessor of zeros)", ctx);
+  if (sp) {
+    valo_status st = check_sparse(g, sp, a, ctx);
+    if (st || a->view < 0) return st;
+  }
   const gview *v = &g->views[a->view];
-  a->size = (uint64_t)comp_size(a->ctype) * (uint64_t)a->comps;
   a->stride = v->stride ? v->stride : a->size;
   if (a->stride < a->size) return gl_bad(g, "%s: its elements (%llu bytes) are longer than buffer view %lld's stride", ctx, (unsigned long long)a->size, (long long)a->view);
   if (a->off + a->stride * (a->count - 1) + a->size > v->len)
@@ -285,6 +321,7 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
     int cs = comp_size(a->ctype);
     if (a->comps != 1 || (a->ctype != 5121 && a->ctype != 5123 && a->ctype != 5125))
       return gl_bad(g, "%s: \"indices\" must be an accessor of unsigned byte, short or int scalars", ctx);
+    if (a->sparse || a->view < 0) return gl_bad(g, "%s: sparse indices are not read", ctx);
     const gview *v = &g->views[a->view];
     if (a->stride != a->size) return gl_bad(g, "%s: the indices' buffer view %lld must not have a stride", ctx, (long long)a->view);
     const unsigned char *d = g->bufs[v->buf].data + v->off + a->off;

@@ -12,7 +12,7 @@
 
 typedef struct gbuf { const unsigned char *data; uint64_t len; } gbuf; /* a buffer's bytes as read */
 typedef struct gview { uint32_t buf; uint64_t off, len, stride; } gview;
-typedef struct gacc { int64_t view; uint64_t off, count, size, stride; int ctype, comps; } gacc;
+typedef struct gacc { int64_t view; uint64_t off, count, size, stride; int ctype, comps, sparse; } gacc;
 
 typedef struct gc {
   const char *path;
