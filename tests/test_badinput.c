@@ -463,6 +463,23 @@ static int png_jpeg_damaged(void) {
   return 0;
 }
 
+/* PFM maps whose header claims more pixels than the file holds: refused before the
+ * pixels are allocated (CI's fuzzer found a 19-byte file claiming 8505 x 52777, 5 GB). */
+static int pfm_damaged(void) {
+  struct { const char *name, *text, *what; } cases[] = {
+      {"claims_5gb.pfm", "PF\n8505 52777\n-1\n\x1e\x38", "8505x52777 pixels need 5386420620 bytes, the file holds 2"},
+      {"short_row.pfm", "PF\n2 1\n-1\n\0\0\0\0\0\0\0\0", "2x1 pixels need 24 bytes, the file holds 8"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    size_t n = strlen(cases[i].text);
+    if (i == 1) n = 10 + 8; /* the header, then 8 zero bytes */
+    const char *p = write_bytes(cases[i].name, cases[i].text, n);
+    const char *a[] = ENV_ARGS(p);
+    if (refused(a, cases[i].name, cases[i].what)) return 1;
+  }
+  return 0;
+}
+
 static int exr_damaged(void) {
   float px[32 * 16 * 3];
   for (int i = 0; i < 32 * 16 * 3; i++) px[i] = (float)(i % 17) / 8.0f;
@@ -667,6 +684,7 @@ int main(int argc, char **argv) {
                                     {"ply_dragon_mutations", ply_dragon_mutations},
                                     {"png_jpeg_damaged", png_jpeg_damaged},
                                     {"exr_damaged", exr_damaged},
+                                    {"pfm_damaged", pfm_damaged},
                                     {"gltf_valid_forms", gltf_valid_forms},
                                     {"gltf_damaged", gltf_damaged},
                                     {NULL, NULL}};
