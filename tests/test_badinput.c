@@ -589,6 +589,11 @@ static int gltf_valid_forms(void) {
   p = write_bytes("quad_bom.gltf", bom, strlen(bom));
   const char *b5[] = MESH_ARGS(p);
   if (accepted(b5, "quad_bom.gltf")) return 1;
+  /* an application's "...Texture" member inside a material's extras is not a texture reference */
+  t = subst(GLTF_QUAD, "\"scene\": 0", "\"materials\": [{\"extras\": {\"myTexture\": {\"file\": \"x.png\"}}}], \"scene\": 0");
+  p = write_bytes("quad_extras.gltf", t, strlen(t));
+  const char *b6[] = MESH_ARGS(p);
+  if (accepted(b6, "quad_extras.gltf")) return 1;
   /* sparse accessors: a morph target, and POSITION itself */
   const char *sp1[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-morph-target.gltf");
   const char *sp2[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-position.gltf");

@@ -72,7 +72,8 @@ valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights) {
 /* ------------------------------------------------ materials and the rest */
 
 /* Every texture reference inside material value v (a member "...Texture" holding an
- * object, core or extension): its "index" must name a texture. */
+ * object, core or extension; not inside "extras", which is the application's): its
+ * "index" must name a texture. */
 static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
   for (uint32_t c = N(g, v)->child; c; c = N(g, c)->next) {
     const char *k = N(g, c)->key;
@@ -93,7 +94,7 @@ static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
       if (r && N(g, r)->t != J_NUM) return gl_bad(g, "%s: KHR_texture_transform \"rotation\" must be a number", ctx);
       if (gl_uint(g, c, "texCoord", 0, 7, 0, &tc, ctx)) return g->err->status;
     }
-    if (N(g, c)->t == J_OBJ || N(g, c)->t == J_ARR) {
+    if ((N(g, c)->t == J_OBJ || N(g, c)->t == J_ARR) && !(k && !strcmp(k, "extras"))) {
       valo_status st = check_texture_refs(g, c, ctx);
       if (st) return st;
     }
@@ -186,7 +187,9 @@ static valo_status check_scene(gc *g, uint32_t o, uint32_t i, const char *ctx) {
 }
 
 static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
-  (void)i; return check_texture_refs(g, o, ctx); }
+  (void)i;
+  return check_texture_refs(g, o, ctx);
+}
 
 valo_status gl_check_objects(gc *g, const uint32_t *arr, uint32_t lights) {
   valo_status st = gl_each(g, arr[5], "scene", check_scene);
