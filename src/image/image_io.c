@@ -170,15 +170,15 @@ static valo_status read_pfm(const char *path, image *out, valo_error *err) {
     return err_set(err, VALO_ERR_PARSE, "%s: not a little-endian RGB PFM file", path);
   }
   fgetc(f);
+  valo_status mst = mem_check_pixels((uint64_t)w, (uint64_t)h, 12, path, err);
+  if (mst) { fclose(f); return mst; }
   /* the pixels must be in the file before they are allocated (a 19-byte file claimed 5 GB) */
   long at = ftell(f), end = at >= 0 && fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
   if (end < 0 || fseek(f, at, SEEK_SET) || (uint64_t)(end - at) < (uint64_t)w * (uint64_t)h * 12u) {
     fclose(f);
-    return err_set(err, VALO_ERR_PARSE, "%s: truncated PFM: %dx%d pixels need %llu bytes, the file holds %ld after its header", path, w, h,
+    return err_set(err, VALO_ERR_PARSE, "%s: truncated PFM: %d x %d pixels need %llu bytes, the file holds %ld after its header", path, w, h,
                    (unsigned long long)w * (unsigned long long)h * 12u, end < 0 ? 0L : end - at);
   }
-  valo_status mst = mem_check_pixels((uint64_t)w, (uint64_t)h, 12, path, err);
-  if (mst) { fclose(f); return mst; }
   out->w = w; out->h = h;
   out->rgb = malloc((size_t)w * h * 3 * sizeof(float));
   if (!out->rgb) { fclose(f); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
