@@ -3,9 +3,9 @@
  * commits the scene. FUZZ_NAME (set by the build) picks the file name, and so the path
  * the loader takes: scene.json (the JSON loader), mesh.obj (valo's OBJ/MTL pre-reader,
  * then Assimp), mesh.ply (valo's PLY check, then Assimp), mesh.gltf or mesh.glb (valo's
- * glTF check, then Assimp). With FUZZ_MTL the input is
- * mesh.mtl, the material library of a fixed OBJ that names it (valo's MTL reading, then
- * Assimp's MTL reader, which a fuzzed OBJ reaches only through a file already on disk). */
+ * glTF check, then Assimp). With FUZZ_MTL the input is mesh.mtl, the material library of
+ * a fixed OBJ that names it (valo's MTL reading, then Assimp's MTL reader, which a fuzzed
+ * OBJ reaches only through a file already on disk). */
 #include "fuzz_util.h"
 
 #ifndef FUZZ_NAME

@@ -77,19 +77,6 @@ int gl_index_array(gc *g, uint32_t o, const char *key, uint32_t count, const cha
 
 /* ------------------------------------------------------------------ files */
 
-static unsigned char *read_all(const char *path, size_t *len) {
-  FILE *f = fopen(path, "rb");
-  if (!f) return NULL;
-  unsigned char *b = NULL;
-  long sz = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-  if (sz >= 0 && fseek(f, 0, SEEK_SET) == 0 && (b = malloc((size_t)sz + 1))) {
-    if (fread(b, 1, (size_t)sz, f) != (size_t)sz) { free(b); b = NULL; }
-    else { b[sz] = 0; *len = (size_t)sz; }
-  }
-  fclose(f);
-  return b;
-}
-
 static int b64(int c) {
   return c >= 'A' && c <= 'Z' ? c - 'A' : c >= 'a' && c <= 'z' ? c - 'a' + 26 : c >= '0' && c <= '9' ? c - '0' + 52 : c == '+' ? 62 : c == '/' ? 63 : -1;
 }
@@ -165,7 +152,7 @@ static valo_status read_buffer(gc *g, uint32_t i, uint32_t o) {
   int dl = slash ? (int)(slash - g->path + 1) : 0;
   if (snprintf(t->path, sizeof t->path, "%.*s%s", dl, g->path, s) >= (int)sizeof t->path) return gl_bad(g, "%s: \"uri\" is too long", ctx);
   size_t len = 0;
-  if (!(t->text = (char *)read_all(t->path, &len)) && strchr(s, '%')) { /* a URI's escapes (%20): the file's own name */
+  if (!(t->text = obj_check_read_whole(t->path, &len)) && strchr(s, '%')) { /* a URI's escapes (%20): the file's own name */
     char *q = t->path + dl;
     for (const char *c = s; *c; c++) {
       unsigned v;
@@ -173,7 +160,7 @@ static valo_status read_buffer(gc *g, uint32_t i, uint32_t o) {
       else *q++ = *c;
     }
     *q = 0;
-    t->text = (char *)read_all(t->path, &len);
+    t->text = obj_check_read_whole(t->path, &len);
     if (t->text) snprintf(t->path, sizeof t->path, "%.*s%s", dl, g->path, s); /* served by the name Assimp asks for */
   }
   if (!t->text) return gl_bad(g, "%s: cannot read %s: %s", ctx, t->path, strerror(errno));
@@ -182,6 +169,20 @@ static valo_status read_buffer(gc *g, uint32_t i, uint32_t o) {
   if (len < stated) return gl_bad(g, "%s: %s holds %zu bytes, \"byteLength\" says %llu", ctx, t->path, len, (unsigned long long)stated);
   *b = (gbuf){(const unsigned char *)t->text, stated};
   return VALO_OK;
+}
+
+/* The little-endian unsigned integer of `bytes` bytes (1, 2 or 4) at p. */
+static uint32_t le_uint(const unsigned char *p, uint64_t bytes) {
+  uint32_t x = 0;
+  for (uint64_t b = bytes; b-- > 0;) x = x << 8 | p[b];
+  return x;
+}
+
+/* The first of n indices of `bytes` bytes at d that is limit or more (its value in *x), or -1. */
+static int64_t first_index_past(const unsigned char *d, uint64_t n, uint64_t bytes, uint64_t limit, uint32_t *x) {
+  for (uint64_t k = 0; k < n; k++)
+    if ((*x = le_uint(d + k * bytes, bytes)) >= limit) return (int64_t)k;
+  return -1;
 }
 
 /* ---------------------------------------------------- views and accessors */
@@ -198,7 +199,7 @@ static int type_comps(const char *s) {
 
 static valo_status check_view(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   gview *v = &g->views[i];
-  int64_t b = gl_index(g, o, "buffer", g->n_buf, "buffer", 1, ctx);
+  int64_t b = gl_index(g, o, "buffer", g->n[K_BUF], "buffer", 1, ctx);
   if (b < 0) return g->err->status;
   v->buf = (uint32_t)b;
   if (gl_uint(g, o, "byteOffset", 0, UINT32_MAX, 0, &v->off, ctx) || gl_uint(g, o, "byteLength", 0, UINT32_MAX, 1, &v->len, ctx) ||
@@ -221,8 +222,8 @@ static valo_status check_sparse(gc *g, uint32_t sp, const gacc *a, const char *a
   if (N(g, sp)->t != J_OBJ || !ix || N(g, ix)->t != J_OBJ || !vx || N(g, vx)->t != J_OBJ)
     return gl_bad(g, "%s must be an object with \"indices\" and \"values\" objects", ctx);
   uint64_t n, ct, ioff, voff;
-  int64_t iv = gl_index(g, ix, "bufferView", g->n_view, "buffer view", 1, ctx);
-  int64_t vv = iv < 0 ? -2 : gl_index(g, vx, "bufferView", g->n_view, "buffer view", 1, ctx);
+  int64_t iv = gl_index(g, ix, "bufferView", g->n[K_VIEW], "buffer view", 1, ctx);
+  int64_t vv = iv < 0 ? -2 : gl_index(g, vx, "bufferView", g->n[K_VIEW], "buffer view", 1, ctx);
   if (vv < 0 || gl_uint(g, sp, "count", 0, a->count, 1, &n, ctx) || gl_uint(g, ix, "componentType", 0, 6000, 1, &ct, ctx) ||
       gl_uint(g, ix, "byteOffset", 0, UINT32_MAX, 0, &ioff, ctx) || gl_uint(g, vx, "byteOffset", 0, UINT32_MAX, 0, &voff, ctx))
     return g->err->status;
@@ -233,12 +234,9 @@ static valo_status check_sparse(gc *g, uint32_t sp, const gacc *a, const char *a
   if ((v->stride && v->stride != cs) || (w->stride && w->stride != a->size)) return gl_bad(g, "%s: its buffer views must not have a stride", ctx);
   if (ioff + n * cs > v->len || voff + n * a->size > w->len)
     return gl_bad(g, "%s: %llu elements do not fit in buffer views %lld and %lld", ctx, (unsigned long long)n, (long long)iv, (long long)vv);
-  const unsigned char *d = g->bufs[v->buf].data + v->off + ioff;
-  for (uint64_t k = 0; k < n; k++) {
-    uint32_t x = 0;
-    for (uint64_t b = cs; b-- > 0;) x = x << 8 | d[k * cs + b];
-    if (x >= a->count) return gl_bad(g, "%s: index %llu is %u, past the accessor's %llu elements", ctx, (unsigned long long)k, x, (unsigned long long)a->count);
-  }
+  uint32_t x;
+  int64_t k = first_index_past(g->bufs[v->buf].data + v->off + ioff, n, cs, a->count, &x);
+  if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the accessor's %llu elements", ctx, (long long)k, x, (unsigned long long)a->count);
   return VALO_OK;
 }
 
@@ -257,7 +255,7 @@ static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx
   uint32_t sp = json_get(&g->d, o, "sparse");
   a->sparse = sp != 0;
   a->size = (uint64_t)comp_size(a->ctype) * (uint64_t)a->comps;
-  a->view = gl_index(g, o, "bufferView", g->n_view, "buffer view", 0, ctx);
+  a->view = gl_index(g, o, "bufferView", g->n[K_VIEW], "buffer view", 0, ctx);
   if (a->view == -2) return g->err->status;
   if (a->view < 0 && !sp) return gl_bad(g, "%s has no \"bufferView\" and is not sparse (Assimp reads no accessor of zeros)", ctx);
   if (sp) {
@@ -275,7 +273,7 @@ static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx
 
 /* Accessor member key of o: its index, -1 when absent, -2 (error set) when wrong. */
 int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const char *ctx) {
-  return gl_index(g, o, key, g->n_acc, "accessor", required, ctx);
+  return gl_index(g, o, key, g->n[K_ACC], "accessor", required, ctx);
 }
 
 /* ------------------------------------------------------------------ meshes */
@@ -296,7 +294,7 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   }
   uint64_t mode;
   if (gl_uint(g, p, "mode", 4, 6, 0, &mode, ctx)) return g->err->status;
-  if (gl_index(g, p, "material", g->n_mat, "material", 0, ctx) == -2) return g->err->status;
+  if (gl_index(g, p, "material", g->n[K_MAT], "material", 0, ctx) == -2) return g->err->status;
   uint32_t tg = json_get(&g->d, p, "targets");
   if (tg) {
     if (N(g, tg)->t != J_ARR) return gl_bad(g, "%s: \"targets\" must be an array", ctx);
@@ -318,31 +316,26 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   if (nv < least[mode]) return gl_bad(g, "%s: %llu vertices are too few for its mode %llu", ctx, (unsigned long long)nv, (unsigned long long)mode);
   if (ix >= 0) { /* every index must name a vertex */
     const gacc *a = &g->accs[ix];
-    int cs = comp_size(a->ctype);
     if (a->comps != 1 || (a->ctype != 5121 && a->ctype != 5123 && a->ctype != 5125))
       return gl_bad(g, "%s: \"indices\" must be an accessor of unsigned byte, short or int scalars", ctx);
     if (a->sparse || a->view < 0) return gl_bad(g, "%s: sparse indices are not read", ctx);
     const gview *v = &g->views[a->view];
     if (a->stride != a->size) return gl_bad(g, "%s: the indices' buffer view %lld must not have a stride", ctx, (long long)a->view);
-    const unsigned char *d = g->bufs[v->buf].data + v->off + a->off;
-    for (uint64_t k = 0; k < a->count; k++) {
-      uint32_t x = 0;
-      for (int b = cs - 1; b >= 0; b--) x = x << 8 | d[k * (uint64_t)cs + (uint64_t)b];
-      if (x >= pa->count) return gl_bad(g, "%s: index %llu is %u, past the %llu vertices", ctx, (unsigned long long)k, x, (unsigned long long)pa->count);
-    }
+    uint32_t x;
+    int64_t k = first_index_past(g->bufs[v->buf].data + v->off + a->off, a->count, a->size, pa->count, &x);
+    if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the %llu vertices", ctx, (long long)k, x, (unsigned long long)pa->count);
   }
   return VALO_OK;
 }
 
 static valo_status check_mesh(gc *g, uint32_t m, uint32_t i, const char *mesh_ctx) {
-  char ctx[64];
-  snprintf(ctx, sizeof ctx, "%s", mesh_ctx);
   int64_t np = gl_objects(g, m, "primitives", "primitives");
   if (np < 0) return g->err->status;
-  if (np == 0) return gl_bad(g, "%s has no primitives", ctx);
+  if (np == 0) return gl_bad(g, "%s has no primitives", mesh_ctx);
   uint32_t pr = json_get(&g->d, m, "primitives");
   uint32_t k = 0;
   for (uint32_t p = N(g, pr)->child; p; p = N(g, p)->next, k++) {
+    char ctx[64];
     snprintf(ctx, sizeof ctx, "mesh %u primitive %u", i, k);
     valo_status st = check_primitive(g, p, ctx);
     if (st) return st;
@@ -359,7 +352,7 @@ static valo_status check_mesh(gc *g, uint32_t m, uint32_t i, const char *mesh_ct
 static valo_status glb_chunks(gc *g, const unsigned char *b, size_t len, const char **json, size_t *json_len) {
   uint32_t w[5];
   if (len < 20) return gl_bad(g, "a .glb shorter than its header");
-  for (int i = 0; i < 5; i++) w[i] = (uint32_t)b[4 * i] | (uint32_t)b[4 * i + 1] << 8 | (uint32_t)b[4 * i + 2] << 16 | (uint32_t)b[4 * i + 3] << 24;
+  for (int i = 0; i < 5; i++) w[i] = le_uint(b + 4 * i, 4);
   if (memcmp(b, "glTF", 4)) return gl_bad(g, "a .glb must start with \"glTF\"");
   if (w[1] != 2) return gl_bad(g, "binary glTF version %u is not read (valo reads version 2)", w[1]);
   if (w[2] != len) return gl_bad(g, "the header gives the length %u, the file has %zu bytes", w[2], len);
@@ -369,8 +362,7 @@ static valo_status glb_chunks(gc *g, const unsigned char *b, size_t len, const c
   size_t at = 20 + (size_t)w[3];
   at += (4 - at % 4) % 4;
   if (at + 8 <= len) {
-    uint32_t cl = (uint32_t)b[at] | (uint32_t)b[at + 1] << 8 | (uint32_t)b[at + 2] << 16 | (uint32_t)b[at + 3] << 24;
-    uint32_t ct = (uint32_t)b[at + 4] | (uint32_t)b[at + 5] << 8 | (uint32_t)b[at + 6] << 16 | (uint32_t)b[at + 7] << 24;
+    uint32_t cl = le_uint(b + at, 4), ct = le_uint(b + at + 4, 4);
     if (ct != GLB_BIN || cl > len - at - 8) return gl_bad(g, "the second chunk must be BIN and fit in the file");
     g->bin = b + at + 8;
     g->bin_len = cl;
@@ -383,41 +375,38 @@ static valo_status check_json(gc *g, const char *text, size_t len) {
   size_t line;
   char msg[200];
   if (json_parse(&g->d, text, len, &line, msg, sizeof msg)) return err_set(g->err, VALO_ERR_PARSE, "%s:%zu: glTF: %s", g->path, line, msg);
-  g->root = 1;
   if (N(g, 1)->t != J_OBJ) return gl_bad(g, "the document must be a JSON object");
   uint32_t v = json_get(&g->d, json_get(&g->d, 1, "asset"), "version");
   if (!v || N(g, v)->t != J_STR) return gl_bad(g, "no \"asset\": {\"version\": ...}");
   if (N(g, v)->str[0] != '2') return gl_bad(g, "version %s is not read (valo reads glTF 2.0)", N(g, v)->str);
-  static const char *kinds[] = {"buffers", "bufferViews", "accessors", "meshes", "nodes", "scenes", "materials",
+  static const char *kinds[K_KINDS] = {"buffers", "bufferViews", "accessors", "meshes", "nodes", "scenes", "materials",
                                 "textures", "images", "samplers", "cameras", "skins", "animations"};
-  uint32_t *counts[] = {&g->n_buf, &g->n_view, &g->n_acc, &g->n_mesh, &g->n_node, &g->n_scene, &g->n_mat,
-                        &g->n_tex, &g->n_img, &g->n_smp, &g->n_cam, &g->n_skin, NULL};
-  uint32_t arr[13];
-  for (int k = 0; k < 13; k++) {
+  for (int k = 0; k < K_KINDS; k++) {
     int64_t n = gl_objects(g, 1, kinds[k], kinds[k]);
     if (n < 0) return g->err->status;
-    if (counts[k]) *counts[k] = (uint32_t)n;
-    arr[k] = json_get(&g->d, 1, kinds[k]);
+    g->n[k] = (uint32_t)n;
+    g->arr[k] = json_get(&g->d, 1, kinds[k]);
   }
   uint32_t lext = json_get(&g->d, json_get(&g->d, 1, "extensions"), "KHR_lights_punctual");
   int64_t nl = gl_objects(g, lext, "lights", "KHR_lights_punctual lights");
   if (nl < 0) return g->err->status;
   g->n_light = (uint32_t)nl;
-  g->bufs = calloc((size_t)g->n_buf + 1, sizeof *g->bufs);
-  g->views = calloc((size_t)g->n_view + 1, sizeof *g->views);
-  g->accs = calloc((size_t)g->n_acc + 1, sizeof *g->accs);
+  g->lights = json_get(&g->d, lext, "lights");
+  g->bufs = calloc((size_t)g->n[K_BUF] + 1, sizeof *g->bufs);
+  g->views = calloc((size_t)g->n[K_VIEW] + 1, sizeof *g->views);
+  g->accs = calloc((size_t)g->n[K_ACC] + 1, sizeof *g->accs);
   if (!g->bufs || !g->views || !g->accs) return gl_bad(g, "out of memory");
   uint32_t i = 0;
-  for (uint32_t o = arr[0] ? N(g, arr[0])->child : 0; o; o = N(g, o)->next, i++) {
+  for (uint32_t o = g->arr[K_BUF] ? N(g, g->arr[K_BUF])->child : 0; o; o = N(g, o)->next, i++) {
     valo_status st = read_buffer(g, i, o);
     if (st) return st;
   }
-  valo_status st = gl_each(g, arr[1], "buffer view", check_view);
-  if (!st) st = gl_each(g, arr[2], "accessor", check_accessor);
-  if (!st) st = gl_each(g, arr[3], "mesh", check_mesh);
-  if (!st) st = gl_check_nodes(g, arr[4], g->n_light);
-  if (!st) st = gl_check_objects(g, arr, json_get(&g->d, lext, "lights"));
-  if (!st && gl_index(g, 1, "scene", g->n_scene, "scene", 0, "the document") == -2) st = g->err->status;
+  valo_status st = gl_each(g, g->arr[K_VIEW], "buffer view", check_view);
+  if (!st) st = gl_each(g, g->arr[K_ACC], "accessor", check_accessor);
+  if (!st) st = gl_each(g, g->arr[K_MESH], "mesh", check_mesh);
+  if (!st) st = gl_check_nodes(g);
+  if (!st) st = gl_check_objects(g);
+  if (!st && gl_index(g, 1, "scene", g->n[K_SCENE], "scene", 0, "the document") == -2) st = g->err->status;
   return st;
 }
 
@@ -428,9 +417,8 @@ valo_status gltf_check_file(const char *path, int binary, obj_check *oc, valo_er
   g.path = path;
   g.err = err;
   g.oc = oc;
-  g.binary = binary;
   size_t len = 0;
-  unsigned char *data = read_all(path, &len);
+  unsigned char *data = (unsigned char *)obj_check_read_whole(path, &len);
   if (!data) return err_set(err, VALO_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
   snprintf(oc->files[0].path, sizeof oc->files[0].path, "%s", path);
   oc->files[0].text = (char *)data;

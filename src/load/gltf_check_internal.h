@@ -14,16 +14,19 @@ typedef struct gbuf { const unsigned char *data; uint64_t len; } gbuf; /* a buff
 typedef struct gview { uint32_t buf; uint64_t off, len, stride; } gview;
 typedef struct gacc { int64_t view; uint64_t off, count, size, stride; int ctype, comps, sparse; } gacc;
 
+/* The top-level arrays the check reads, in this order (gltf_check.c, kinds[]). */
+enum { K_BUF, K_VIEW, K_ACC, K_MESH, K_NODE, K_SCENE, K_MAT, K_TEX, K_IMG, K_SMP, K_CAM, K_SKIN, K_ANIM, K_KINDS };
+
 typedef struct gc {
   const char *path;
   valo_error *err;
   obj_check *oc;
   jdoc d;
-  uint32_t root;
   const unsigned char *bin;
   uint64_t bin_len;
-  int binary, has_bin;
-  uint32_t n_buf, n_view, n_acc, n_mesh, n_node, n_scene, n_mat, n_tex, n_img, n_smp, n_cam, n_skin, n_light;
+  int has_bin;
+  uint32_t arr[K_KINDS], n[K_KINDS]; /* each top-level array (0 when absent) and its length */
+  uint32_t lights, n_light;          /* KHR_lights_punctual's array of lights and its length */
   gbuf *bufs;
   gview *views;
   gacc *accs;
@@ -51,8 +54,7 @@ int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const 
 int64_t gl_data_uri(gc *g, const char *s, const char *ctx);
 
 /* gltf_objects.c: the nodes (trees of valid references, bounded depth), then scenes,
- * materials, textures, images, cameras, skins, animations and KHR_lights_punctual lights
- * (arr: the top-level arrays in gltf_check.c's order; lights: their array or 0). */
-valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights);
-valo_status gl_check_objects(gc *g, const uint32_t *arr, uint32_t lights);
+ * materials, textures, images, cameras, skins, animations and KHR_lights_punctual lights. */
+valo_status gl_check_nodes(gc *g);
+valo_status gl_check_objects(gc *g);
 #endif

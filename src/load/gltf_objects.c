@@ -8,8 +8,8 @@
 #include <string.h>
 
 /* Children indices valid, each node the child of at most one node, no cycle, depth bounded. */
-valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights) {
-  uint32_t n = g->n_node;
+valo_status gl_check_nodes(gc *g) {
+  uint32_t n = g->n[K_NODE], arr = g->arr[K_NODE];
   int64_t *parent = malloc(((size_t)n + 1) * sizeof *parent);
   uint32_t *stack = malloc(((size_t)n + 1) * sizeof *stack), *depth = malloc(((size_t)n + 1) * sizeof *depth);
   uint32_t *obj = malloc(((size_t)n + 1) * sizeof *obj);
@@ -20,8 +20,8 @@ valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights) {
     char ctx[48];
     snprintf(ctx, sizeof ctx, "node %u", i);
     obj[i] = o;
-    if (gl_index_array(g, o, "children", n, "node", ctx) || gl_index(g, o, "mesh", g->n_mesh, "mesh", 0, ctx) == -2 ||
-        gl_index(g, o, "camera", g->n_cam, "camera", 0, ctx) == -2 || gl_index(g, o, "skin", g->n_skin, "skin", 0, ctx) == -2) {
+    if (gl_index_array(g, o, "children", n, "node", ctx) || gl_index(g, o, "mesh", g->n[K_MESH], "mesh", 0, ctx) == -2 ||
+        gl_index(g, o, "camera", g->n[K_CAM], "camera", 0, ctx) == -2 || gl_index(g, o, "skin", g->n[K_SKIN], "skin", 0, ctx) == -2) {
       st = g->err->status;
       break;
     }
@@ -35,7 +35,7 @@ valo_status gl_check_nodes(gc *g, uint32_t arr, uint32_t lights) {
       if (!ok) st = gl_bad(g, "%s: \"%s\" must be an array of %u numbers", ctx, vecs[k], lens[k]);
     }
     uint32_t ext = json_get(&g->d, json_get(&g->d, o, "extensions"), "KHR_lights_punctual");
-    if (!st && ext && gl_index(g, ext, "light", lights, "light", 1, ctx) < 0) st = g->err->status;
+    if (!st && ext && gl_index(g, ext, "light", g->n_light, "light", 1, ctx) < 0) st = g->err->status;
     uint32_t ch = json_get(&g->d, o, "children");
     for (uint32_t c = ch ? N(g, ch)->child : 0; c && !st; c = N(g, c)->next) {
       uint32_t k = (uint32_t)N(g, c)->num;
@@ -80,7 +80,7 @@ static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
     size_t kl = k ? strlen(k) : 0;
     if (N(g, c)->t == J_OBJ && kl >= 7 && !strcmp(k + kl - 7, "Texture")) {
       uint64_t tc;
-      if (gl_index(g, c, "index", g->n_tex, "texture", 1, ctx) < 0 || gl_uint(g, c, "texCoord", 0, 7, 0, &tc, ctx)) return g->err->status;
+      if (gl_index(g, c, "index", g->n[K_TEX], "texture", 1, ctx) < 0 || gl_uint(g, c, "texCoord", 0, 7, 0, &tc, ctx)) return g->err->status;
     }
     if (N(g, c)->t == J_OBJ && k && !strcmp(k, "KHR_texture_transform")) { /* Assimp indexes these without looking */
       static const char *vec2[] = {"offset", "scale"};
@@ -104,11 +104,11 @@ static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
 
 static valo_status check_texture(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   (void)i;
-  if (gl_index(g, o, "source", g->n_img, "image", 0, ctx) == -2 || gl_index(g, o, "sampler", g->n_smp, "sampler", 0, ctx) == -2)
+  if (gl_index(g, o, "source", g->n[K_IMG], "image", 0, ctx) == -2 || gl_index(g, o, "sampler", g->n[K_SMP], "sampler", 0, ctx) == -2)
     return g->err->status;
   uint32_t ext = json_get(&g->d, o, "extensions");
   for (uint32_t c = ext && N(g, ext)->t == J_OBJ ? N(g, ext)->child : 0; c; c = N(g, c)->next)
-    if (N(g, c)->t == J_OBJ && gl_index(g, c, "source", g->n_img, "image", 0, ctx) == -2) return g->err->status;
+    if (N(g, c)->t == J_OBJ && gl_index(g, c, "source", g->n[K_IMG], "image", 0, ctx) == -2) return g->err->status;
   return VALO_OK;
 }
 
@@ -124,7 +124,7 @@ static valo_status check_image(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   /* Assimp reads through a null pointer when the type has no '/' */
   if (json_get(&g->d, o, "bufferView") && (!mt || N(g, mt)->t != J_STR || !strchr(N(g, mt)->str, '/')))
     return gl_bad(g, "%s: an image in a buffer view needs a \"mimeType\" such as image/png", ctx);
-  return gl_index(g, o, "bufferView", g->n_view, "buffer view", 0, ctx) == -2 ? g->err->status : VALO_OK;
+  return gl_index(g, o, "bufferView", g->n[K_VIEW], "buffer view", 0, ctx) == -2 ? g->err->status : VALO_OK;
 }
 
 static valo_status check_camera(gc *g, uint32_t o, uint32_t i, const char *ctx) {
@@ -143,7 +143,7 @@ static valo_status check_skin(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   (void)i;
   uint32_t j = json_get(&g->d, o, "joints");
   if (!j || N(g, j)->t != J_ARR || N(g, j)->n == 0) return gl_bad(g, "%s: \"joints\" must be a non-empty array", ctx);
-  if (gl_index_array(g, o, "joints", g->n_node, "node", ctx) || gl_index(g, o, "skeleton", g->n_node, "node", 0, ctx) == -2) return g->err->status;
+  if (gl_index_array(g, o, "joints", g->n[K_NODE], "node", ctx) || gl_index(g, o, "skeleton", g->n[K_NODE], "node", 0, ctx) == -2) return g->err->status;
   int64_t m = gl_accessor_ref(g, o, "inverseBindMatrices", 1, ctx); /* optional in glTF; Assimp reads through a NULL without */
   if (m < 0) return g->err->status;
   if ((g->accs[m].comps != 16 || g->accs[m].ctype != 5126 || g->accs[m].count < N(g, j)->n))
@@ -168,7 +168,7 @@ static valo_status check_animation(gc *g, uint32_t o, uint32_t i, const char *ct
     uint32_t t = json_get(&g->d, c, "target");
     if (gl_index(g, c, "sampler", (uint32_t)ns, "sampler of the animation", 1, ctx) < 0) return g->err->status;
     if (!t || N(g, t)->t != J_OBJ) return gl_bad(g, "%s: a channel has no \"target\" object", ctx);
-    if (gl_index(g, t, "node", g->n_node, "node", 0, ctx) == -2) return g->err->status;
+    if (gl_index(g, t, "node", g->n[K_NODE], "node", 0, ctx) == -2) return g->err->status;
   }
   return VALO_OK;
 }
@@ -183,7 +183,7 @@ static valo_status check_light(gc *g, uint32_t o, uint32_t i, const char *ctx) {
 
 static valo_status check_scene(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   (void)i;
-  return gl_index_array(g, o, "nodes", g->n_node, "node", ctx) ? g->err->status : VALO_OK;
+  return gl_index_array(g, o, "nodes", g->n[K_NODE], "node", ctx) ? g->err->status : VALO_OK;
 }
 
 static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
@@ -191,14 +191,14 @@ static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx
   return check_texture_refs(g, o, ctx);
 }
 
-valo_status gl_check_objects(gc *g, const uint32_t *arr, uint32_t lights) {
-  valo_status st = gl_each(g, arr[5], "scene", check_scene);
-  if (!st) st = gl_each(g, arr[6], "material", check_material);
-  if (!st) st = gl_each(g, arr[7], "texture", check_texture);
-  if (!st) st = gl_each(g, arr[8], "image", check_image);
-  if (!st) st = gl_each(g, arr[10], "camera", check_camera);
-  if (!st) st = gl_each(g, arr[11], "skin", check_skin);
-  if (!st) st = gl_each(g, arr[12], "animation", check_animation);
-  if (!st) st = gl_each(g, lights, "light", check_light);
+valo_status gl_check_objects(gc *g) {
+  valo_status st = gl_each(g, g->arr[K_SCENE], "scene", check_scene);
+  if (!st) st = gl_each(g, g->arr[K_MAT], "material", check_material);
+  if (!st) st = gl_each(g, g->arr[K_TEX], "texture", check_texture);
+  if (!st) st = gl_each(g, g->arr[K_IMG], "image", check_image);
+  if (!st) st = gl_each(g, g->arr[K_CAM], "camera", check_camera);
+  if (!st) st = gl_each(g, g->arr[K_SKIN], "skin", check_skin);
+  if (!st) st = gl_each(g, g->arr[K_ANIM], "animation", check_animation);
+  if (!st) st = gl_each(g, g->lights, "light", check_light);
   return st;
 }

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <strings.h>
 
-static char *read_whole(const char *path, size_t *len) {
+char *obj_check_read_whole(const char *path, size_t *len) {
   FILE *f = fopen(path, "rb");
   if (!f) return NULL;
   size_t cap = 1 << 16, n = 0;
@@ -156,7 +156,7 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
     return VALO_OK;
   }
   size_t len;
-  char *txt = read_whole(path, &len);
+  char *txt = obj_check_read_whole(path, &len);
   if (!txt) {
     log_warning("%s:%d: material library %s cannot be read (%s): its materials become grey diffuse", obj_path, obj_line, path,
                 strerror(errno));
@@ -286,7 +286,7 @@ static int check_ref(const char *b, const char *e, const long sofar[3], const lo
 valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err) {
   memset(oc, 0, sizeof *oc);
   size_t len;
-  char *txt = read_whole(path, &len);
+  char *txt = obj_check_read_whole(path, &len);
   if (!txt) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
   const char *end = txt + len, *next;
   char dir[1024] = "";

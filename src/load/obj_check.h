@@ -43,8 +43,12 @@ valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err);
 void obj_check_free(obj_check *oc);
 /* The PBR-extension values of material `name`, or NULL. */
 const mtl_pbr *obj_check_pbr(const obj_check *oc, const char *name);
-/* An Assimp file system (struct aiFileIO *) serving the repaired texts and reading every
- * other file from disk; valid while oc lives. */
+/* The file at path, whole and NUL-terminated (malloc'd; *len bytes before the NUL), or
+ * NULL with errno set. */
+char *obj_check_read_whole(const char *path, size_t *len);
+/* An Assimp file system (struct aiFileIO *) serving the texts in oc->files (repaired
+ * OBJ/MTL, a checked glTF and its buffers, a repaired PLY) and opening no other file;
+ * valid while oc lives. */
 struct aiFileIO;
 void obj_check_fileio(obj_check *oc, struct aiFileIO *io);
 #endif
