@@ -76,6 +76,17 @@ static const char *out_png(void) {
 #define ENV_ARGS(file) {"render", DEFAULT_SCENE, "--env", file, "--spp", "1", "--res", "16x16", "-q", "-o", out_png(), NULL}
 #define MESH_ARGS(file) {"render", file, "--spp", "1", "--res", "16x16", "-q", "-o", out_png(), NULL}
 
+/* The mesh file `name` (n bytes) written to the scratch folder, then loaded by valo:
+ * mesh_loads must render it, mesh_refused must see it refused saying `what`. */
+static int mesh_loads(const char *name, const void *d, size_t n) {
+  const char *a[] = MESH_ARGS(write_bytes(name, d, n));
+  return accepted(a, name);
+}
+static int mesh_refused(const char *name, const void *d, size_t n, const char *what) {
+  const char *a[] = MESH_ARGS(write_bytes(name, d, n));
+  return refused(a, name, what);
+}
+
 /* ---- Radiance HDR ---- */
 
 /* A w x h RGBE image in the adaptive RLE (w in 8..32767) or flat; pixels with runs. */
@@ -287,10 +298,9 @@ static int ply_ascii_damaged(void) {
     buf b = {0};
     ply_header(&b, "ascii", cases[i].nv, cases[i].nf, "uchar");
     puts_(&b, cases[i].body);
-    const char *p = write_bytes(cases[i].name, b.d, b.n);
+    int rc = mesh_refused(cases[i].name, b.d, b.n, cases[i].what);
     free(b.d);
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, cases[i].name, cases[i].what)) return 1;
+    if (rc) return 1;
   }
   /* Headers. */
   struct { const char *name, *what, *text; } heads[] = {
@@ -316,9 +326,7 @@ static int ply_ascii_damaged(void) {
        "property list uchar int vertex_indices\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"},
   };
   for (size_t i = 0; i < sizeof heads / sizeof heads[0]; i++) {
-    const char *p = write_bytes(heads[i].name, heads[i].text, strlen(heads[i].text));
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, heads[i].name, heads[i].what)) return 1;
+    if (mesh_refused(heads[i].name, heads[i].text, strlen(heads[i].text), heads[i].what)) return 1;
   }
   return 0;
 }
@@ -345,19 +353,17 @@ static int ply_binary_damaged(void) {
       if (cases[i].cut) b.n -= cases[i].cut;
       char name[64];
       snprintf(name, sizeof name, "%s_%s", be ? "be" : "le", cases[i].name);
-      const char *p = write_bytes(name, b.d, b.n);
+      int rc = mesh_refused(name, b.d, b.n, cases[i].what);
       free(b.d);
-      const char *a[] = MESH_ARGS(p);
-      if (refused(a, name, cases[i].what)) return 1;
+      if (rc) return 1;
     }
     /* A face list whose uchar count says 255 items: runs past the end. */
     buf b = {0};
     ply_binary(&b, be, 4, 2, ok2, 2);
     b.d[b.n - 13] = 255;
-    const char *p = write_bytes(be ? "be_list_255.ply" : "le_list_255.ply", b.d, b.n);
+    int rc = mesh_refused(be ? "be_list_255.ply" : "le_list_255.ply", b.d, b.n, "past the end");
     free(b.d);
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, be ? "be_list_255.ply" : "le_list_255.ply", "past the end")) return 1;
+    if (rc) return 1;
   }
   return 0;
 }
@@ -375,20 +381,17 @@ static int ply_dragon_mutations(void) {
   for (int i = 0; i < 3; i++) {
     char name[64];
     snprintf(name, sizeof name, "dragon_cut%d.ply", i);
-    const char *p = write_bytes(name, d, cuts[i]);
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, name, NULL)) { free(d); return 1; }
+    if (mesh_refused(name, d, cuts[i], NULL)) { free(d); return 1; }
   }
   /* 2000 bytes of the vertex list spliced into the face list. */
   buf b = {0};
   put(&b, d, 250000);
   put(&b, d + 1000, 2000);
   put(&b, d + 250000, n - 250000);
-  const char *p = write_bytes("dragon_splice.ply", b.d, b.n);
+  int rc = mesh_refused("dragon_splice.ply", b.d, b.n, NULL);
   free(b.d);
   free(d);
-  const char *a[] = MESH_ARGS(p);
-  return refused(a, "dragon_splice.ply", NULL);
+  return rc;
 }
 
 /* ---- PNG, JPEG, EXR ---- */
@@ -467,14 +470,14 @@ static int png_jpeg_damaged(void) {
  * pixels are allocated (CI's fuzzer found a 19-byte file claiming 8505 x 52777, 5 GB;
  * 8505 x 5277 here, well within the memory check, so the file's size refuses it). */
 static int pfm_damaged(void) {
-  struct { const char *name, *text, *what; } cases[] = {
-      {"claims_500mb.pfm", "PF\n8505 5277\n-1\n\x1e\x38", "8505 x 5277 pixels need 538570620 bytes, the file holds 2"},
-      {"short_row.pfm", "PF\n2 1\n-1\n\0\0\0\0\0\0\0\0", "2 x 1 pixels need 24 bytes, the file holds 8"},
+#define PFM_CASE(name, bytes, what) {name, bytes, sizeof bytes - 1, what}
+  struct { const char *name, *bytes; size_t n; const char *what; } cases[] = {
+      PFM_CASE("claims_500mb.pfm", "PF\n8505 5277\n-1\n\x1e\x38", "8505 x 5277 pixels need 538570620 bytes, the file holds 2"),
+      PFM_CASE("short_row.pfm", "PF\n2 1\n-1\n\0\0\0\0\0\0\0\0", "2 x 1 pixels need 24 bytes, the file holds 8"),
   };
+#undef PFM_CASE
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-    size_t n = strlen(cases[i].text);
-    if (i == 1) n = 10 + 8; /* the header, then 8 zero bytes */
-    const char *p = write_bytes(cases[i].name, cases[i].text, n);
+    const char *p = write_bytes(cases[i].name, cases[i].bytes, cases[i].n);
     const char *a[] = ENV_ARGS(p);
     if (refused(a, cases[i].name, cases[i].what)) return 1;
   }
@@ -563,9 +566,7 @@ static void make_glb(buf *b, const char *json, const unsigned char *bin, size_t 
 }
 
 static int gltf_valid_forms(void) {
-  const char *p = write_bytes("quad.gltf", GLTF_QUAD, strlen(GLTF_QUAD));
-  const char *a[] = MESH_ARGS(p);
-  if (accepted(a, "quad.gltf")) return 1;
+  if (mesh_loads("quad.gltf", GLTF_QUAD, strlen(GLTF_QUAD))) return 1;
   /* the buffer in a file beside it, and the same in a .glb */
   static const float pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
   static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
@@ -575,26 +576,18 @@ static int gltf_valid_forms(void) {
   write_bytes("quad.bin", bin, sizeof bin);
   const char *t = subst(GLTF_QUAD, "data:application/octet-stream;base64," QUAD_B64, "quad.bin");
   CHECK(t, "template");
-  p = write_bytes("quad_file.gltf", t, strlen(t));
-  const char *b2[] = MESH_ARGS(p);
-  if (accepted(b2, "quad_file.gltf")) return 1;
+  if (mesh_loads("quad_file.gltf", t, strlen(t))) return 1;
   /* a buffer file named with a URI's escape (Assimp 5.2 opened "quad%20file.bin" as written) */
   write_bytes("quad file.bin", bin, sizeof bin);
   t = subst(GLTF_QUAD, "data:application/octet-stream;base64," QUAD_B64, "quad%20file.bin");
-  p = write_bytes("quad_escaped.gltf", t, strlen(t));
-  const char *b4[] = MESH_ARGS(p);
-  if (accepted(b4, "quad_escaped.gltf")) return 1;
+  if (mesh_loads("quad_escaped.gltf", t, strlen(t))) return 1;
   /* a UTF-8 byte-order mark before the JSON (Assimp 5.2 read no glTF after one) */
   char bom[4096];
   snprintf(bom, sizeof bom, "\xef\xbb\xbf%s", GLTF_QUAD);
-  p = write_bytes("quad_bom.gltf", bom, strlen(bom));
-  const char *b5[] = MESH_ARGS(p);
-  if (accepted(b5, "quad_bom.gltf")) return 1;
+  if (mesh_loads("quad_bom.gltf", bom, strlen(bom))) return 1;
   /* an application's "...Texture" member inside a material's extras is not a texture reference */
   t = subst(GLTF_QUAD, "\"scene\": 0", "\"materials\": [{\"extras\": {\"myTexture\": {\"file\": \"x.png\"}}}], \"scene\": 0");
-  p = write_bytes("quad_extras.gltf", t, strlen(t));
-  const char *b6[] = MESH_ARGS(p);
-  if (accepted(b6, "quad_extras.gltf")) return 1;
+  if (mesh_loads("quad_extras.gltf", t, strlen(t))) return 1;
   /* sparse accessors: a morph target, and POSITION itself */
   const char *sp1[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-morph-target.gltf");
   const char *sp2[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-position.gltf");
@@ -603,10 +596,9 @@ static int gltf_valid_forms(void) {
   snprintf(json, sizeof json, "%s", subst(GLTF_QUAD, ", \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"", ""));
   buf g = {0};
   make_glb(&g, json, bin, sizeof bin);
-  p = write_bytes("quad.glb", g.d, g.n);
+  int rc = mesh_loads("quad.glb", g.d, g.n);
   free(g.d);
-  const char *b3[] = MESH_ARGS(p);
-  return accepted(b3, "quad.glb");
+  return rc;
 }
 
 /* Each refused in valo's words: those Assimp 5.2.5 crashed on (a sparse accessor, an
@@ -645,18 +637,14 @@ static int gltf_damaged(void) {
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     const char *t = cases[i].find ? subst(GLTF_QUAD, cases[i].find, cases[i].repl) : cases[i].repl;
     CHECK(t, "%s: the template lacks %s", cases[i].name, cases[i].find);
-    const char *p = write_bytes(cases[i].name, t, strlen(t));
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, cases[i].name, cases[i].what)) return 1;
+    if (mesh_refused(cases[i].name, t, strlen(t), cases[i].what)) return 1;
   }
   /* a triangle strip of 2 indices (Assimp counted 2 - 2 - 1 triangles: an allocation of 2^64 bytes) */
   char two[8192];
   snprintf(two, sizeof two, "%s", subst(GLTF_QUAD, "\"count\": 6", "\"count\": 2"));
   const char *st = subst(two, "\"indices\": 1}", "\"indices\": 1, \"mode\": 5}");
   CHECK(st, "template");
-  const char *sp = write_bytes("g_strip.gltf", st, strlen(st));
-  const char *sa[] = MESH_ARGS(sp);
-  if (refused(sa, "g_strip.gltf", "2 vertices are too few for its mode 5")) return 1;
+  if (mesh_refused("g_strip.gltf", st, strlen(st), "2 vertices are too few for its mode 5")) return 1;
   /* .glb containers */
   buf g = {0};
   make_glb(&g, GLTF_QUAD, NULL, 0);
@@ -672,9 +660,7 @@ static int gltf_damaged(void) {
     memcpy(c, g.d, g.n);
     memset(c + g.n, 0, 8);
     for (int k = 0; k < 4; k++) c[glbs[i].at + (size_t)k] = (unsigned char)(glbs[i].word >> (8 * k));
-    const char *p = write_bytes(glbs[i].name, c, glbs[i].len);
-    const char *a[] = MESH_ARGS(p);
-    if (refused(a, glbs[i].name, glbs[i].what)) { free(c); free(g.d); return 1; }
+    if (mesh_refused(glbs[i].name, c, glbs[i].len, glbs[i].what)) { free(c); free(g.d); return 1; }
   }
   free(c);
   free(g.d);
