@@ -1,7 +1,8 @@
 /* test_badinput.c — damaged files never crash or hang valo: Radiance HDR maps (header cut,
  * scanline cut, bad run lengths, absurd sizes), PLY meshes (ASCII and binary: face counts,
  * indices, truncated element lists), glTF files (.gltf and .glb: references, lengths,
- * strict JSON; gltf_check.h), PNG/JPEG textures and EXR maps, truncated and corrupted.
+ * strict JSON; gltf_check.h), other mesh formats Assimp crashes or stalls on
+ * (import_probe.h), PNG/JPEG textures and EXR maps, truncated and corrupted.
  * Each file is made here from a valid one, handed to the real `valo` binary (ASan+UBSan
  * in CI), and must be refused with exit 1, a message naming the file, in well under a
  * second; a run still alive after 10 s is killed and fails the case. Valid files of each
@@ -667,6 +668,67 @@ static int gltf_damaged(void) {
   return 0;
 }
 
+/* Formats valo does not check itself go to Assimp in a child process first
+ * (import_probe.h): valid STL, OFF, Collada and DirectX files load; a Collada file that
+ * crashed Assimp (a float_array whose count is 0 but which holds nine numbers: a
+ * segfault), an OFF header claiming billions of vertices (a 22 GB allocation, then more
+ * than 30 s filling it) and an import past VALO_IMPORT_TIMEOUT are refused in valo's
+ * words, with no crash and no sanitizer report. */
+#define DAE_TRIANGLE                                                                                                 \
+  "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"                                                                     \
+  "<COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">\n"                             \
+  "<library_geometries><geometry id=\"g\"><mesh>\n"                                                                  \
+  "<source id=\"p\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 1 0</float_array>\n"                            \
+  "<technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\"><param name=\"X\" type=\"float\"/>"           \
+  "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>\n"    \
+  "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices>\n"                                     \
+  "<triangles count=\"1\"><input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles>\n"         \
+  "</mesh></geometry></library_geometries>\n"                                                                        \
+  "<library_visual_scenes><visual_scene id=\"s\"><node id=\"n\"><instance_geometry url=\"#g\"/></node>"              \
+  "</visual_scene></library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>\n</COLLADA>\n"
+static int other_formats(void) {
+  static const char stl[] = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                            "endloop\nendfacet\nendsolid t\n";
+  static const char off[] = "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n";
+  static const char x[] = "xof 0302txt 0032\nMesh m {\n3;\n0;0;0;,\n1;0;0;,\n0;1;0;;\n1;\n3;0,1,2;;\n}\n";
+  unsigned char bstl[84 + 50] = {0};
+  bstl[80] = 1; /* one triangle: normal, three vertices, attribute bytes */
+  const float tri[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  memcpy(bstl + 84, tri, sizeof tri);
+  if (mesh_loads("o_ascii.stl", stl, strlen(stl)) || mesh_loads("o_binary.stl", bstl, sizeof bstl) ||
+      mesh_loads("o_quad.off", off, strlen(off)) || mesh_loads("o_triangle.dae", DAE_TRIANGLE, strlen(DAE_TRIANGLE)) ||
+      mesh_loads("o_triangle.x", x, strlen(x)))
+    return 1;
+  const char *dae = subst(DAE_TRIANGLE, "count=\"9\"", "count=\"0\"");
+  CHECK(dae, "template");
+  if (mesh_refused("o_crash.dae", dae, strlen(dae), "Assimp crashed reading the file")) return 1;
+  char huge[128];
+  snprintf(huge, sizeof huge, "OFF%s\n4 21 0\n1  2\n", "7777777777777777777777777777777777777777777777777777777777");
+  /* Assimp's std::bad_alloc at valo's limit; under the sanitizers their allocator ends
+   * the child first, reported as a crash */
+#if defined(__SANITIZE_ADDRESS__)
+#define HUGE_SAYS "Assimp crashed reading the file"
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define HUGE_SAYS "Assimp crashed reading the file"
+#endif
+#endif
+#ifndef HUGE_SAYS
+#define HUGE_SAYS "Assimp ran out of memory reading the file (std::bad_alloc): it may use 1.0 GiB"
+#endif
+  if (mesh_refused("o_huge.off", huge, strlen(huge), HUGE_SAYS)) return 1;
+  /* the time limit: a valid OFF of 200 000 vertices, which takes Assimp far longer than 1 ms */
+  buf b = {0};
+  puts_(&b, "OFF\n200000 1 0\n");
+  for (int i = 0; i < 200000; i++) puts_(&b, "0.125 0.25 0.5\n");
+  puts_(&b, "3 0 1 2\n");
+  setenv("VALO_IMPORT_TIMEOUT", "0.001", 1);
+  int rc = mesh_refused("o_slow.off", b.d, b.n, "did not finish reading the file within 0.001 s");
+  unsetenv("VALO_IMPORT_TIMEOUT");
+  free(b.d);
+  return rc;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"hdr_decoder_matches_stb", hdr_decoder_matches_stb},
                                     {"hdr_damaged", hdr_damaged},
@@ -679,6 +741,7 @@ int main(int argc, char **argv) {
                                     {"pfm_damaged", pfm_damaged},
                                     {"gltf_valid_forms", gltf_valid_forms},
                                     {"gltf_damaged", gltf_damaged},
+                                    {"other_formats", other_formats},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -2,7 +2,9 @@
  * and the rest Assimp reads): node transforms, triangulated faces, normals and UVs,
  * MTL material meanings (../shared/scenes/README.md: Kd, Ke front-sided, illum 5 mirror,
  * illum 7 glass, illum 2 Phong), a file camera, and the input checks (NaN/Inf vertices,
- * out-of-range indices, degenerate or empty meshes). */
+ * out-of-range indices, degenerate or empty meshes). OBJ, PLY and glTF are checked by
+ * valo before Assimp reads them; any other format is first imported in a child process
+ * (import_probe.h). */
 #include "load/load.h"
 #include "core/error.h"
 #include "core/memlimit.h"
@@ -16,6 +18,7 @@
 #include <assimp/ObjMaterial.h>
 #include "image/texture.h"
 #include "load/gltf_check.h"
+#include "load/import_probe.h"
 #include "load/obj_check.h"
 #include "load/ply_check.h"
 #include <assimp/cfileio.h>
@@ -479,7 +482,12 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     oc.nfiles = 1;
     obj_check_fileio(&oc, &io);
   }
-  const struct aiScene *ai = obj || gltf || ply_fixed ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
+  int checked = obj || gltf || ply_fixed;
+  if (!checked) { /* any other format: tried in a child process first (import_probe.h) */
+    valo_status ist = import_probe(path, flags, err);
+    if (ist) return ist;
+  }
+  const struct aiScene *ai = checked ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
   if (!ai) {
     const char *msg = aiGetErrorString();
     obj_check_free(&oc);
