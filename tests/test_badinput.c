@@ -589,6 +589,10 @@ static int gltf_valid_forms(void) {
   /* an application's "...Texture" member inside a material's extras is not a texture reference */
   t = subst(GLTF_QUAD, "\"scene\": 0", "\"materials\": [{\"extras\": {\"myTexture\": {\"file\": \"x.png\"}}}], \"scene\": 0");
   if (mesh_loads("quad_extras.gltf", t, strlen(t))) return 1;
+  /* a skin without inverseBindMatrices (valid glTF; Assimp 5.2 crashed on it: valo hides skins from it) */
+  t = subst(GLTF_QUAD, "[{\"mesh\": 0}]", "[{\"mesh\": 0, \"skin\": 0}], \"skins\": [{\"joints\": [0]}]");
+  CHECK(t, "template");
+  if (mesh_loads("quad_skin.gltf", t, strlen(t))) return 1;
   /* sparse accessors: a morph target, and POSITION itself */
   const char *sp1[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-morph-target.gltf");
   const char *sp2[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-position.gltf");

@@ -371,6 +371,18 @@ static valo_status glb_chunks(gc *g, const unsigned char *b, size_t len, const c
   return VALO_OK;
 }
 
+/* valo renders meshes in their bind pose and reads no skin, so when a skin lacks
+ * inverseBindMatrices (valid glTF, on which Assimp 5.2 crashes) the text given to Assimp
+ * names none: the top-level "skins" and each node's "skin" are renamed in place ("_kins",
+ * "_kin"), which keeps the JSON valid and its length, and Assimp ignores unknown names. */
+static void hide_skins(gc *g) {
+  for (uint32_t c = N(g, 1)->child; c; c = N(g, c)->next) /* every "skins", should a name repeat */
+    if (!strcmp(N(g, c)->key, "skins")) ((char *)N(g, c)->key_at)[1] = '_';
+  for (uint32_t o = g->arr[K_NODE] ? N(g, g->arr[K_NODE])->child : 0; o; o = N(g, o)->next)
+    for (uint32_t c = N(g, o)->child; c; c = N(g, c)->next)
+      if (!strcmp(N(g, c)->key, "skin")) ((char *)N(g, c)->key_at)[1] = '_';
+}
+
 static valo_status check_json(gc *g, const char *text, size_t len) {
   size_t line;
   char msg[200];
@@ -407,6 +419,7 @@ static valo_status check_json(gc *g, const char *text, size_t len) {
   if (!st) st = gl_check_nodes(g);
   if (!st) st = gl_check_objects(g);
   if (!st && gl_index(g, 1, "scene", g->n[K_SCENE], "scene", 0, "the document") == -2) st = g->err->status;
+  if (!st && g->drop_skins) hide_skins(g);
   return st;
 }
 

@@ -32,6 +32,7 @@ typedef struct gc {
   gacc *accs;
   unsigned char *decoded[64];
   int ndecoded;
+  int drop_skins; /* a skin has no inverseBindMatrices: Assimp is given none (gltf_check_file) */
 } gc;
 
 static inline const jnode *N(const gc *g, uint32_t i) { return &g->d.nodes[i]; }

@@ -133,9 +133,10 @@ static int parse_container(jparse *j, uint32_t id, int depth) {
   if (j->p < j->end && *j->p == close) { j->p++; return 0; }
   uint32_t last = 0;
   for (;;) {
-    const char *key = NULL;
+    const char *key = NULL, *key_at = NULL;
     if (obj) {
       if (j->p >= j->end || *j->p != '"') return fail(j, "a member name (a string) expected");
+      key_at = j->p;
       if (parse_string(j, &key)) return -1;
       skip_ws(j);
       if (j->p >= j->end || *j->p != ':') return fail(j, "':' expected after a member name");
@@ -144,6 +145,7 @@ static int parse_container(jparse *j, uint32_t id, int depth) {
     uint32_t c;
     if (parse_value(j, &c, depth + 1)) return -1;
     j->d->nodes[c].key = key;
+    j->d->nodes[c].key_at = key_at;
     if (last) j->d->nodes[last].next = c;
     else j->d->nodes[id].child = c;
     last = c;

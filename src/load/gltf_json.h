@@ -16,6 +16,7 @@ typedef struct jnode {
   int is_int;        /* a number written as an integer */
   double num;
   const char *key;   /* the member's name (unescaped), in an object; else NULL */
+  const char *key_at; /* where that name's opening quote is in the text parsed */
   const char *str;   /* a string's value (unescaped; \u0000 is refused) */
   uint32_t child, next, n; /* node indices (0: none); n: the members or elements */
 } jnode;

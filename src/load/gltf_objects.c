@@ -144,8 +144,13 @@ static valo_status check_skin(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   uint32_t j = json_get(&g->d, o, "joints");
   if (!j || N(g, j)->t != J_ARR || N(g, j)->n == 0) return gl_bad(g, "%s: \"joints\" must be a non-empty array", ctx);
   if (gl_index_array(g, o, "joints", g->n[K_NODE], "node", ctx) || gl_index(g, o, "skeleton", g->n[K_NODE], "node", 0, ctx) == -2) return g->err->status;
-  int64_t m = gl_accessor_ref(g, o, "inverseBindMatrices", 1, ctx); /* optional in glTF; Assimp reads through a NULL without */
-  if (m < 0) return g->err->status;
+  /* optional in glTF, but Assimp 5.2 reads through a null pointer without it */
+  int64_t m = gl_accessor_ref(g, o, "inverseBindMatrices", 0, ctx);
+  if (m == -2) return g->err->status;
+  if (m == -1) {
+    g->drop_skins = 1;
+    return VALO_OK;
+  }
   if ((g->accs[m].comps != 16 || g->accs[m].ctype != 5126 || g->accs[m].count < N(g, j)->n))
     return gl_bad(g, "%s: \"inverseBindMatrices\" must be MAT4 floats, one per joint", ctx);
   return VALO_OK;
