@@ -104,6 +104,9 @@ static int unsupported_format(void) {
   const char *obj = write_file("ok.obj", CUBE_OBJ);
   EXPECT_FAIL(2, "render", obj, "-o", "out.bmp");
   SAID("out.bmp"); SAID("format"); NO_SANITIZER();
+  const char *env = write_file("envmap", "#?RADIANCE\n");
+  EXPECT_FAIL(1, "render", obj, "--env", env, "-o", "x.png");
+  SAID("envmap: no file extension"); SAID(".exr, .hdr and .pfm"); NO_SANITIZER();
   return 0;
 }
 

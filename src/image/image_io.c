@@ -338,5 +338,6 @@ valo_status image_read(const char *path, image *out, valo_error *err) {
   if (!strcasecmp(ext, "exr")) return read_exr(path, out, err);
   if (!strcasecmp(ext, "pfm")) return read_pfm(path, out, err);
   if (!strcasecmp(ext, "hdr")) return hdr_read(path, out, err);
+  if (!*ext) return err_set(err, VALO_ERR_UNSUPPORTED, "%s: no file extension; valo reads .exr, .hdr and .pfm images here", path);
   return err_set(err, VALO_ERR_UNSUPPORTED, "%s: cannot read \".%s\" images (exr, hdr, pfm)", path, ext);
 }
