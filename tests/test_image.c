@@ -11,6 +11,9 @@
 #include <stb_image.h>
 #include <dirent.h>
 #include <math.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -122,6 +125,50 @@ static int atomic_write(void) {
   /* A failed write leaves nothing and says why. */
   CHECK(image_write("/no/such/dir/x.exr", 1, 1, b, NULL, &err) != VALO_OK, "write to a missing folder succeeded");
   CHECK(strstr(err.message, "/no/such/dir/x.exr") != NULL, "message: %s", err.message);
+  /* A symbolic link is followed: the file it names is replaced (made, when it dangles) and
+   * the link stays a link. */
+  char real[1200], link[1200], made[1200], dangling[1200];
+  snprintf(real, sizeof real, "%s/real.pfm", scratch_dir());
+  snprintf(link, sizeof link, "%s/link.pfm", scratch_dir());
+  snprintf(made, sizeof made, "%s/made.pfm", scratch_dir());
+  snprintf(dangling, sizeof dangling, "%s/dangling.pfm", scratch_dir());
+  CHECK(image_write(real, 1, 1, b, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(symlink("real.pfm", link) == 0 && symlink("made.pfm", dangling) == 0, "symlink");
+  float c[3] = {4, 5, 6};
+  CHECK(image_write(link, 1, 1, c, NULL, &err) == VALO_OK, "%s", err.message);
+  CHECK(image_write(dangling, 1, 1, c, NULL, &err) == VALO_OK, "%s", err.message);
+  struct stat st;
+  CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode) && lstat(dangling, &st) == 0 && S_ISLNK(st.st_mode),
+        "a symbolic link was replaced by a file");
+  const char *through[2] = {real, made};
+  for (int i = 0; i < 2; i++) {
+    CHECK(image_read(through[i], &im, &err) == VALO_OK, "%s", err.message);
+    CHECK(im.rgb[0] == 4 && im.rgb[2] == 6, "%s does not hold what was written through its link", through[i]);
+    image_free(&im);
+  }
+  /* A FIFO is written in place, not replaced: a child process reads it into a file. */
+  char fifo[1200], copy[1200];
+  snprintf(fifo, sizeof fifo, "%s/fifo.pfm", scratch_dir());
+  snprintf(copy, sizeof copy, "%s/fifo-copy.pfm", scratch_dir());
+  CHECK(mkfifo(fifo, 0600) == 0, "mkfifo");
+  pid_t pid = fork();
+  if (pid == 0) {
+    FILE *in = fopen(fifo, "rb"), *out = fopen(copy, "wb");
+    char buf[4096];
+    size_t k;
+    while (in && out && (k = fread(buf, 1, sizeof buf, in)) > 0) fwrite(buf, 1, k, out);
+    _exit(in && out && fclose(out) == 0 ? 0 : 1);
+  }
+  CHECK(pid > 0, "fork");
+  valo_status ws = image_write(fifo, 1, 1, c, NULL, &err);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  CHECK(ws == VALO_OK, "%s", err.message);
+  CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0, "the FIFO's reader failed");
+  CHECK(lstat(fifo, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced by a file");
+  CHECK(image_read(copy, &im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im.w == 1 && im.rgb[1] == 5, "the FIFO's reader did not get the image");
+  image_free(&im);
   return 0;
 }
 

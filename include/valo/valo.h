@@ -301,6 +301,11 @@ VALO_API void valo_render_destroy(valo_render *r);
 VALO_API valo_status valo_image_read(const char *path, int *w, int *h, float **rgb, valo_error *err);
 VALO_API valo_status valo_image_write(const char *path, int w, int h, const float *rgb, const valo_output_options *o, valo_error *err);
 VALO_API void valo_image_free(float *rgb);
+/* Writes n bytes to path as valo writes its images: atomically through a temporary file
+ * renamed over the file (a symbolic link is followed and kept), or in place into a FIFO,
+ * a device or /dev/stdout. VALO_ERR_IO with the reason. For tools built on valo (the
+ * CLI's --stats-json and report files). */
+VALO_API valo_status valo_file_write(const char *path, const void *data, size_t n, valo_error *err);
 
 /* The declared options (one table: the command line's flags, the JSON scene file's
  * keys, defaults, ranges and help all come from it). valo_option_at(i) is entry i (NULL

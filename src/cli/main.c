@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #define EXIT_INTERRUPTED 130
@@ -119,7 +120,15 @@ static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_s
     const char *slash = strrchr(file, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s", slash == file ? 1 : (int)(slash - file), file);
     else snprintf(dir, sizeof dir, ".");
-    if (access(dir, W_OK) != 0) {
+    /* a FIFO, a device or /dev/stdout is written in place (valo_file_write): it must be
+     * writable itself */
+    struct stat st;
+    int in_place = stat(file, &st) == 0 && (!S_ISREG(st.st_mode) || !strncmp(file, "/dev/", 5) || !strncmp(file, "/proc/", 6));
+    if (in_place && access(file, W_OK) != 0) {
+      snprintf(err->message, sizeof err->message, "%s: cannot write: %s", i >= ca->nout ? extra[i - ca->nout] : ca->outputs[i], strerror(errno));
+      return 1;
+    }
+    if (!in_place && access(dir, W_OK) != 0) {
       snprintf(err->message, sizeof err->message, "%s: cannot write there: folder %s %s", i >= ca->nout ? extra[i - ca->nout] : ca->outputs[i], dir,
                errno == ENOENT ? "does not exist" : strerror(errno));
       return 1;

@@ -6,6 +6,7 @@
 #include "valo/valo.h"
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8"};
@@ -20,22 +21,30 @@ static void put_html(FILE *f, const char *s) {
   }
 }
 
-/* Opens dir/name for writing into a temporary name; the caller renames with finish(). */
-static FILE *open_in(const char *dir, const char *name, char *tmp, size_t n) {
-  snprintf(tmp, n, "%s/.%s.tmp", dir, name);
-  FILE *f = fopen(tmp, "w");
-  if (!f) fprintf(stderr, "valo: error: %s/%s: cannot write\n", dir, name);
-  return f;
+/* A report file is made in memory, then written as valo writes its images
+ * (valo_file_write: atomically, links followed). */
+typedef struct out_file { FILE *f; char *buf; size_t len; } out_file;
+static FILE *open_in(out_file *o) {
+  o->buf = NULL;
+  o->len = 0;
+  o->f = open_memstream(&o->buf, &o->len);
+  if (!o->f) fprintf(stderr, "valo: error: out of memory for a report file\n");
+  return o->f;
 }
-static int finish(FILE *f, const char *tmp, const char *dir, const char *name) {
+static int finish(out_file *o, const char *dir, const char *name) {
   char path[4400];
   snprintf(path, sizeof path, "%s/%s", dir, name);
-  if (fclose(f) != 0 || rename(tmp, path) != 0) {
-    remove(tmp);
-    fprintf(stderr, "valo: error: %s: cannot write\n", path);
-    return -1;
+  valo_error err;
+  int rc = 0;
+  if (fclose(o->f) != 0) {
+    fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path);
+    rc = -1;
+  } else if (valo_file_write(path, o->buf, o->len, &err)) {
+    fprintf(stderr, "valo: error: %s\n", err.message);
+    rc = -1;
   }
-  return 0;
+  free(o->buf);
+  return rc;
 }
 
 /* The width an image is shown at: small films scaled up by a whole factor (pixelated) to
@@ -48,8 +57,8 @@ static int shown_width(int w) {
 static const char *ref_name(const cmp_report *r) { return r->reference[0] ? r->reference : r->runs[r->ref_run - 1].name; }
 
 int report_write_summary(const cmp_report *r, const char *dir) {
-  char tmp[4400];
-  FILE *f = open_in(dir, "summary.json", tmp, sizeof tmp);
+  out_file o;
+  FILE *f = open_in(&o);
   if (!f) return -1;
   fprintf(f, "{\n  \"scene\": ");
   json_put_string(f, r->scene);
@@ -72,7 +81,7 @@ int report_write_summary(const cmp_report *r, const char *dir) {
     fprintf(f, "]}");
   }
   fprintf(f, "\n  ]\n}\n");
-  return finish(f, tmp, dir, "summary.json");
+  return finish(&o, dir, "summary.json");
 }
 
 /* The relMSE-against-time plot: log10 axes over the decades the curves span. */
@@ -141,8 +150,8 @@ static void put_figures(FILE *f, const cmp_report *r, const char *suffix, int sc
 }
 
 int report_write_html(const cmp_report *r, const char *dir) {
-  char tmp[4400];
-  FILE *f = open_in(dir, "index.html", tmp, sizeof tmp);
+  out_file o;
+  FILE *f = open_in(&o);
   if (!f) return -1;
   fprintf(f, "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>valo compare: ");
   put_html(f, r->scene);
@@ -174,5 +183,5 @@ int report_write_html(const cmp_report *r, const char *dir) {
   fprintf(f, "<h2>relMSE against time</h2>\n");
   put_svg(f, r);
   fprintf(f, "<p>Made by valo %s.</p>\n</body></html>\n", valo_version());
-  return finish(f, tmp, dir, "index.html");
+  return finish(&o, dir, "index.html");
 }

@@ -1,12 +1,11 @@
 /* run_stats.c — owns the peak-memory figure (getrusage) and the `--stats-json` file:
  * load, build and render seconds, spp, samples, rays, rays/s, peak memory and the lost
- * samples by cause, written atomically. */
+ * samples by cause, written as valo writes its images (valo_file_write). */
 #include "cli/run_stats.h"
-#include <errno.h>
+#include "valo/valo.h"
 #include <stdio.h>
-#include <string.h>
+#include <stdlib.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
 uint64_t run_peak_memory(void) {
   struct rusage ru;
@@ -67,20 +66,15 @@ static void put_report(FILE *f, const run_report *r) {
 }
 
 int run_stats_write_json(const char *path, const run_report *r) {
-  char tmp[4200];
-  if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid()) >= (int)sizeof tmp) {
-    fprintf(stderr, "valo: error: %s: --stats-json name too long\n", path);
-    return -1;
-  }
-  FILE *f = fopen(tmp, "w");
-  if (!f) { fprintf(stderr, "valo: error: %s: cannot write: %s\n", path, strerror(errno)); return -1; }
+  char *buf = NULL;
+  size_t len = 0;
+  FILE *f = open_memstream(&buf, &len);
+  if (!f) { fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path); return -1; }
   put_report(f, r);
-  int bad = fflush(f) != 0 || fsync(fileno(f)) != 0;
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    fprintf(stderr, "valo: error: %s: cannot write: %s\n", path, strerror(errno));
-    remove(tmp);
-    return -1;
-  }
-  return 0;
+  if (fclose(f) != 0) { free(buf); fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path); return -1; }
+  valo_error err;
+  int rc = valo_file_write(path, buf, len, &err) ? -1 : 0;
+  if (rc) fprintf(stderr, "valo: error: %s\n", err.message);
+  free(buf);
+  return rc;
 }
