@@ -597,6 +597,18 @@ static int gltf_valid_forms(void) {
   const char *sp1[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-morph-target.gltf");
   const char *sp2[] = MESH_ARGS(VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-position.gltf");
   if (accepted(sp1, "sparse-morph-target.gltf") || accepted(sp2, "sparse-position.gltf")) return 1;
+  /* sparse indices (on a base whose last triangle is 0 0 0, and with no base at all) give
+   * the quad's image byte for byte */
+  static const char *const sparse_ix[3] = {NULL, VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-indices.gltf",
+                                           VALO_SOURCE_DIR "/fuzz/seeds/gltf/sparse-indices-no-base.gltf"};
+  char exr[3][1200];
+  for (int i = 0; i < 3; i++) {
+    snprintf(exr[i], sizeof exr[i], "%s/sparse%d.exr", scratch_dir(), i);
+    const char *file = sparse_ix[i] ? sparse_ix[i] : write_bytes("quad_ref.gltf", GLTF_QUAD, strlen(GLTF_QUAD));
+    const char *a[] = {"render", file, "--spp", "4", "--res", "32x32", "--seed", "3", "-q", "-o", exr[i], NULL};
+    if (accepted(a, file)) return 1;
+  }
+  CHECK(same_bytes(exr[0], exr[1]) && same_bytes(exr[0], exr[2]), "sparse indices do not give the quad's image");
   char json[2048];
   snprintf(json, sizeof json, "%s", subst(GLTF_QUAD, ", \"uri\": \"data:application/octet-stream;base64," QUAD_B64 "\"", ""));
   buf g = {0};
@@ -650,6 +662,14 @@ static int gltf_damaged(void) {
   const char *st = subst(two, "\"indices\": 1}", "\"indices\": 1, \"mode\": 5}");
   CHECK(st, "template");
   if (mesh_refused("g_strip.gltf", st, strlen(st), "2 vertices are too few for its mode 5")) return 1;
+  /* a sparse index value past the vertices (the short 49024 at byte 2, in -1.0f) */
+  char sp[8192];
+  snprintf(sp, sizeof sp, "%s", subst(GLTF_QUAD, "\"count\": 6, \"type\": \"SCALAR\"}", "\"count\": 6, \"type\": \"SCALAR\", "
+       "\"sparse\": {\"count\": 1, \"indices\": {\"bufferView\": 2, \"componentType\": 5123}, \"values\": {\"bufferView\": 3}}}"));
+  const char *spv = subst(sp, "\"byteLength\": 12}]", "\"byteLength\": 12}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 2}, "
+                                                   "{\"buffer\": 0, \"byteOffset\": 2, \"byteLength\": 2}]");
+  CHECK(spv, "template");
+  if (mesh_refused("g_sparse_index.gltf", spv, strlen(spv), "sparse index value 0 is 49024, past the 4 vertices")) return 1;
   /* .glb containers */
   buf g = {0};
   make_glb(&g, GLTF_QUAD, NULL, 0);

@@ -215,7 +215,7 @@ static valo_status check_view(gc *g, uint32_t o, uint32_t i, const char *ctx) {
 /* An accessor's sparse part: count, index and value views that hold them, indices inside
  * the accessor (Assimp writes each value at its index: a count past the data overflowed
  * its heap). */
-static valo_status check_sparse(gc *g, uint32_t sp, const gacc *a, const char *acc_ctx) {
+static valo_status check_sparse(gc *g, uint32_t sp, gacc *a, const char *acc_ctx) {
   char ctx[80];
   snprintf(ctx, sizeof ctx, "%s sparse", acc_ctx);
   uint32_t ix = json_get(&g->d, sp, "indices"), vx = json_get(&g->d, sp, "values");
@@ -237,6 +237,8 @@ static valo_status check_sparse(gc *g, uint32_t sp, const gacc *a, const char *a
   uint32_t x;
   int64_t k = first_index_past(g->bufs[v->buf].data + v->off + ioff, n, cs, a->count, &x);
   if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the accessor's %llu elements", ctx, (long long)k, x, (unsigned long long)a->count);
+  a->sparse_values = g->bufs[w->buf].data + w->off + voff;
+  a->sparse_n = n;
   return VALO_OK;
 }
 
@@ -318,12 +320,15 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
     const gacc *a = &g->accs[ix];
     if (a->comps != 1 || (a->ctype != 5121 && a->ctype != 5123 && a->ctype != 5125))
       return gl_bad(g, "%s: \"indices\" must be an accessor of unsigned byte, short or int scalars", ctx);
-    if (a->sparse || a->view < 0) return gl_bad(g, "%s: sparse indices are not read", ctx);
-    const gview *v = &g->views[a->view];
-    if (a->stride != a->size) return gl_bad(g, "%s: the indices' buffer view %lld must not have a stride", ctx, (long long)a->view);
     uint32_t x;
-    int64_t k = first_index_past(g->bufs[v->buf].data + v->off + a->off, a->count, a->size, pa->count, &x);
-    if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the %llu vertices", ctx, (long long)k, x, (unsigned long long)pa->count);
+    if (a->view >= 0) { /* the indices, or a sparse accessor's base, which its values replace in part */
+      const gview *v = &g->views[a->view];
+      if (a->stride != a->size) return gl_bad(g, "%s: the indices' buffer view %lld must not have a stride", ctx, (long long)a->view);
+      int64_t k = first_index_past(g->bufs[v->buf].data + v->off + a->off, a->count, a->size, pa->count, &x);
+      if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the %llu vertices", ctx, (long long)k, x, (unsigned long long)pa->count);
+    }
+    int64_t k = a->sparse ? first_index_past(a->sparse_values, a->sparse_n, a->size, pa->count, &x) : -1;
+    if (k >= 0) return gl_bad(g, "%s: sparse index value %lld is %u, past the %llu vertices", ctx, (long long)k, x, (unsigned long long)pa->count);
   }
   return VALO_OK;
 }

@@ -12,7 +12,13 @@
 
 typedef struct gbuf { const unsigned char *data; uint64_t len; } gbuf; /* a buffer's bytes as read */
 typedef struct gview { uint32_t buf; uint64_t off, len, stride; } gview;
-typedef struct gacc { int64_t view; uint64_t off, count, size, stride; int ctype, comps, sparse; } gacc;
+typedef struct gacc {
+  int64_t view;
+  uint64_t off, count, size, stride;
+  int ctype, comps, sparse;
+  const unsigned char *sparse_values; /* a sparse part's values (sparse_n elements of size bytes) */
+  uint64_t sparse_n;
+} gacc;
 
 /* The top-level arrays the check reads, in this order (gltf_check.c, kinds[]). */
 enum { K_BUF, K_VIEW, K_ACC, K_MESH, K_NODE, K_SCENE, K_MAT, K_TEX, K_IMG, K_SMP, K_CAM, K_SKIN, K_ANIM, K_KINDS };
