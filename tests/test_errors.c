@@ -2,6 +2,7 @@
  * non-zero exit, never a crash or a hang (run under ASan+UBSan in CI). Each case runs the
  * real `valo` binary with a 60 s watchdog and checks the exit code and stderr. Also the
  * command line's own behaviour: --help, --version, usage errors. */
+#define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 #include "harness.h"
 #include "image/image_io.h"
 #include <cjson/cJSON.h>
@@ -190,6 +191,47 @@ static int no_light(void) {
 }
 
 /* Command-line behaviour. */
+/* On a terminal (a pseudo-terminal here): a status line while loading and building,
+ * cleared before the next line; a note (a mesh without light) printed whole on its own
+ * line; the progress bar redrawn in place with its ETA; the summary after it. */
+static int tty_progress(void) {
+  const char *obj = write_file("tty.obj", CUBE_OBJ);
+  char out[1200];
+  snprintf(out, sizeof out, "%s/tty.png", scratch_dir());
+  int m = posix_openpt(O_RDWR | O_NOCTTY);
+  CHECK(m >= 0 && grantpt(m) == 0 && unlockpt(m) == 0 && ptsname(m), "no pseudo-terminal");
+  const char *slave = ptsname(m);
+  pid_t pid = fork();
+  if (pid == 0) {
+    int sl = open(slave, O_RDWR);
+    if (sl < 0) _exit(126);
+    dup2(sl, 2);
+    close(m);
+    execl(VALO_EXE, "valo", "render", obj, "--spp", "8", "--res", "16x16", "-o", out, (char *)NULL);
+    _exit(127);
+  }
+  CHECK(pid > 0, "fork");
+  size_t n = 0;
+  for (;;) { /* until the terminal closes (EIO once valo has exited) */
+    ssize_t k = read(m, g_out + n, sizeof g_out - 1 - n);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0 || (n += (size_t)k) == sizeof g_out - 1) break;
+  }
+  g_out[n] = 0;
+  close(m);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0, "valo on a terminal: status %d; it said: %s", status, g_out);
+  SAID("valo: loading ");
+  SAID("valo: building the acceleration structure of ");
+  SAID("\r\033[Kvalo: note: "); /* the status line cleared before the note */
+  SAID("\r[##############################] 100%");
+  SAID("ETA");
+  SAID("valo: summary: 2 triangles");
+  NO_SANITIZER();
+  return 0;
+}
+
 static int cli_behaviour(void) {
   const char *obj = write_file("ok.obj", CUBE_OBJ);
   char out[1200];
@@ -651,7 +693,7 @@ int main(int argc, char **argv) {
                                     {"sigint_writes_image", sigint_writes_image},
                                     {"malformed_obj", malformed_obj},
                                     {"no_light", no_light},
-                                    {"cli_behaviour", cli_behaviour},
+                                    {"cli_behaviour", cli_behaviour}, {"tty_progress", tty_progress},
                                     {"frames_cli", frames_cli},
                                     {"stats_json", stats_json},
                                     {"memory_limits", memory_limits},

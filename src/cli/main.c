@@ -105,6 +105,32 @@ static int on_progress(void *user, double frac, int spp_done, double seconds) {
 /* Warnings of ranks above 0 are dropped: rank 0 prints the same ones. */
 static void quiet_warning(void *user, const char *message) { (void)user; (void)message; }
 
+/* On a terminal, the phases before the progress bar (loading, building: seconds for a
+ * large scene) show a status line, cleared when they end; warnings clear it (and the
+ * progress bar's line) first, then it is shown again. */
+static char g_status[256];
+static void status_clear(void) {
+  if (g_status[0]) fprintf(stderr, "\r\033[K");
+}
+static void status_show(const char *what, const char *name) {
+  status_clear();
+  snprintf(g_status, sizeof g_status, "valo: %s %.200s ...", what, name);
+  fprintf(stderr, "%s", g_status);
+  fflush(stderr);
+}
+static void status_end(void) {
+  status_clear();
+  g_status[0] = 0;
+}
+static void tty_warning(void *user, const char *message) {
+  (void)user;
+  fprintf(stderr, "\r\033[K");
+  if (!strncmp(message, "note: ", 6)) fprintf(stderr, "valo: %s\n", message);
+  else fprintf(stderr, "valo: warning: %s\n", message);
+  if (g_status[0]) fprintf(stderr, "%s", g_status);
+  fflush(stderr);
+}
+
 /* Everything before the render runs: the output folders, the scene, the render, the
  * resume. 0, or an exit code with the message in err (printed here on rank 0). */
 static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_scene **sc, valo_render **r, double *load_s, valo_error *err) {
@@ -134,7 +160,14 @@ static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_s
       return 1;
     }
   }
-  if (valo_scene_load_with(ca->scene_path, &ca->lo, sc, err)) return 1;
+  int tty = rank == 0 && !ca->quiet && isatty(2);
+  if (tty) {
+    valo_set_warning_handler(tty_warning, NULL);
+    status_show("loading", ca->scene_path);
+  }
+  int lrc = valo_scene_load_with(ca->scene_path, &ca->lo, sc, err);
+  if (tty) status_end();
+  if (lrc) return 1;
   *load_s = cli_now() - t0;
   valo_options file_opts;
   valo_scene_file_options(*sc, &file_opts);
@@ -151,7 +184,10 @@ static int setup(const cli_args *ca, valo_options *opt, const char *ckpt, valo_s
       return EXIT_USAGE;
     }
   }
-  if (valo_render_create(*sc, opt, r, err)) return 1;
+  if (tty) status_show("building the acceleration structure of", ca->scene_path);
+  int crc = valo_render_create(*sc, opt, r, err);
+  if (tty) status_end();
+  if (crc) return 1;
   if (rank > 0) valo_render_set_warning_handler(*r, quiet_warning, NULL);
   if ((ca->resume && valo_render_resume(*r, ca->resume, err)) || (ckpt && valo_render_checkpoint_to(*r, ckpt, ca->ckpt_every, err))) return 1;
   return 0;
