@@ -145,21 +145,16 @@ static int max_depth_direct_only(void) {
 }
 
 /* A map of constant radiance 1 is the white furnace again: albedo 0.5 shows 0.5. */
-static int furnace_constant_map(void) {
-  float *px = malloc(sizeof(float) * 32 * 16 * 3);
-  for (int i = 0; i < 32 * 16 * 3; i++) px[i] = 1;
-  char path[1200];
-  snprintf(path, sizeof path, "%s/white.pfm", scratch_dir());
-  valo_error err;
-  CHECK(image_write(path, 32, 16, px, NULL, &err) == VALO_OK, "%s", err.message);
-  free(px);
+/* A diffuse sphere of albedo 0.5 under a constant map of radiance L (file, in the
+ * scratch folder): the background must be L and the sphere 0.5 L. */
+static int furnace_map(const char *file, double L) {
   char json[2048];
   snprintf(json, sizeof json,
            "{ \"camera\": {\"position\": [0,0,4], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 40},\n"
            "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 256, \"seed\": 5},\n"
            "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
            "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 4, \"smooth\": false, \"material\": \"m\"}],\n"
-           "  \"environment\": {\"type\": \"map\", \"file\": \"white.pfm\", \"rotation\": 17} }\n");
+           "  \"environment\": {\"type\": \"map\", \"file\": \"%s\", \"rotation\": 17} }\n", file);
   int w, h;
   float *img = render_json_text(json, NULL, &w, &h);
   CHECK(img, "render failed");
@@ -173,10 +168,26 @@ static int furnace_constant_map(void) {
       n[k]++;
     }
   free(img);
-  fprintf(stderr, "constant map: sphere %.5f, background %.5f\n", sum[1] / n[1], sum[0] / n[0]);
-  CHECK(fabs(sum[1] / n[1] - 0.5) < 0.005, "sphere mean %g, expected 0.5", sum[1] / n[1]);
-  CHECK(fabs(sum[0] / n[0] - 1) < 1e-5, "background %g, expected 1", sum[0] / n[0]);
+  fprintf(stderr, "constant map %s: sphere %.5f, background %.5f (L = %.5f)\n", file, sum[1] / n[1], sum[0] / n[0], L);
+  CHECK(fabs(sum[1] / n[1] - 0.5 * L) < 0.005 * L, "sphere mean %g, expected %g", sum[1] / n[1], 0.5 * L);
+  CHECK(fabs(sum[0] / n[0] - L) < 1e-5 * L, "background %g, expected %g", sum[0] / n[0], L);
   return 0;
+}
+
+/* The same map as a linear PFM (L = 1) and as an 8-bit PNG, whose bytes are decoded from
+ * sRGB: linear 0.5 is stored as 188, which is radiance ((188/255 + 0.055) / 1.055)^2.4. */
+static int furnace_constant_map(void) {
+  float *px = malloc(sizeof(float) * 32 * 16 * 3);
+  char path[1200];
+  valo_error err;
+  for (int i = 0; i < 32 * 16 * 3; i++) px[i] = 1;
+  snprintf(path, sizeof path, "%s/white.pfm", scratch_dir());
+  CHECK(image_write(path, 32, 16, px, NULL, &err) == VALO_OK, "%s", err.message);
+  for (int i = 0; i < 32 * 16 * 3; i++) px[i] = 0.5f;
+  snprintf(path, sizeof path, "%s/grey.png", scratch_dir());
+  CHECK(image_write(path, 32, 16, px, NULL, &err) == VALO_OK, "%s", err.message);
+  free(px);
+  return furnace_map("white.pfm", 1.0) || furnace_map("grey.png", pow((188.0 / 255.0 + 0.055) / 1.055, 2.4));
 }
 
 /* Adaptive sampling keeps the image unbiased where paths are rare and bright:

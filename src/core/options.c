@@ -68,8 +68,8 @@ const option_decl option_table[] = {
           "adaptive sampling that stops once every pixel's relative\nstandard error is below X (e.g. 0.01); implies --adaptive"),
      R(noise_threshold), .type = OPT_REAL, .lo = 0, .hi = 10, .def = 0, .unset = VALO_UNSET, .range_text = "a relative error, 1e-6..10"},
     {INFO("--env", "FILE", NULL,
-          "light by this environment map (.exr/.hdr/.pfm), replacing\nthe scene's; a mesh file without lights gets a uniform\n"
-          "white environment otherwise"),
+          "light by this environment map (.exr/.hdr/.pfm, or PNG/JPEG\nfrom sRGB), replacing the scene's; a mesh file without\n"
+          "lights gets a uniform white environment otherwise"),
      L(env_file), .type = OPT_NAME, .range_text = "a file name"},
     {INFO("--env-scale", "S", NULL, "multiply the --env map by S (default 1)"), L(env_scale), .type = OPT_REAL, .lo = 0, .hi = 1e9, .def = 1,
      .range_text = "a scale >= 0"},

@@ -3,8 +3,10 @@
 #include "image/image_io.h"
 #include "image/texture.h"
 #include "core/error.h"
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static vec3 to_map(const envmap *e, vec3 d) { /* world -> map frame: rotate by -rotation about y */
   return v3(e->rot_cos * d.x - e->rot_sin * d.z, d.y, e->rot_sin * d.x + e->rot_cos * d.z);
@@ -74,9 +76,35 @@ int envmap_init(envmap *e, int w, int h, float *px, float scale, float rotation_
   return rc;
 }
 
+/* The map's linear RGB: an HDR file (.exr, .hdr, .pfm) as it is, any other image (PNG,
+ * JPEG, ...) through the texture loader, its 8-bit values decoded from sRGB. */
+static valo_status read_map(const char *path, image *im, valo_error *err) {
+  const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+  if (dot && (!slash || dot > slash) && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm")))
+    return image_read(path, im, err);
+  texture t;
+  valo_status st = texture_load_file(&t, path, 1, err);
+  const char *why = st && err ? strstr(err->message, ": cannot read texture: ") : NULL;
+  if (why) { /* said of an environment map, with what valo reads */
+    char reason[200];
+    snprintf(reason, sizeof reason, "%s", why + strlen(": cannot read texture: "));
+    return err_set(err, st, "%s: cannot read it as an environment map (.exr, .hdr, .pfm, or an 8-bit image such as PNG or JPEG): %s",
+                   path, reason);
+  }
+  if (st) return st;
+  im->w = t.w;
+  im->h = t.h;
+  im->rgb = malloc((size_t)t.w * t.h * 3 * sizeof(float));
+  if (!im->rgb) { texture_free(&t); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); }
+  for (size_t i = 0; i < (size_t)t.w * t.h; i++)
+    for (int c = 0; c < 3; c++) im->rgb[3 * i + c] = t.px[4 * i + c];
+  texture_free(&t);
+  return VALO_OK;
+}
+
 valo_status envmap_load(envmap *e, const char *path, float scale, float rotation_deg, valo_error *err) {
   image im;
-  valo_status st = image_read(path, &im, err);
+  valo_status st = read_map(path, &im, err);
   if (st) return st;
   if (im.w < 2 || im.h < 1) { image_free(&im); return err_set(err, VALO_ERR_INVALID, "%s: environment map too small", path); }
   /* Lossy EXR compression (DWAA/DWAB) rings around a bright sun into negative texels;
