@@ -83,6 +83,38 @@ static int srgb_png(void) {
   return 0;
 }
 
+/* .hdr: Radiance RGBE read back by valo's reader, each value within the shared
+ * exponent's precision (2^-7 of the pixel's largest channel); .jpg: a JPEG that stb
+ * decodes to the size written and, for flat linear 0.5, the sRGB byte 188 (within 1). */
+static int hdr_jpeg_write(void) {
+  int w = 37, h = 19;
+  float *p = test_pattern(w, h);
+  char path[1200];
+  valo_error err;
+  snprintf(path, sizeof path, "%s/rt.hdr", scratch_dir());
+  CHECK(image_write(path, w, h, p, NULL, &err) == VALO_OK, "%s", err.message);
+  image im;
+  CHECK(image_read(path, &im, &err) == VALO_OK, "%s", err.message);
+  CHECK(im.w == w && im.h == h, "size %dx%d", im.w, im.h);
+  for (int i = 0; i < w * h; i++) {
+    const float *a = p + 3 * i, *b = im.rgb + 3 * i;
+    float m = fmaxf(a[0], fmaxf(a[1], a[2]));
+    for (int c = 0; c < 3; c++) CHECK(fabsf(a[c] - b[c]) <= m / 128, "pixel %d channel %d: %g written, %g read", i, c, a[c], b[c]);
+  }
+  image_free(&im);
+  free(p);
+  float grey[16 * 8 * 3];
+  for (int i = 0; i < 16 * 8 * 3; i++) grey[i] = 0.5f;
+  snprintf(path, sizeof path, "%s/grey.jpg", scratch_dir());
+  CHECK(image_write(path, 16, 8, grey, NULL, &err) == VALO_OK, "%s", err.message);
+  int jw = 0, jh = 0, n = 0;
+  unsigned char *j = stbi_load(path, &jw, &jh, &n, 3);
+  CHECK(j && jw == 16 && jh == 8, "the JPEG decodes to %dx%d", jw, jh);
+  for (int i = 0; i < 16 * 8 * 3; i++) CHECK(abs((int)j[i] - 188) <= 1, "byte %d is %d, not 188", i, j[i]);
+  stbi_image_free(j);
+  return 0;
+}
+
 static int tone_curves(void) {
   tonemap_kind k;
   CHECK(tonemap_parse("reinhard", &k) == 0, "reinhard");
@@ -341,7 +373,7 @@ static int bloom(void) {
 
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"exr_roundtrip", exr_roundtrip}, {"exr_zip_equal_size", exr_zip_equal_size}, {"pfm_roundtrip", pfm_roundtrip}, {"srgb_png", srgb_png},
-                                    {"tone_curves", tone_curves},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files}, {"exr_layers", exr_layers}, {"independent_readers", independent_readers}, {"bloom", bloom},
+                                    {"tone_curves", tone_curves},     {"hdr_jpeg_write", hdr_jpeg_write},     {"atomic_write", atomic_write},   {"real_exr_files", real_exr_files}, {"exr_layers", exr_layers}, {"independent_readers", independent_readers}, {"bloom", bloom},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -15,7 +15,8 @@ void usage_render(FILE *f) {
           "SCENE is a .json scene file (docs/scene-format.md) or a mesh file read by Assimp\n"
           "(OBJ/MTL, glTF 2.0, PLY, ...; its camera is used, or the view is framed automatically).\n"
           "Options override the scene file:\n"
-          "  -o, --output FILE      output image; .exr/.pfm linear float, .png 8-bit sRGB;\n"
+          "  -o, --output FILE      output image; .exr/.pfm linear float, .hdr Radiance RGBE,\n"
+          "                         .png/.jpg 8-bit sRGB;\n"
           "                         repeat for several outputs (default: SCENE-NAME.png);\n"
           "                         albedo:FILE, normal:FILE, depth:FILE write those AOVs,\n"
           "                         ao:FILE ambient occlusion (ao.distance), bent:FILE the bent normal,\n"
@@ -161,8 +162,11 @@ int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err) 
     if (pat == -2) { fprintf(err, "valo: %s: a '%%' in an output name must be a frame pattern, %%d or %%04d\n", ca->outputs[i]); return EXIT_USAGE; }
     if (pat >= 0 && opt->frames == VALO_UNSET) { fprintf(err, "valo: %s: a frame pattern needs --frames\n", ca->outputs[i]); return EXIT_USAGE; }
     const char *dot = strrchr(ca->outputs[i], '.');
-    if (!dot || (strcasecmp(dot, ".exr") && strcasecmp(dot, ".pfm") && strcasecmp(dot, ".png"))) {
-      fprintf(err, "valo: %s: unknown output format (use .exr, .pfm or .png)\n", ca->outputs[i]);
+    static const char *const formats[] = {".exr", ".pfm", ".hdr", ".png", ".jpg", ".jpeg"};
+    int known = 0;
+    for (size_t k = 0; dot && k < sizeof formats / sizeof formats[0]; k++) known |= !strcasecmp(dot, formats[k]);
+    if (!known) {
+      fprintf(err, "valo: %s: unknown output format (use .exr, .pfm, .hdr, .png or .jpg)\n", ca->outputs[i]);
       return EXIT_USAGE;
     }
   }

@@ -16,6 +16,8 @@
 #include <strings.h>
 #include <unistd.h>
 
+#define JPEG_QUALITY 95 /* stb_image_write's scale, 1-100 */
+
 static void exr_quiet(exr_const_context_t ctxt, exr_result_t code, const char *msg);
 
 static const char *ext_of(const char *path) {
@@ -116,14 +118,18 @@ void image_to_srgb8(int w, int h, const float *px, const valo_output_options *o,
 
 valo_status image_write(const char *path, int w, int h, const float *px, const valo_output_options *o, valo_error *err) {
   const char *ext = ext_of(path);
-  int kind = !strcasecmp(ext, "exr") ? 0 : !strcasecmp(ext, "pfm") ? 1 : !strcasecmp(ext, "png") ? 2 : -1;
-  if (kind < 0) return err_set(err, VALO_ERR_UNSUPPORTED, "%s: unknown output format \".%s\" (use .exr, .pfm or .png)", path, ext);
+  /* 0 EXR, 1 PFM, 2 PNG, 3 JPEG, 4 Radiance HDR */
+  int kind = !strcasecmp(ext, "exr") ? 0 : !strcasecmp(ext, "pfm") ? 1 : !strcasecmp(ext, "png") ? 2
+           : !strcasecmp(ext, "jpg") || !strcasecmp(ext, "jpeg") ? 3 : !strcasecmp(ext, "hdr") ? 4 : -1;
+  if (kind < 0)
+    return err_set(err, VALO_ERR_UNSUPPORTED, "%s: unknown output format \".%s\" (use .exr, .pfm, .hdr, .png or .jpg)", path, ext);
   char tmp[4200];
   if (atomic_temp_name(path, tmp, sizeof tmp)) return err_set(err, VALO_ERR_INVALID, "%s: name too long", path);
   valo_status st = VALO_OK;
   char msg[256] = "";
   if (kind == 0) st = write_exr(tmp, w, h, px, msg, sizeof msg);
   else if (kind == 1) st = write_pfm(tmp, w, h, px);
+  else if (kind == 4) st = stbi_write_hdr(tmp, w, h, 3, px) ? VALO_OK : VALO_ERR_IO; /* RGBE: 8-bit mantissas */
   else {
     unsigned char *bytes = malloc((size_t)w * h * 3);
     float *disp = NULL;
@@ -146,7 +152,8 @@ valo_status image_write(const char *path, int w, int h, const float *px, const v
     } else {
       image_to_srgb8(w, h, px, o, bytes);
     }
-    st = stbi_write_png(tmp, w, h, 3, bytes, w * 3) ? VALO_OK : VALO_ERR_IO;
+    int ok = kind == 2 ? stbi_write_png(tmp, w, h, 3, bytes, w * 3) : stbi_write_jpg(tmp, w, h, 3, bytes, JPEG_QUALITY);
+    st = ok ? VALO_OK : VALO_ERR_IO;
     free(bytes);
   }
   if (st) {

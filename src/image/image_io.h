@@ -1,7 +1,8 @@
 /* image_io.h — owns image files: linear float EXR through OpenEXRCore (read and write),
- * PFM (read and write), 8-bit sRGB PNG through stb_image_write; Radiance HDR through hdr.c. Every write goes to a
- * temporary file in the destination folder and is renamed over the target, so readers
- * never see a partial image. Pixels are RGB float, row-major, top row first. */
+ * PFM (read and write), Radiance HDR (read through hdr.c, written by stb_image_write),
+ * and 8-bit sRGB PNG and JPEG written by stb_image_write. Every write goes through
+ * atomicfile.h (a temporary file renamed over the target), so readers never see a
+ * partial image. Pixels are RGB float, row-major, top row first. */
 #ifndef VALO_IMAGE_IO_H
 #define VALO_IMAGE_IO_H
 #include "valo/valo.h"
