@@ -2,6 +2,7 @@
  * (import_probe.h): the child's memory limit, the parent's time limit, and the errors
  * that name what happened. */
 #include "load/import_probe.h"
+#include "core/clock.h"
 #include "core/error.h"
 #include "core/memlimit.h"
 #include <assimp/cimport.h>
@@ -16,7 +17,6 @@
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 /* What the child reports through the pipe: one of these bytes, then Assimp's message. */
@@ -25,9 +25,7 @@ enum { PROBE_OK = 'O', PROBE_REFUSED = 'E', PROBE_MEMORY = 'M' };
 /* What the child may add to its address space: 64 times the file's size, at least 1 GiB
  * and at most valo's memory limit. A header that claims billions of elements then fails
  * its allocation at once instead of filling the machine. */
-static uint64_t memory_budget(const char *path) {
-  struct stat sb;
-  uint64_t size = stat(path, &sb) == 0 && sb.st_size > 0 ? (uint64_t)sb.st_size : 0;
+static uint64_t memory_budget(uint64_t size) {
   uint64_t lim = size < (1ull << 40) ? 64 * size : UINT64_MAX;
   if (lim < (1ull << 30)) lim = 1ull << 30;
   return lim < mem_limit() ? lim : mem_limit();
@@ -80,27 +78,22 @@ static void child(int fd, const char *path, unsigned flags, uint64_t budget) {
   _exit(0); /* no atexit handlers, no stdio flush of the parent's buffers */
 }
 
-static double seconds_now(void) {
-  struct timespec t;
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double time_limit(const char *path) {
+/* 30 s plus 2 s per MiB of the file, or VALO_IMPORT_TIMEOUT seconds. */
+static double time_limit(uint64_t size) {
   const char *e = getenv("VALO_IMPORT_TIMEOUT");
   if (e && *e) {
     double v = strtod(e, NULL);
     if (v > 0) return v;
   }
-  struct stat sb;
-  double mib = stat(path, &sb) == 0 ? (double)sb.st_size / 1048576.0 : 0.0;
-  return 30.0 + 2.0 * mib;
+  return 30.0 + 2.0 * (double)size / 1048576.0;
 }
 
 valo_status import_probe(const char *path, unsigned flags, valo_error *err) {
   int fds[2];
   if (pipe(fds)) return err_set(err, VALO_ERR_IO, "%s: cannot start the trial import: %s", path, strerror(errno));
-  uint64_t budget = memory_budget(path);
+  struct stat sb;
+  uint64_t size = stat(path, &sb) == 0 && sb.st_size > 0 ? (uint64_t)sb.st_size : 0;
+  uint64_t budget = memory_budget(size);
   fflush(NULL); /* nothing buffered is written twice */
   pid_t pid = fork();
   if (pid < 0) {
@@ -113,12 +106,12 @@ valo_status import_probe(const char *path, unsigned flags, valo_error *err) {
     child(fds[1], path, flags, budget);
   }
   close(fds[1]);
-  double limit = time_limit(path), end = seconds_now() + limit;
+  double limit = time_limit(size), end = now_seconds() + limit;
   char msg[512];
   size_t len = 0;
   int timed_out = 0;
   for (;;) {
-    double left = end - seconds_now();
+    double left = end - now_seconds();
     if (left <= 0) { timed_out = 1; break; }
     struct pollfd p = {fds[0], POLLIN, 0};
     int r = poll(&p, 1, left > 1000.0 ? 1000000 : (int)(left * 1000.0) + 1);
