@@ -339,6 +339,11 @@ done:
   return st;
 }
 
+int image_is_float_file(const char *path) {
+  const char *ext = ext_of(path);
+  return !strcasecmp(ext, "exr") || !strcasecmp(ext, "pfm") || !strcasecmp(ext, "hdr");
+}
+
 valo_status image_read(const char *path, image *out, valo_error *err) {
   out->w = out->h = 0; out->rgb = NULL;
   const char *ext = ext_of(path);

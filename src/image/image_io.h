@@ -13,6 +13,8 @@ valo_status image_write(const char *path, int w, int h, const float *px, const v
 /* Reads an EXR (any compression OpenEXR supports; half/float/uint; R,G,B or Y), PFM or
  * Radiance HDR. */
 valo_status image_read(const char *path, image *out, valo_error *err);
+/* 1 when path's extension is one image_read reads (.exr, .hdr, .pfm), else 0. */
+int image_is_float_file(const char *path);
 void image_free(image *im);
 /* Display transform used for PNG: exposure, tone map, sRGB encode, 8-bit. */
 void image_to_srgb8(int w, int h, const float *px, const valo_output_options *o, unsigned char *out);

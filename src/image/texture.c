@@ -8,7 +8,6 @@
 #include <stb_image.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 /* Texels are 16 bytes: a header that claims more than this many (4 GiB of texels) is
  * refused from stb's header read, before anything is decoded or allocated. */
@@ -86,9 +85,12 @@ valo_status texture_load_memory(texture *t, const unsigned char *data, size_t le
 }
 
 valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error *err) {
+  return texture_load_file_as(t, path, srgb, "texture", err);
+}
+
+valo_status texture_load_file_as(texture *t, const char *path, int srgb, const char *what, valo_error *err) {
   memset(t, 0, sizeof *t);
-  const char *dot = strrchr(path, '.');
-  if (dot && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm"))) {
+  if (image_is_float_file(path)) {
     image im;
     valo_status st = image_read(path, &im, err);
     if (st) return st;
@@ -118,7 +120,7 @@ valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error
   valo_status st = check_size(ok, w, h, bytes, pixels_per_byte_max(head, hn), path, err);
   if (st) return st;
   unsigned char *img = stbi_load(path, &w, &h, &n, 0);
-  if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read texture: %s", path, stbi_failure_reason());
+  if (!img) return err_set(err, VALO_ERR_IO, "%s: cannot read %s: %s", path, what, stbi_failure_reason());
   return from_8bit(t, img, w, h, n, srgb, path, err);
 }
 

@@ -19,6 +19,9 @@ typedef struct texture {
 
 /* srgb: decode 8-bit values from sRGB (colour maps) or keep them linear (data maps). */
 valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error *err);
+/* The same, saying "PATH: cannot read WHAT: reason" when the file cannot be decoded
+ * (texture_load_file's WHAT is "texture"). */
+valo_status texture_load_file_as(texture *t, const char *path, int srgb, const char *what, valo_error *err);
 valo_status texture_load_memory(texture *t, const unsigned char *data, size_t len, const char *name, int srgb, valo_error *err);
 void texture_free(texture *t);
 /* Bilinear RGBA at (u, v). */

@@ -3,10 +3,8 @@
 #include "image/image_io.h"
 #include "image/texture.h"
 #include "core/error.h"
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <strings.h>
 
 static vec3 to_map(const envmap *e, vec3 d) { /* world -> map frame: rotate by -rotation about y */
   return v3(e->rot_cos * d.x - e->rot_sin * d.z, d.y, e->rot_sin * d.x + e->rot_cos * d.z);
@@ -79,18 +77,9 @@ int envmap_init(envmap *e, int w, int h, float *px, float scale, float rotation_
 /* The map's linear RGB: an HDR file (.exr, .hdr, .pfm) as it is, any other image (PNG,
  * JPEG, ...) through the texture loader, its 8-bit values decoded from sRGB. */
 static valo_status read_map(const char *path, image *im, valo_error *err) {
-  const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
-  if (dot && (!slash || dot > slash) && (!strcasecmp(dot, ".exr") || !strcasecmp(dot, ".hdr") || !strcasecmp(dot, ".pfm")))
-    return image_read(path, im, err);
+  if (image_is_float_file(path)) return image_read(path, im, err);
   texture t;
-  valo_status st = texture_load_file(&t, path, 1, err);
-  const char *why = st && err ? strstr(err->message, ": cannot read texture: ") : NULL;
-  if (why) { /* said of an environment map, with what valo reads */
-    char reason[200];
-    snprintf(reason, sizeof reason, "%s", why + strlen(": cannot read texture: "));
-    return err_set(err, st, "%s: cannot read it as an environment map (.exr, .hdr, .pfm, or an 8-bit image such as PNG or JPEG): %s",
-                   path, reason);
-  }
+  valo_status st = texture_load_file_as(&t, path, 1, "it as an environment map (.exr, .hdr, .pfm, or an 8-bit image such as PNG or JPEG)", err);
   if (st) return st;
   im->w = t.w;
   im->h = t.h;
