@@ -6,7 +6,6 @@
 #include "valo/valo.h"
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 static const char *const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf", "#000000", "#aec7e8"};
@@ -21,30 +20,10 @@ static void put_html(FILE *f, const char *s) {
   }
 }
 
-/* A report file is made in memory, then written as valo writes its images
- * (valo_file_write: atomically, links followed). */
-typedef struct out_file { FILE *f; char *buf; size_t len; } out_file;
-static FILE *open_in(out_file *o) {
-  o->buf = NULL;
-  o->len = 0;
-  o->f = open_memstream(&o->buf, &o->len);
-  if (!o->f) fprintf(stderr, "valo: error: out of memory for a report file\n");
-  return o->f;
-}
-static int finish(out_file *o, const char *dir, const char *name) {
-  char path[4400];
-  snprintf(path, sizeof path, "%s/%s", dir, name);
-  valo_error err;
-  int rc = 0;
-  if (fclose(o->f) != 0) {
-    fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path);
-    rc = -1;
-  } else if (valo_file_write(path, o->buf, o->len, &err)) {
-    fprintf(stderr, "valo: error: %s\n", err.message);
-    rc = -1;
-  }
-  free(o->buf);
-  return rc;
+/* dir/name, made in memory and written by cli_out_write (run_stats.h). */
+static FILE *open_in(cli_out *o, char *path, size_t n, const char *dir, const char *name) {
+  snprintf(path, n, "%s/%s", dir, name);
+  return cli_out_open(o, path);
 }
 
 /* The width an image is shown at: small films scaled up by a whole factor (pixelated) to
@@ -57,8 +36,9 @@ static int shown_width(int w) {
 static const char *ref_name(const cmp_report *r) { return r->reference[0] ? r->reference : r->runs[r->ref_run - 1].name; }
 
 int report_write_summary(const cmp_report *r, const char *dir) {
-  out_file o;
-  FILE *f = open_in(&o);
+  cli_out o;
+  char path[4400];
+  FILE *f = open_in(&o, path, sizeof path, dir, "summary.json");
   if (!f) return -1;
   fprintf(f, "{\n  \"scene\": ");
   json_put_string(f, r->scene);
@@ -81,7 +61,7 @@ int report_write_summary(const cmp_report *r, const char *dir) {
     fprintf(f, "]}");
   }
   fprintf(f, "\n  ]\n}\n");
-  return finish(&o, dir, "summary.json");
+  return cli_out_write(&o, path);
 }
 
 /* The relMSE-against-time plot: log10 axes over the decades the curves span. */
@@ -150,8 +130,9 @@ static void put_figures(FILE *f, const cmp_report *r, const char *suffix, int sc
 }
 
 int report_write_html(const cmp_report *r, const char *dir) {
-  out_file o;
-  FILE *f = open_in(&o);
+  cli_out o;
+  char path[4400];
+  FILE *f = open_in(&o, path, sizeof path, dir, "index.html");
   if (!f) return -1;
   fprintf(f, "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>valo compare: ");
   put_html(f, r->scene);
@@ -183,5 +164,5 @@ int report_write_html(const cmp_report *r, const char *dir) {
   fprintf(f, "<h2>relMSE against time</h2>\n");
   put_svg(f, r);
   fprintf(f, "<p>Made by valo %s.</p>\n</body></html>\n", valo_version());
-  return finish(&o, dir, "index.html");
+  return cli_out_write(&o, path);
 }

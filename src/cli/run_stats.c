@@ -65,16 +65,31 @@ static void put_report(FILE *f, const run_report *r) {
   fprintf(f, "\n}\n");
 }
 
-int run_stats_write_json(const char *path, const run_report *r) {
-  char *buf = NULL;
-  size_t len = 0;
-  FILE *f = open_memstream(&buf, &len);
-  if (!f) { fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path); return -1; }
-  put_report(f, r);
-  if (fclose(f) != 0) { free(buf); fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path); return -1; }
+FILE *cli_out_open(cli_out *o, const char *path) {
+  o->buf = NULL;
+  o->len = 0;
+  o->f = open_memstream(&o->buf, &o->len);
+  if (!o->f) fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path);
+  return o->f;
+}
+
+int cli_out_write(cli_out *o, const char *path) {
   valo_error err;
-  int rc = valo_file_write(path, buf, len, &err) ? -1 : 0;
-  if (rc) fprintf(stderr, "valo: error: %s\n", err.message);
-  free(buf);
+  int rc = 0;
+  if (fclose(o->f) != 0) {
+    fprintf(stderr, "valo: error: %s: cannot write: out of memory\n", path);
+    rc = -1;
+  } else if (valo_file_write(path, o->buf, o->len, &err)) {
+    fprintf(stderr, "valo: error: %s\n", err.message);
+    rc = -1;
+  }
+  free(o->buf);
   return rc;
+}
+
+int run_stats_write_json(const char *path, const run_report *r) {
+  cli_out o;
+  if (!cli_out_open(&o, path)) return -1;
+  put_report(o.f, r);
+  return cli_out_write(&o, path);
 }
