@@ -24,7 +24,11 @@
 #    Mitsuba's envmap has u = 0 at -z, so its to_world is a turn of 180 + rotation degrees
 #    about +y where valo's is `rotation`; both look the map up bilinearly;
 #  - camera: pinhole, vertical fov, box pixel filter one pixel wide; path tracing with no
-#    depth limit (Russian roulette from depth 5); an independent sampler.
+#    depth limit (Russian roulette from depth 5); an independent sampler;
+#  - orthographic camera (CAMERA_SCENES): Mitsuba's "orthographic" sees x in [-1, 1] and
+#    y in [-1/aspect, 1/aspect] of its camera space, so valo's view height H is a to_world
+#    scale of H * aspect / 2 on x and y (measured: a unit square on films of aspect 2 and
+#    1/2 covers 1/2 and 1/4 of the film's width and height).
 import argparse, json, math, os, struct, zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -66,6 +70,11 @@ LIGHT_SCENES = {
                     "cone_delta_angle": 0.01}],
     "sun-light": [{"type": "directional", "direction": [-0.4, -1, -0.5], "irradiance": [3, 3, 3]}],
 }
+# The diffuse sphere (0.7) on the floor under the lamp, seen by an orthographic camera of
+# view height 1.6 from the usual place, on a film of aspect 1.6.
+CAMERA_SCENES = {"ortho-camera": {"type": "orthographic", "height": 1.6, "position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0],
+                                  "up": [0, 1, 0]}}
+ORTHO_W, ORTHO_H = 128, 80
 # A quad textured with an sRGB PNG under a uniform white environment (radiance = albedo):
 # quadrants red, green, blue, yellow from the image's top-left, so a flipped u or v shows.
 TEXTURE_SCENES = {"textured-quad": "quad-texture.png"}
@@ -155,6 +164,13 @@ def texture_json(name, tex):
             "environment": {"type": "constant", "radiance": 1}}
 
 
+def camera_json(name, cam):
+    j = valo_json(name, {"type": "diffuse", "reflectance": 0.7})
+    j["camera"] = cam
+    j["film"] = {"width": ORTHO_W, "height": ORTHO_H}
+    return j
+
+
 def env_json(name, mats):
     return {"camera": {"position": [0, 0, 4.2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
             "film": {"width": 128, "height": 64}, "render": {"spp": 64},
@@ -188,10 +204,14 @@ def mitsuba_bsdf(mat):
 
 
 def sensor(mi, cam, w, h, spp):
-    return {"type": "perspective", "fov_axis": "y", "fov": cam["fov"],
-            "to_world": mi.ScalarTransform4f().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"]),
-            "film": {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-            "sampler": {"type": "independent", "sample_count": spp}}
+    T = mi.ScalarTransform4f
+    to_world = T().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"])
+    film = {"type": "hdrfilm", "width": w, "height": h, "rfilter": {"type": "box"}, "pixel_format": "rgb"}
+    sampler = {"type": "independent", "sample_count": spp}
+    if cam.get("type") == "orthographic":
+        s = cam["height"] * w / h / 2
+        return {"type": "orthographic", "to_world": to_world @ T().scale([s, s, 1]), "film": film, "sampler": sampler}
+    return {"type": "perspective", "fov_axis": "y", "fov": cam["fov"], "to_world": to_world, "film": film, "sampler": sampler}
 
 
 def scene_dict(mi, name, mat, spp):
@@ -216,6 +236,10 @@ def scene_dict(mi, name, mat, spp):
                       "bsdf": {"type": "diffuse", "reflectance": {"type": "bitmap", "filename": os.path.join(OUT, mat),
                                                                   "filter_type": "bilinear"}}}}
         return d, 96, 96
+    if name in CAMERA_SCENES:
+        d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)
+        d["sensor"] = sensor(mi, mat, ORTHO_W, ORTHO_H, spp)
+        return d, ORTHO_W, ORTHO_H
     if name in LIGHT_SCENES:
         d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)
         d.pop("lamp")
@@ -289,7 +313,8 @@ def main():
     write_meshes()
     for tex in TEXTURE_SCENES.values():
         write_texture(os.path.join(OUT, tex))
-    kinds = [(SCENES, valo_json), (ENV_SCENES, env_json), (TEXTURE_SCENES, texture_json), (LIGHT_SCENES, light_json)]
+    kinds = [(SCENES, valo_json), (ENV_SCENES, env_json), (TEXTURE_SCENES, texture_json), (LIGHT_SCENES, light_json),
+             (CAMERA_SCENES, camera_json)]
     for table, to_json in kinds:
         for name, what in table.items():
             with open(os.path.join(OUT, name + ".json"), "w") as f:
@@ -297,7 +322,8 @@ def main():
                 f.write("\n")
     import mitsuba as mi
     mi.set_variant(a.variant)
-    for name, mat in list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()):
+    for name, mat in (list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()) +
+                      list(CAMERA_SCENES.items())):
         if not a.only or a.only == name:
             render(mi, name, mat, a.spp, a.seed)
 

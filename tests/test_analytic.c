@@ -608,6 +608,128 @@ static int thin_lens_gltf_camera(void) {
   return 0;
 }
 
+/* An orthographic camera (camera.type "orthographic", height H): rays run along the view
+ * axis from their own point of the camera plane, so an object's size on the film does not
+ * depend on its distance. Two emitting spheres of radius 0.5, one at distance 2 and one
+ * at 30, each cover pi (0.5 * 64 / H)^2 pixels centred where their centres project, and
+ * the depth AOV is the distance from the camera plane (1.5 at the near one's front). The
+ * thin lens spreads a point at depth D focused at F into a disk of radius A |1 - D/F| in
+ * scene units; in focus it stays a dot. */
+static int orthographic_camera(void) {
+  const double H = 4, ppu = 64 / H; /* pixels per scene unit */
+  const char *json = scratch_file("ortho.json",
+      "{ \"camera\": {\"type\": \"orthographic\", \"height\": 4, \"position\": [0,0,0], \"look_at\": [0,0,-1]},\n"
+      "  \"film\": {\"width\": 96, \"height\": 64}, \"render\": {\"spp\": 64},\n"
+      "  \"materials\": {\"e\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1}},\n"
+      "  \"shapes\": [{\"type\": \"sphere\", \"center\": [-1,0,-2], \"radius\": 0.5, \"subdivisions\": 5, \"material\": \"e\"},\n"
+      "             {\"type\": \"sphere\", \"center\": [1,0,-30], \"radius\": 0.5, \"subdivisions\": 5, \"material\": \"e\"}] }\n");
+  valo_options o;
+  valo_options_init(&o);
+  o.aovs = 1;
+  valo_scene *sc;
+  valo_render *r = render_file(json, &o, &sc);
+  CHECK(r, "render failed");
+  float *px = malloc(96 * 64 * 3 * sizeof *px), *depth = malloc(96 * 64 * 3 * sizeof *depth);
+  valo_error err;
+  valo_render_pixels(r, px);
+  CHECK(valo_render_layer(r, "depth", depth, &err) == VALO_OK, "%s", err.message);
+  double area[2] = {0, 0}, cx[2] = {0, 0}, cy[2] = {0, 0};
+  for (int y = 0; y < 64; y++)
+    for (int x = 0; x < 96; x++) {
+      double v = px[3 * (y * 96 + x) + 1];
+      int k = x >= 48;
+      area[k] += v; cx[k] += v * (x + 0.5); cy[k] += v * (y + 0.5);
+    }
+  double d_near = depth[3 * (32 * 96 + 32)], d_far = depth[3 * (32 * 96 + 64)];
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  free(px); free(depth);
+  double want = M_PI * (0.5 * ppu) * (0.5 * ppu);
+  for (int k = 0; k < 2; k++) { cx[k] /= area[k]; cy[k] /= area[k]; }
+  fprintf(stderr, "orthographic: sphere areas %.1f and %.1f px (predicted %.1f), centres (%.2f, %.2f) and (%.2f, %.2f) "
+          "(predicted (32, 32) and (64, 32)), depth %.4f and %.4f (predicted 1.5 and 29.5)\n",
+          area[0], area[1], want, cx[0], cy[0], cx[1], cy[1], d_near, d_far);
+  for (int k = 0; k < 2; k++) {
+    CHECK(fabs(area[k] - want) < 0.02 * want, "sphere %d covers %.1f px, predicted %.1f", k, area[k], want);
+    CHECK(fabs(cx[k] - (k ? 64 : 32)) < 0.05 && fabs(cy[k] - 32) < 0.05, "sphere %d centred at (%.2f, %.2f)", k, cx[k], cy[k]);
+  }
+  CHECK(fabs(d_near - 1.5) < 0.01 && fabs(d_far - 29.5) < 0.01, "depth %.4f and %.4f, predicted 1.5 and 29.5", d_near, d_far);
+  /* The lens: a point at depth 4 seen through radius 0.1 focused at 2 (or 4), H = 2. */
+  double A = 0.1, predicted = A * fabs(1 - 4.0 / 2.0) * 48, rr[3];
+  for (int k = 0; k < 3; k++) {
+    char text[1024];
+    snprintf(text, sizeof text,
+             "{ \"camera\": {\"type\": \"orthographic\", \"height\": 2, \"position\": [0,0,0], \"look_at\": [0,0,-1], "
+             "\"aperture_radius\": %g, \"focus_distance\": %g},\n" SPOT_SCENE_TAIL,
+             k == 2 ? 0 : A, k == 1 ? 4.0 : 2.0, "", 0.0);
+    rr[k] = spot_radius(text, NULL);
+  }
+  fprintf(stderr, "orthographic spot radius: defocused %.2f px (predicted %.2f), in focus %.2f px, pinhole %.2f px\n", rr[0], predicted, rr[1], rr[2]);
+  CHECK(rr[0] > 0 && rr[1] >= 0 && rr[2] >= 0, "render failed");
+  CHECK(fabs(rr[0] - predicted) < 0.05 * predicted + 0.5, "defocus radius %.2f px, predicted %.2f", rr[0], predicted);
+  CHECK(rr[1] < 1.5 && rr[2] < 1.5, "in focus the spot should stay within a pixel or so (%.2f, %.2f)", rr[1], rr[2]);
+  return 0;
+}
+
+/* A glTF orthographic camera (xmag 3, ymag 1.5, at z = 5 looking down -z) over a 2 x 2
+ * square at z = 0 and its twin at z = -10 behind it: the film takes the camera's aspect
+ * (512 x 256) and the square covers a third of its width and two thirds of its height,
+ * whatever its distance. camera.from_file takes it; "height" there overrides ymag and
+ * "fov" is refused. */
+static const char gltf_ortho[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}],\n"
+    " \"nodes\": [{\"camera\": 0, \"translation\": [0, 0, 5], \"name\": \"cam\"}, {\"mesh\": 0}],\n"
+    " \"cameras\": [{\"type\": \"orthographic\", \"orthographic\": {\"xmag\": 3, \"ymag\": 1.5, \"znear\": 0.01, \"zfar\": 100}}],\n"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1}]}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 8, \"type\": \"VEC3\", \"min\": [-1,-1,-10], \"max\": [1,1,0]},\n"
+    "                {\"bufferView\": 1, \"componentType\": 5125, \"count\": 12, \"type\": \"SCALAR\"}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 96}, {\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 48}],\n"
+    " \"buffers\": [{\"byteLength\": 144, \"uri\": \"data:application/octet-stream;base64,"
+    "AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAACAPwAAgD8AAAAAAACAvwAAgD8AAAAAAACAvwAAgL8AACDBAACAPwAAgL8AACDBAACAPwAAgD8AACDBAACAvwAAgD8AACDB"
+    "AAAAAAEAAAACAAAAAAAAAAIAAAADAAAABAAAAAUAAAAGAAAABAAAAAYAAAAHAAAA\"}]}\n";
+static double ortho_square_share(const char *path, int *w, int *h) {
+  valo_options o;
+  valo_options_init(&o);
+  o.spp = 16;
+  valo_scene *sc;
+  valo_render *r = render_file(path, &o, &sc);
+  if (!r) return -1;
+  valo_stats st;
+  valo_render_stats(r, &st);
+  *w = st.width; *h = st.height;
+  float *px = malloc((size_t)st.width * st.height * 3 * sizeof *px);
+  valo_render_pixels(r, px);
+  long n = 0;
+  for (int i = 0; i < st.width * st.height; i++) n += px[3 * i + 1] < 0.9f; /* the square; the white environment is 1 */
+  free(px);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return (double)n / ((double)st.width * st.height);
+}
+static int orthographic_gltf_camera(void) {
+  const char *gltf = scratch_file("ortho_camera.gltf", gltf_ortho);
+  CHECK(gltf, "cannot write the glTF file");
+  int w, h;
+  double share = ortho_square_share(gltf, &w, &h);
+  fprintf(stderr, "glTF orthographic camera: film %dx%d, the square covers %.4f of it (predicted %.4f)\n", w, h, share, 2.0 / 9);
+  CHECK(w == 512 && h == 256, "film %dx%d, expected the camera's aspect 512x256", w, h);
+  CHECK(fabs(share - 2.0 / 9) < 0.01, "the square covers %.4f of the film, predicted 2/9", share);
+  /* camera.from_file with height 2.5 on this JSON's 512 x 256 film: a view of 5 x 2.5,
+   * of which the square covers 2/5 x 4/5. */
+  const char *json = scratch_file("ortho_from_file.json",
+      "{ \"camera\": {\"from_file\": true, \"height\": 2.5}, \"film\": {\"width\": 512, \"height\": 256},\n"
+      "  \"environment\": {\"type\": \"constant\", \"radiance\": 1}, \"shapes\": [{\"file\": \"ortho_camera.gltf\"}] }\n");
+  share = ortho_square_share(json, &w, &h);
+  fprintf(stderr, "from_file with height 2.5: the square covers %.4f (predicted %.4f)\n", share, 0.32);
+  CHECK(fabs(share - 0.32) < 0.01, "from_file height 2.5: the square covers %.4f, predicted 0.32", share);
+  json = scratch_file("ortho_fov.json", "{ \"camera\": {\"from_file\": true, \"fov\": 30}, \"shapes\": [{\"file\": \"ortho_camera.gltf\"}] }\n");
+  valo_scene *sc;
+  valo_error err;
+  CHECK(valo_scene_load(json, &sc, &err) == VALO_ERR_INVALID && strstr(err.message, "camera.fov") && strstr(err.message, "orthographic"),
+        "a field of view for an orthographic file camera was taken (%s)", err.message);
+  return 0;
+}
+
 /* Adaptive sampling on the albedo-0.5 furnace (64x64): the budget is used exactly,
  * background pixels (zero variance, away from the sphere: the rule looks at 17x17
  * neighbourhoods) get no more than the first pass (half the budget), sphere pixels get
@@ -754,7 +876,8 @@ int main(int argc, char **argv) {
                                     {"envmap_orientation", envmap_orientation}, {"envmap_cube", envmap_cube}, {"envmap_irradiance", envmap_irradiance},
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
-                                    {"thin_lens_gltf_camera", thin_lens_gltf_camera}, {"thin_lens_restir", thin_lens_restir},
+                                    {"thin_lens_gltf_camera", thin_lens_gltf_camera},
+                                    {"orthographic_camera", orthographic_camera}, {"orthographic_gltf_camera", orthographic_gltf_camera}, {"thin_lens_restir", thin_lens_restir},
                                     {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased},
                                     {"adaptive_pays_caustic", adaptive_pays_caustic}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};

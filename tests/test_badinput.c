@@ -649,6 +649,8 @@ static int gltf_damaged(void) {
       {"g_image_type.gltf", "TYPE/SUBTYPE", "\"scene\": 0", "\"images\": [{\"uri\": \"data:image;base64,AAAA\"}], \"scene\": 0"},
       {"g_image_view.gltf", "needs a \"mimeType\"", "\"scene\": 0", "\"images\": [{\"bufferView\": 0, \"mimeType\": \"png\"}], \"scene\": 0"},
       {"g_sparse.gltf", "accessor 1 sparse must be an object with \"indices\" and \"values\"", "\"count\": 6,", "\"count\": 6, \"sparse\": {},"},
+      {"g_ortho.gltf", "camera 0: \"xmag\" must be a number other than 0", "\"scene\": 0",
+       "\"cameras\": [{\"type\": \"orthographic\", \"orthographic\": {\"xmag\": 0, \"ymag\": 1, \"znear\": 0.1, \"zfar\": 9}}], \"scene\": 0"},
       {"g_not_json.gltf", "g_not_json.gltf:1: glTF: a value expected", NULL, "ogeometrynodeff{"},
   };
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {

@@ -86,6 +86,25 @@ static int wrong_type(void) {
   p = write_file("type6.json", "{ \"camera\": {\"from_file\": true}, \"shapes\": [{\"type\": \"sphere\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("type6.json"); SAID("no shape file has a camera"); NO_SANITIZER();
+  /* camera.type: a perspective camera's fov and an orthographic one's height, not both */
+  p = write_file("cam1.json", "{ \"camera\": {\"type\": \"orthographic\", \"fov\": 30} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("cam1.json"); SAID("camera.fov"); SAID("orthographic camera has no field of view"); NO_SANITIZER();
+  p = write_file("cam2.json", "{ \"camera\": {\"height\": 3} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("cam2.json"); SAID("camera.height"); SAID("\"type\": \"orthographic\""); NO_SANITIZER();
+  p = write_file("cam3.json", "{ \"camera\": {\"type\": \"fisheye\"} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("camera.type"); SAID("\"perspective\" or \"orthographic\""); NO_SANITIZER();
+  p = write_file("cam4.json", "{ \"camera\": {\"type\": \"orthographic\", \"height\": 0} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("camera.height"); NO_SANITIZER();
+  p = write_file("cam5.json", "{ \"camera\": {\"type\": \"orthographic\", \"keyframes\": [{\"frame\": 0, \"fov\": 20}]} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("camera.keyframes[0].fov"); NO_SANITIZER();
+  p = write_file("cam6.json", "{ \"camera\": {\"from_file\": true, \"type\": \"orthographic\"} }\n");
+  EXPECT_FAIL(1, "render", p);
+  SAID("cam6.json"); SAID("from_file"); NO_SANITIZER();
   p = write_file("type7.json", "{ \"environment\": {\"type\": \"cube\", \"faces\": [\"a.png\", \"b.png\"]} }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("type7.json"); SAID("environment.faces"); SAID("six"); NO_SANITIZER();

@@ -90,6 +90,9 @@ static int pbr_metal(void) { return against_mitsuba("pbr-metal", 512, 16, 0); }
 /* punctual lights in their units: a spot (W/sr, hard cone) and a sun (W/m^2) */
 static int spot_light(void) { return against_mitsuba("spot-light", 256, 16, 0); }
 static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
+/* An orthographic camera (camera.type): the diffuse sphere under the lamp on a film of
+ * aspect 1.6, against Mitsuba's "orthographic" sensor scaled to the same view. */
+static int ortho_camera(void) { return against_mitsuba("ortho-camera", 256, 16, 0); }
 /* a diffuse and a rough gold sphere lit only by a map turned 60 degrees: the background
  * pixels check the map's orientation and rotation, the spheres its sampling. 32x32
  * blocks: Mitsuba spreads the map's rows over [0, 1] from centre to centre, valo from
@@ -103,7 +106,7 @@ static int env_spheres(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
-                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"textured_quad", textured_quad},
+                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {NULL, NULL}};

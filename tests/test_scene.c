@@ -1,10 +1,12 @@
 /* test_scene.c — scene loading: non-unit normals normalised (head.obj), the JSON
  * transform order (scale, rotate x/y/z, translate), MTL meanings of McGuire's Cornell
  * boxes (Kd, Ke front-sided emitters, illum 5 mirror, illum 7 glass), automatic framing
- * of a mesh without a camera, and polygon triangulation. */
+ * of a mesh without a camera, polygon triangulation, and the camera's film point of a world
+ * point (ReSTIR's reprojection) as the inverse of its rays, perspective and orthographic. */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"
+#include "scene/camera.h"
 #include "light/light.h"
 #include <math.h>
 #include <stdlib.h>
@@ -379,11 +381,39 @@ static int fallback_warnings(void) {
   return 0;
 }
 
+/* cam_view_project inverts cam_view_ray: a point along the ray through film point (fx, fy)
+ * projects back to (fx, fy), for a perspective and an orthographic camera (the ray
+ * origins of the latter spread over its plane); a point behind the camera or its plane is
+ * not seen. */
+static int camera_project_inverts_ray(void) {
+  for (int ortho = 0; ortho < 2; ortho++) {
+    camera c = {.pos = {1, 2, 3}, .look_at = {0.5f, 1.5f, -2}, .up = {0.1f, 1, 0}, .fov_deg = 35, .ortho_height = ortho ? 3.5f : 0};
+    cam_view v;
+    CHECK(cam_view_make(&c, 120, 80, &v) == 0, "basis");
+    double worst = 0;
+    for (int i = 0; i < 1000; i++) {
+      float fx = 120.0f * (float)((i * 37) % 1000) / 1000, fy = 80.0f * (float)((i * 91) % 1000) / 1000, t = 0.5f + (float)(i % 17);
+      vec3 o, d;
+      cam_view_ray(&v, fx, fy, &o, &d);
+      if (ortho) CHECK(v3_dot(d, v.fwd) > 0.99999f, "an orthographic ray is not along the view axis");
+      float gx, gy;
+      CHECK(cam_view_project(&v, v3_add(o, v3_scale(d, t)), &gx, &gy), "a point along the ray through (%g, %g) is not seen", fx, fy);
+      worst = fmax(worst, fmax(fabs(gx - fx), fabs(gy - fy)));
+      float hx, hy;
+      CHECK(!cam_view_project(&v, v3_sub(v.o, v3_scale(v.fwd, t)), &hx, &hy), "a point behind the camera is seen");
+    }
+    fprintf(stderr, "%s: largest film distance of a round trip %.2g px\n", ortho ? "orthographic" : "perspective", worst);
+    CHECK(worst < 1e-3, "a round trip moved a film point by %g px", worst);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"mtl_before_newmtl", mtl_before_newmtl},
                                     {"obj_mtl_indented", obj_mtl_indented},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
-                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings}, {NULL, NULL}};
+                                    {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings},
+                                    {"camera_project_inverts_ray", camera_project_inverts_ray}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

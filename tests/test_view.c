@@ -253,6 +253,17 @@ static int step_api(void) {
   c = c0;
   c.fov_deg = 0;
   CHECK(valo_render_set_camera(b, &c, &err) == VALO_ERR_INVALID, "a field of view of 0 was taken");
+  /* an orthographic camera (its height; the field of view unused) is taken and reported back */
+  c.ortho_height = 2;
+  CHECK(valo_render_set_camera(b, &c, &err) == VALO_OK && valo_render_step(b, 4, 1, &err) == VALO_OK, "%s", err.message);
+  valo_camera back;
+  valo_render_camera(b, &back);
+  CHECK(back.ortho_height == 2, "the orthographic height came back as %g", back.ortho_height);
+  valo_render_pixels(b, pc);
+  CHECK(memcmp(pa, pc, n * sizeof *pa) != 0, "an orthographic camera rendered the perspective image");
+  c.ortho_height = -1;
+  CHECK(valo_render_set_camera(b, &c, &err) == VALO_ERR_INVALID, "a negative orthographic height was taken");
+  CHECK(valo_render_set_camera(b, &c0, &err) == VALO_OK, "%s", err.message);
   valo_camera now;
   valo_render_camera(b, &now);
   CHECK(!memcmp(&now, &c0, sizeof now), "a refused camera changed the render's");

@@ -245,15 +245,18 @@ VALO_API int valo_render_rank_stats(const valo_render *r, int k, valo_rank_stats
 
 /* Interactive rendering (valo view): the camera moves between steps and the film is
  * shown as it fills. A camera: position, the point looked at, the up direction and the
- * vertical field of view in degrees. */
+ * vertical field of view in degrees, or an orthographic camera's height in scene units
+ * (ortho_height > 0; 0: perspective). */
 typedef struct valo_camera {
   double pos[3], look_at[3], up[3];
   double fov_deg;
+  double ortho_height;
 } valo_camera;
 VALO_API void valo_render_camera(const valo_render *r, valo_camera *out);
 /* Moves the camera (lens and focus unchanged); the next step should restart the film.
  * VALO_ERR_INVALID when up is parallel to the view direction, the field of view is not in
- * (0, 180) or the render is a sequence (valo_options.frames). */
+ * (0, 180) (a perspective camera), the height is not positive and finite (an orthographic
+ * one) or the render is a sequence (valo_options.frames). */
 VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c, valo_error *err);
 /* Renders one step on the current camera and returns: per-ray integrators add `spp`
  * samples per pixel to the film (sample indices going on from the film's count, so a

@@ -204,16 +204,22 @@ static void cam_move(valo_camera *c, double a, double b, double f) {
   }
 }
 
+/* Moves the camera toward its look-at point (factor < 1) or away; an orthographic
+ * camera's view, which distance does not change, grows or shrinks by the same factor. */
 static void cam_zoom(valo_camera *c, double factor) {
   double fwd[3], right[3], up[3];
   double dist = cam_frame(c, fwd, right, up) * factor;
   if (!(dist > 1e-6)) return;
   for (int k = 0; k < 3; k++) c->pos[k] = c->look_at[k] - fwd[k] * dist;
+  if (c->ortho_height > 0 && c->ortho_height * factor > 1e-6) c->ortho_height *= factor;
 }
 
 static void print_camera(const valo_camera *c) {
-  printf("\"camera\": {\"position\": [%.6g, %.6g, %.6g], \"look_at\": [%.6g, %.6g, %.6g], \"up\": [%.6g, %.6g, %.6g], \"fov\": %.6g}\n",
-         c->pos[0], c->pos[1], c->pos[2], c->look_at[0], c->look_at[1], c->look_at[2], c->up[0], c->up[1], c->up[2], c->fov_deg);
+  char size[64];
+  if (c->ortho_height > 0) snprintf(size, sizeof size, "\"type\": \"orthographic\", \"height\": %.6g", c->ortho_height);
+  else snprintf(size, sizeof size, "\"fov\": %.6g", c->fov_deg);
+  printf("\"camera\": {\"position\": [%.6g, %.6g, %.6g], \"look_at\": [%.6g, %.6g, %.6g], \"up\": [%.6g, %.6g, %.6g], %s}\n",
+         c->pos[0], c->pos[1], c->pos[2], c->look_at[0], c->look_at[1], c->look_at[2], c->up[0], c->up[1], c->up[2], size);
   fflush(stdout);
 }
 
@@ -281,7 +287,9 @@ static void handle_events(viewer *v) {
       int pan = (e.motion.state & (SDL_BUTTON_RMASK | SDL_BUTTON_MMASK)) || (SDL_GetModState() & KMOD_SHIFT);
       double wh = (double)v->h * v->scale;
       if (pan) {
-        double k = 2 * tan(v->cam.fov_deg * M_PI / 360) / wh;
+        double fwd[3], right[3], up[3], dist = cam_frame(&v->cam, fwd, right, up);
+        /* a pixel's width at the look-at point, in units of its distance (cam_move's) */
+        double k = (v->cam.ortho_height > 0 ? v->cam.ortho_height / dist : 2 * tan(v->cam.fov_deg * M_PI / 360)) / wh;
         cam_move(&v->cam, -e.motion.xrel * k, e.motion.yrel * k, 0);
       } else {
         cam_orbit(&v->cam, -e.motion.xrel * 0.006, -e.motion.yrel * 0.006);

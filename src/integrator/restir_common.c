@@ -48,7 +48,7 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
   if (delta_walk_next(&w, c, &smp, ts)) {
     g->it = w.it; g->fr = w.fr; g->b = w.b; g->wo = w.wo; g->beta = w.beta; g->valid = 1; g->chain = w.depth > 0;
   }
-  if (w.hit_any) g->depth = v3_len(v3_sub(w.first_p, f->lens->view.o));
+  if (w.hit_any) g->depth = cam_view_depth(&f->lens->view, w.first_p);
   g->Le = w.L;
 }
 
@@ -74,7 +74,7 @@ static int64_t reproject(const restir_state *s, const restir_cfg *cfg, const fra
   size_t q = (size_t)py * s->width + px;
   const gpix *h = &s->g_prev[q];
   if (!h->valid || h->chain) return -1;
-  float d_prev = v3_len(v3_sub(g->it.p, f->prev.o));
+  float d_prev = cam_view_depth(&f->prev, g->it.p);
   if (!restir_similar(cfg, g->fr.n, d_prev, h->fr.n, h->depth)) return -1;
   return (int64_t)q;
 }

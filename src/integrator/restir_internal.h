@@ -21,7 +21,7 @@ typedef struct gpix {
   vec3 wo;
   rgb beta;      /* throughput of the delta chain from the camera to it */
   rgb Le;        /* emission seen along that chain (weighted) */
-  float depth;   /* camera-to-first-hit distance */
+  float depth;   /* how far the camera is from the first hit (cam_view_depth) */
   int valid;     /* a surface with a non-delta lobe */
   int chain;     /* reached through a delta bounce: not reprojected */
 } gpix;

@@ -3,6 +3,7 @@
  * KHR_texture_transform, which Assimp indexes without looking), textures, images,
  * cameras, skins, animations and KHR_lights_punctual lights. */
 #include "load/gltf_check_internal.h"
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -136,6 +137,12 @@ static valo_status check_camera(gc *g, uint32_t o, uint32_t i, const char *ctx) 
   if (!p || N(g, p)->t != J_OBJ) return gl_bad(g, "%s has no \"%s\" object", ctx, type);
   for (uint32_t c = N(g, p)->child; c; c = N(g, c)->next)
     if (N(g, c)->t != J_NUM && strcmp(N(g, c)->key, "extensions") && strcmp(N(g, c)->key, "extras")) return gl_bad(g, "%s: \"%s\" must be a number", ctx, N(g, c)->key);
+  /* the view's size: Assimp takes an orthographic camera with xmag 0 for a perspective one */
+  static const char *const mags[] = {"xmag", "ymag"};
+  for (int k = 0; k < 2 && !strcmp(type, "orthographic"); k++) {
+    uint32_t m = json_get(&g->d, p, mags[k]);
+    if (!m || !(N(g, m)->num != 0) || !isfinite(N(g, m)->num)) return gl_bad(g, "%s: \"%s\" must be a number other than 0", ctx, mags[k]);
+  }
   return VALO_OK;
 }
 

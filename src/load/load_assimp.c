@@ -382,14 +382,26 @@ static void take_file_camera(load_ctx *c, const mat34 *xf) {
     return;
   }
   float aspect = cam->mAspect > 0 ? cam->mAspect : 1.0f;
-  float vfov;
-  if (gltf) vfov = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV / (cam->mAspect > 0 ? cam->mAspect : 1.0f) : 0.8f;
-  else vfov = 2.0f * atanf(tanf(cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f) / aspect);
-  if (!(cam->mHorizontalFOV > 0) || !(vfov > 1e-4f && vfov < 3.1f)) {
-    log_warning("%s: camera '%s' has no usable field of view (%g): %.1f degrees (vertical) is used", c->path, cam->mName.data,
-                (double)cam->mHorizontalFOV, 0.8 * 180 / M_PI);
-    vfov = 0.8f;
+  float vfov = 0.8f, height = 0;
+  if (cam->mOrthographicWidth != 0) {
+    /* Orthographic (glTF's xmag and ymag: mOrthographicWidth = xmag, mAspect = xmag / ymag):
+     * the height 2 ymag, scaled as the node's transform scales the up vector. */
+    height = 2.0f * fabsf(cam->mOrthographicWidth) / aspect * v3_len(up) / v3_len(v3(cam->mUp.x, cam->mUp.y, cam->mUp.z));
+    if (!(height > 0 && height < 1e30f)) {
+      log_warning("%s: orthographic camera '%s' has no usable size (half width %g): it is ignored and the view is framed "
+                  "automatically", c->path, cam->mName.data, (double)cam->mOrthographicWidth);
+      return;
+    }
+  } else {
+    if (gltf) vfov = cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV / (cam->mAspect > 0 ? cam->mAspect : 1.0f) : 0.8f;
+    else vfov = 2.0f * atanf(tanf(cam->mHorizontalFOV > 0 ? cam->mHorizontalFOV : 0.5f) / aspect);
+    if (!(cam->mHorizontalFOV > 0) || !(vfov > 1e-4f && vfov < 3.1f)) {
+      log_warning("%s: camera '%s' has no usable field of view (%g): %.1f degrees (vertical) is used", c->path, cam->mName.data,
+                  (double)cam->mHorizontalFOV, 0.8 * 180 / M_PI);
+      vfov = 0.8f;
+    }
   }
+  c->s->cam.ortho_height = height;
   c->s->cam.pos = pos;
   c->s->cam.look_at = v3_add(pos, v3_norm(look));
   c->s->cam.up = v3_norm(up);

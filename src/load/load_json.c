@@ -24,8 +24,24 @@ static valo_status check_view(jctx *c, const char *where, vec3 pos, vec3 look_at
   return VALO_OK;
 }
 
-/* camera.keyframes: [{"frame": F, "position", "look_at", "up", "fov"}, ...], frames
- * increasing; a key's missing fields take the camera's. */
+/* The camera's field of view or height, whichever its kind takes: the other key is an
+ * error naming both. */
+static valo_status get_view_size(jctx *c, const cJSON *o, const char *where, int ortho, float *fov_deg, float *height) {
+  const char *wrong = ortho ? "fov" : "height";
+  if (cJSON_GetObjectItemCaseSensitive(o, wrong)) {
+    char w[96];
+    snprintf(w, sizeof w, "%s.%s", where, wrong);
+    return json_bad(c, w, ortho ? "an orthographic camera has no field of view; give its \"height\" in scene units"
+                                : "\"height\" is an orthographic camera's; a perspective camera takes \"fov\" (or give \"type\": \"orthographic\")");
+  }
+  double d = ortho ? *height : *fov_deg;
+  if (ortho) { TRY(json_get_num(c, o, "height", where, 1e-6, 1e9, &d)); *height = (float)d; }
+  else { TRY(json_get_num(c, o, "fov", where, 1e-3, 179.9, &d)); *fov_deg = (float)d; }
+  return VALO_OK;
+}
+
+/* camera.keyframes: [{"frame": F, "position", "look_at", "up", "fov" or "height"}, ...],
+ * frames increasing; a key's missing fields take the camera's. */
 static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
   if (!cJSON_IsArray(a) || cJSON_GetArraySize(a) < 1) return json_bad(c, "camera.keyframes", "must be a non-empty array of objects");
   int n = cJSON_GetArraySize(a);
@@ -34,7 +50,7 @@ static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
   if (!k) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   c->s->cam_keys = k;
   c->s->ncam_keys = (uint32_t)n;
-  static const char *const keys[] = {"frame", "position", "look_at", "up", "fov", NULL};
+  static const char *const keys[] = {"frame", "position", "look_at", "up", "fov", "height", NULL};
   int i = 0;
   for (const cJSON *e = a->child; e; e = e->next, i++) {
     char where[64];
@@ -45,18 +61,20 @@ static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
     TRY(json_get_num(c, e, "frame", where, -1e9, 1e9, &d));
     k[i].frame = (float)d;
     if (i > 0 && !(k[i].frame > k[i - 1].frame)) return json_bad(c, where, "frames must increase from key to key");
-    k[i].pos = cam->pos; k[i].look_at = cam->look_at; k[i].up = cam->up; k[i].fov_deg = cam->fov_deg;
+    k[i].pos = cam->pos; k[i].look_at = cam->look_at; k[i].up = cam->up;
+    k[i].fov_deg = cam->fov_deg; k[i].ortho_height = cam->ortho_height;
     TRY(json_get_vec(c, e, "position", where, 0, &k[i].pos));
     TRY(json_get_vec(c, e, "look_at", where, 0, &k[i].look_at));
     TRY(json_get_vec(c, e, "up", where, 0, &k[i].up));
-    d = k[i].fov_deg; TRY(json_get_num(c, e, "fov", where, 1e-3, 179.9, &d)); k[i].fov_deg = (float)d;
+    TRY(get_view_size(c, e, where, cam->ortho_height > 0, &k[i].fov_deg, &k[i].ortho_height));
     TRY(check_view(c, where, k[i].pos, k[i].look_at, k[i].up));
   }
   return VALO_OK;
 }
 
 static valo_status parse_camera(jctx *c, const cJSON *o) {
-  static const char *const keys[] = {"position", "look_at", "up", "fov", "aperture_radius", "focus_distance", "from_file", "keyframes", NULL};
+  static const char *const keys[] = {"type", "position", "look_at", "up", "fov", "height", "aperture_radius", "focus_distance",
+                                     "from_file", "keyframes", NULL};
   TRY(json_check_keys(c, o, "camera", keys));
   camera *cam = &c->s->cam;
   const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
@@ -65,22 +83,29 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
     /* The first shape file with a camera supplies position, orientation and fov; the
      * lens (and optionally fov) come from here. */
     if (cJSON_GetObjectItemCaseSensitive(o, "position") || cJSON_GetObjectItemCaseSensitive(o, "look_at") ||
-        cJSON_GetObjectItemCaseSensitive(o, "up"))
-      return json_bad(c, "camera", "\"from_file\" takes position, look_at and up from the file; give only fov, aperture_radius, focus_distance");
+        cJSON_GetObjectItemCaseSensitive(o, "up") || cJSON_GetObjectItemCaseSensitive(o, "type"))
+      return json_bad(c, "camera", "\"from_file\" takes the type, position, look_at and up from the file; give only fov (or an "
+                                   "orthographic camera's height), aperture_radius, focus_distance");
     double d = -1;
     TRY(json_get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); c->cam_fov = (float)d;
+    d = -1; TRY(json_get_num(c, o, "height", "camera", 1e-6, 1e9, &d)); c->cam_height = (float)d;
     d = 0; TRY(json_get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); c->cam_aperture = (float)d;
     d = -1; TRY(json_get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); c->cam_focus = (float)d;
     c->cam_from_file = 1;
     return VALO_OK;
   }
   cam->pos = v3(0, 0, 5); cam->look_at = v3(0, 0, 0); cam->up = v3(0, 1, 0);
-  cam->fov_deg = 40; cam->aperture_radius = 0; cam->focus_distance = -1;
+  cam->fov_deg = 40; cam->ortho_height = 0; cam->aperture_radius = 0; cam->focus_distance = -1;
+  const char *type = "perspective";
+  TRY(json_get_str(c, o, "type", "camera", &type));
+  int ortho = !strcmp(type, "orthographic");
+  if (!ortho && strcmp(type, "perspective")) return json_bad(c, "camera.type", "must be \"perspective\" or \"orthographic\"");
+  if (ortho) cam->ortho_height = 2; /* the view from -1 to 1, as pbrt's default screen window */
   double d;
   TRY(json_get_vec(c, o, "position", "camera", 0, &cam->pos));
   TRY(json_get_vec(c, o, "look_at", "camera", 0, &cam->look_at));
   TRY(json_get_vec(c, o, "up", "camera", 0, &cam->up));
-  d = cam->fov_deg; TRY(json_get_num(c, o, "fov", "camera", 1e-3, 179.9, &d)); cam->fov_deg = (float)d;
+  TRY(get_view_size(c, o, "camera", ortho, &cam->fov_deg, &cam->ortho_height));
   d = 0; TRY(json_get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); cam->aperture_radius = (float)d;
   d = -1; TRY(json_get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); cam->focus_distance = (float)d;
   TRY(check_view(c, "camera", cam->pos, cam->look_at, cam->up));
@@ -383,7 +408,15 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
   }
   if (c.cam_from_file) {
     if (!s->has_camera) { st = json_bad(&c, "camera.from_file", "no shape file has a camera"); goto done; }
+    int ortho = s->cam.ortho_height > 0;
+    if (ortho ? c.cam_fov > 0 : c.cam_height > 0) {
+      st = json_bad(&c, ortho ? "camera.fov" : "camera.height",
+                    ortho ? "the file's camera is orthographic: give its \"height\" in scene units, not a field of view"
+                          : "the file's camera is a perspective camera: give its \"fov\", not a height");
+      goto done;
+    }
     if (c.cam_fov > 0) s->cam.fov_deg = c.cam_fov;
+    if (c.cam_height > 0) s->cam.ortho_height = c.cam_height;
     s->cam.aperture_radius = c.cam_aperture;
     s->cam.focus_distance = c.cam_focus; /* <= 0: autofocus */
   }

@@ -9,7 +9,8 @@ typedef struct jctx {
   scene *s; const char *path; char dir[1024]; valo_error *err;
   valo_options *file;          /* the render settings the file asks for ("film", "render") */
   int cam_from_file;           /* camera.from_file: take the first shape file's camera */
-  float cam_fov, cam_aperture, cam_focus; /* its overrides (fov <= 0: keep the file's) */
+  float cam_fov, cam_height, cam_aperture, cam_focus; /* its overrides (fov, height <= 0: keep
+                                                         the file's) */
 } jctx;
 
 /* The getters: a missing key leaves *out as it is; a present one of the wrong type or

@@ -266,12 +266,16 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
 
 valo_status session_set_camera(session *ss, const camera *c, valo_error *err) {
   if (ss->opt.frames > 0) return err_set(err, VALO_ERR_INVALID, "the camera of a sequence (frames) follows the scene's animation");
-  if (!(c->fov_deg > 0 && c->fov_deg < 180)) return err_set(err, VALO_ERR_INVALID, "field of view %g: must be in (0, 180) degrees", (double)c->fov_deg);
+  if (!(c->ortho_height >= 0 && c->ortho_height < 1e30f))
+    return err_set(err, VALO_ERR_INVALID, "orthographic height %g: must be positive and finite (0: a perspective camera)", (double)c->ortho_height);
+  if (!(c->ortho_height > 0) && !(c->fov_deg > 0 && c->fov_deg < 180))
+    return err_set(err, VALO_ERR_INVALID, "field of view %g: must be in (0, 180) degrees", (double)c->fov_deg);
   camera keep = ss->cam_still;
   ss->cam_still.pos = c->pos;
   ss->cam_still.look_at = c->look_at;
   ss->cam_still.up = c->up;
   ss->cam_still.fov_deg = c->fov_deg;
+  ss->cam_still.ortho_height = c->ortho_height;
   if (v3_len(v3_sub(c->look_at, c->pos)) > 0 && !session_set_view(ss, 0)) return VALO_OK;
   ss->cam_still = keep;
   session_set_view(ss, 0);

@@ -9,6 +9,7 @@ int cam_view_make(const camera *c, int width, int height, cam_view *v) {
   v->right = v3_norm(v3_cross(v->fwd, c->up));
   v->up = v3_cross(v->right, v->fwd);
   v->tan_half = tanf(0.5f * c->fov_deg * PI_F / 180.0f);
+  v->ortho_half = c->ortho_height > 0 ? 0.5f * c->ortho_height : 0;
   v->width = width;
   v->height = height;
   v->aspect = (float)width / (float)height;
@@ -20,21 +21,22 @@ ray camera_ray(const cam_lens *l, int px, int py, sampler *smp) {
   float jx, jy;
   sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
-  vec3 d = cam_view_dir(v, (float)px + jx, (float)py + jy);
   ray ry;
-  ry.o = v->o;
+  vec3 d;
+  cam_view_ray(v, (float)px + jx, (float)py + jy, &ry.o, &d);
   ry.tmax = INFINITY;
   float lu, lv;
   sampler_set_dim(smp, SDIM_LENS);
   sampler_2d(smp, &lu, &lv);
   sampler_set_dim(smp, SDIM_WAVELENGTH);
   if (l->aperture > 0) {
-    /* Thin lens: every ray through the lens meets at the plane of focus. */
+    /* Thin lens: every ray through the lens meets at the plane of focus (an orthographic
+     * camera's lens sits around the ray's own point of the camera plane). */
     float ft = l->focus / v3_dot(d, v->fwd);
-    vec3 pf = v3_add(v->o, v3_scale(d, ft));
+    vec3 pf = v3_add(ry.o, v3_scale(d, ft));
     float dx, dy;
     sample_concentric_disk(lu, lv, &dx, &dy);
-    ry.o = v3_add(v->o, v3_add(v3_scale(v->right, dx * l->aperture), v3_scale(v->up, dy * l->aperture)));
+    ry.o = v3_add(ry.o, v3_add(v3_scale(v->right, dx * l->aperture), v3_scale(v->up, dy * l->aperture)));
     d = v3_norm(v3_sub(pf, ry.o));
   }
   ry.d = d;

@@ -1,20 +1,21 @@
-/* camera.h — owns camera rays: the pinhole basis of one frame (cam_view: from the scene's
- * camera, or its keyframes at frame f), the ray through a film point, the film point
- * where a world point is seen, and the thin lens (cam_lens) that every integrator's
- * camera rays go through — the per-ray tile loop's and ReSTIR's G-buffer alike. It sits
- * in the scene model, below both. Film coordinates are pixels from the top-left corner
- * (x right, y down). */
+/* camera.h — owns camera rays: the basis of one frame's perspective or orthographic camera
+ * (cam_view: from the scene's camera, or its keyframes at frame f), the ray through a film
+ * point, the film point where a world point is seen, and the thin lens (cam_lens) that
+ * every integrator's camera rays go through — the per-ray tile loop's and ReSTIR's
+ * G-buffer alike. It sits in the scene model, below both. Film coordinates are pixels
+ * from the top-left corner (x right, y down). */
 #ifndef VALO_CAMERA_H
 #define VALO_CAMERA_H
 #include "core/rng.h"
 #include "geometry/accel.h"
 #include "scene/scene.h"
 
-/* A pinhole camera on a film: unit basis, tangent of half the vertical field of view and
- * the film's aspect. */
+/* A camera on a film: unit basis and the film's aspect; a perspective camera's tangent of
+ * half the vertical field of view, or an orthographic camera's half height in scene
+ * units (ortho_half > 0; then o is the centre of the plane the rays start from). */
 typedef struct cam_view {
   vec3 o, fwd, right, up;
-  float tan_half, aspect;
+  float tan_half, ortho_half, aspect;
   int width, height;
 } cam_view;
 
@@ -25,26 +26,42 @@ typedef struct cam_lens {
   float aperture, focus;
 } cam_lens;
 
-/* The pinhole basis of camera c on a width x height film; -1 when up is parallel to the
- * view direction. */
+/* The basis of camera c on a width x height film; -1 when up is parallel to the view
+ * direction. */
 int cam_view_make(const camera *c, int width, int height, cam_view *v);
 
-/* Unit direction of the pinhole ray through film point (fx, fy). */
-static inline vec3 cam_view_dir(const cam_view *v, float fx, float fy) {
-  float sx = (2.0f * fx / (float)v->width - 1.0f) * v->tan_half * v->aspect;
-  float sy = (1.0f - 2.0f * fy / (float)v->height) * v->tan_half;
-  return v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
+/* The pinhole ray through film point (fx, fy): unit direction *d from *o. An
+ * orthographic camera's rays all run along fwd, from the point of its plane that the film
+ * point covers. */
+static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, vec3 *d) {
+  float ax = 2.0f * fx / (float)v->width - 1.0f, ay = 1.0f - 2.0f * fy / (float)v->height;
+  if (v->ortho_half > 0) {
+    *o = v3_add(v->o, v3_add(v3_scale(v->right, ax * v->ortho_half * v->aspect), v3_scale(v->up, ay * v->ortho_half)));
+    *d = v->fwd;
+    return;
+  }
+  float sx = ax * v->tan_half * v->aspect, sy = ay * v->tan_half;
+  *o = v->o;
+  *d = v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
 }
-/* Film point where p is seen (the inverse of cam_view_dir); 0 when p is behind the camera
- * or off the film. */
+/* Film point where p is seen (the inverse of cam_view_ray); 0 when p is behind the camera
+ * (or its plane) or off the film. */
 static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
   vec3 d = v3_sub(p, v->o);
   float z = v3_dot(d, v->fwd);
   if (!(z > 0)) return 0;
-  float sx = v3_dot(d, v->right) / (z * v->tan_half * v->aspect), sy = v3_dot(d, v->up) / (z * v->tan_half);
+  float hs = v->ortho_half > 0 ? v->ortho_half : z * v->tan_half;
+  float sx = v3_dot(d, v->right) / (hs * v->aspect), sy = v3_dot(d, v->up) / hs;
   *fx = (sx + 1.0f) * 0.5f * (float)v->width;
   *fy = (1.0f - sy) * 0.5f * (float)v->height;
   return *fx >= 0 && *fy >= 0 && *fx < (float)v->width && *fy < (float)v->height;
+}
+
+/* How far the camera is from p: its distance from the pinhole, or from an orthographic
+ * camera's plane (what ReSTIR compares between pixels and frames). */
+static inline float cam_view_depth(const cam_view *v, vec3 p) {
+  vec3 d = v3_sub(p, v->o);
+  return v->ortho_half > 0 ? v3_dot(d, v->fwd) : v3_len(d);
 }
 
 /* The camera ray of pixel (px, py) for one sample: the position in the pixel from the

@@ -269,6 +269,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
     /* Framed automatically (docs/scene-format.md): a front view, 40 degree vertical fov;
      * scene_camera_fit fits the distance to the bounds for the film's aspect (camera_frame). */
     s->cam.fov_deg = 40;
+    s->cam.ortho_height = 0;
     s->cam.look_at = s->center;
     s->cam.up = s->up_z ? v3(0, 0, 1) : v3(0, 1, 0);
     vec3 back = s->up_z ? v3(0, -1, 0) : v3(0, 0, 1);
@@ -382,9 +383,10 @@ camera scene_camera_at(const scene *s, const camera *still, float f) {
     c.look_at = v3_add(v3_scale(k[i].look_at, 1 - t), v3_scale(k[i + 1].look_at, t));
     c.up = v3_add(v3_scale(k[i].up, 1 - t), v3_scale(k[i + 1].up, t));
     c.fov_deg = k[i].fov_deg * (1 - t) + k[i + 1].fov_deg * t;
+    c.ortho_height = k[i].ortho_height * (1 - t) + k[i + 1].ortho_height * t;
     return c;
   }
-  c.pos = k[i].pos; c.look_at = k[i].look_at; c.up = k[i].up; c.fov_deg = k[i].fov_deg;
+  c.pos = k[i].pos; c.look_at = k[i].look_at; c.up = k[i].up; c.fov_deg = k[i].fov_deg; c.ortho_height = k[i].ortho_height;
   return c;
 }
 

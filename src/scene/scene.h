@@ -71,14 +71,16 @@ typedef struct light {
 
 typedef struct camera {
   vec3 pos, look_at, up;
-  float fov_deg;          /* vertical */
+  float fov_deg;          /* vertical (a perspective camera) */
+  float ortho_height;     /* > 0: orthographic, the view's height in scene units (fov_deg
+                             unused); 0: perspective */
   float aperture_radius, focus_distance;
 } camera;
 
 /* One keyframe of a camera animation: the camera at frame `frame` (frames between
- * keyframes interpolate position, look_at, up and fov linearly; before the first and
- * after the last the camera holds still). */
-typedef struct cam_key { float frame; vec3 pos, look_at, up; float fov_deg; } cam_key;
+ * keyframes interpolate position, look_at, up and fov, or an orthographic camera's
+ * height, linearly; before the first and after the last the camera holds still). */
+typedef struct cam_key { float frame; vec3 pos, look_at, up; float fov_deg, ortho_height; } cam_key;
 
 /* Triangle flags. */
 enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
