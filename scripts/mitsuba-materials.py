@@ -23,7 +23,8 @@
 #  - environment: valo's map has its centre looking down -z and u growing towards +x;
 #    Mitsuba's envmap has u = 0 at -z, so its to_world is a turn of 180 + rotation degrees
 #    about +y where valo's is `rotation`; both look the map up bilinearly;
-#  - camera: pinhole, vertical fov, box pixel filter one pixel wide; path tracing with no
+#  - camera: pinhole, vertical fov, box pixel filter one pixel wide (ortho-gaussian: both
+#    renderers' Gaussian filter, standard deviation 0.5 px cut at 2 px); path tracing with no
 #    depth limit (Russian roulette from depth 5); an independent sampler;
 #  - orthographic camera (CAMERA_SCENES): Mitsuba's "orthographic" sees x in [-1, 1] and
 #    y in [-1/aspect, 1/aspect] of its camera space, so valo's view height H is a to_world
@@ -71,9 +72,10 @@ LIGHT_SCENES = {
     "sun-light": [{"type": "directional", "direction": [-0.4, -1, -0.5], "irradiance": [3, 3, 3]}],
 }
 # The diffuse sphere (0.7) on the floor under the lamp, seen by an orthographic camera of
-# view height 1.6 from the usual place, on a film of aspect 1.6.
-CAMERA_SCENES = {"ortho-camera": {"type": "orthographic", "height": 1.6, "position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0],
-                                  "up": [0, 1, 0]}}
+# view height 1.6 from the usual place, on a film of aspect 1.6; and the same through the
+# Gaussian pixel filter (valo's film.filter, Mitsuba's rfilter, both at their defaults).
+ORTHO = {"type": "orthographic", "height": 1.6, "position": [0, 1.1, 3.6], "look_at": [0, 0.55, 0], "up": [0, 1, 0]}
+CAMERA_SCENES = {"ortho-camera": {"camera": ORTHO, "filter": "box"}, "ortho-gaussian": {"camera": ORTHO, "filter": "gaussian"}}
 ORTHO_W, ORTHO_H = 128, 80
 # A quad textured with an sRGB PNG under a uniform white environment (radiance = albedo):
 # quadrants red, green, blue, yellow from the image's top-left, so a flipped u or v shows.
@@ -164,10 +166,12 @@ def texture_json(name, tex):
             "environment": {"type": "constant", "radiance": 1}}
 
 
-def camera_json(name, cam):
+def camera_json(name, view):
     j = valo_json(name, {"type": "diffuse", "reflectance": 0.7})
-    j["camera"] = cam
+    j["camera"] = view["camera"]
     j["film"] = {"width": ORTHO_W, "height": ORTHO_H}
+    if view["filter"] != "box":
+        j["film"]["filter"] = view["filter"]
     return j
 
 
@@ -238,7 +242,8 @@ def scene_dict(mi, name, mat, spp):
         return d, 96, 96
     if name in CAMERA_SCENES:
         d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)
-        d["sensor"] = sensor(mi, mat, ORTHO_W, ORTHO_H, spp)
+        d["sensor"] = sensor(mi, mat["camera"], ORTHO_W, ORTHO_H, spp)
+        d["sensor"]["film"]["rfilter"] = {"type": mat["filter"]}
         return d, ORTHO_W, ORTHO_H
     if name in LIGHT_SCENES:
         d, w, h = scene_dict(mi, "gold-rough", {"type": "diffuse", "reflectance": 0.7}, spp)

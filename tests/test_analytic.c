@@ -730,6 +730,54 @@ static int orthographic_gltf_camera(void) {
   return 0;
 }
 
+/* Pixel filters (film.filter): an orthographic view, one scene unit per pixel, of an
+ * emitting half-plane whose edge crosses the film at x = 8.3 pixels. With filter
+ * importance sampling a pixel whose centre lies d pixels left of the edge sees the share
+ * of the filter beyond d: for the box 1/2 - d/(2r) clipped to [0, 1], for the tent and
+ * Mitsuba's windowed Gaussian their integrals (the Gaussian's by quadrature here,
+ * independent of valo's table). Every row must show that profile. */
+static double filter_share(const char *name, double r, double d) {
+  if (d >= r) return 0;
+  if (d <= -r) return 1;
+  if (!strcmp(name, "box")) return 0.5 - d / (2 * r);
+  if (!strcmp(name, "tent")) { double t = 1 - fabs(d) / r; return d > 0 ? 0.5 * t * t : 1 - 0.5 * t * t; }
+  double sd = r / 4, a = -1 / (2 * sd * sd), bias = exp(a * r * r), all = 0, part = 0;
+  for (int j = 0; j < 20000; j++) {
+    double x = -r + (j + 0.5) * 2 * r / 20000, g = exp(a * x * x) - bias;
+    all += g;
+    if (x > d) part += g;
+  }
+  return part / all;
+}
+static int pixel_filter_edge(void) {
+  CHECK(scratch_file("halfplane.obj", "v 0.3 -100 -1\nv 100 -100 -1\nv 100 100 -1\nv 0.3 100 -1\nf 1 2 3 4\n"), "cannot write the mesh");
+  static const struct { const char *name; double radius; } fs[] = {{"box", 0.5}, {"box", 1.5}, {"tent", 1}, {"gaussian", 2}, {"gaussian", 1.2}};
+  for (size_t k = 0; k < sizeof fs / sizeof fs[0]; k++) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"type\": \"orthographic\", \"height\": 16, \"position\": [0,0,0], \"look_at\": [0,0,-1]},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16, \"filter\": \"%s\", \"filter_radius\": %g}, \"render\": {\"spp\": 256},\n"
+             "  \"materials\": {\"e\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1}},\n"
+             "  \"shapes\": [{\"file\": \"halfplane.obj\", \"material\": \"e\"}] }\n", fs[k].name, fs[k].radius);
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "%s: render failed", fs[k].name);
+    double worst = 0;
+    int wx = -1;
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++) {
+        double e = fabs(px[3 * (y * w + x) + 1] - filter_share(fs[k].name, fs[k].radius, 8.3 - (x + 0.5)));
+        if (e > worst) { worst = e; wx = x; }
+      }
+    fprintf(stderr, "filter %s radius %g: row 8 ", fs[k].name, fs[k].radius);
+    for (int x = 4; x < 13; x++) fprintf(stderr, "%.3f/%.3f ", px[3 * (8 * w + x) + 1], filter_share(fs[k].name, fs[k].radius, 8.3 - (x + 0.5)));
+    fprintf(stderr, "(rendered/predicted); worst %.4f at column %d\n", worst, wx);
+    free(px);
+    CHECK(worst < 0.01, "%s radius %g: a pixel differs from the predicted profile by %.4f (column %d)", fs[k].name, fs[k].radius, worst, wx);
+  }
+  return 0;
+}
+
 /* Adaptive sampling on the albedo-0.5 furnace (64x64): the budget is used exactly,
  * background pixels (zero variance, away from the sphere: the rule looks at 17x17
  * neighbourhoods) get no more than the first pass (half the budget), sphere pixels get
@@ -877,7 +925,8 @@ int main(int argc, char **argv) {
                                     {"aovs", aovs},
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {"thin_lens_gltf_camera", thin_lens_gltf_camera},
-                                    {"orthographic_camera", orthographic_camera}, {"orthographic_gltf_camera", orthographic_gltf_camera}, {"thin_lens_restir", thin_lens_restir},
+                                    {"orthographic_camera", orthographic_camera}, {"orthographic_gltf_camera", orthographic_gltf_camera},
+                                    {"pixel_filter_edge", pixel_filter_edge}, {"thin_lens_restir", thin_lens_restir},
                                     {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased},
                                     {"adaptive_pays_caustic", adaptive_pays_caustic}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};

@@ -93,6 +93,56 @@ static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
 /* An orthographic camera (camera.type): the diffuse sphere under the lamp on a film of
  * aspect 1.6, against Mitsuba's "orthographic" sensor scaled to the same view. */
 static int ortho_camera(void) { return against_mitsuba("ortho-camera", 256, 16, 0); }
+
+/* The Gaussian pixel filter (film.filter) against Mitsuba's, on the same view: the image
+ * as above, and on the silhouette's pixels (where the box reference's green changes by
+ * more than 0.05 per pixel, central differences), where filters differ, the mean absolute
+ * difference must stay below 1.5 % of the reference's mean there and below half of that
+ * against the box-filtered reference. */
+static int edge_difference(const float *img, const image *ref, const image *mask, double *rel) {
+  double diff = 0, sum = 0;
+  int n = 0, w = ref->w, h = ref->h;
+  for (int y = 1; y < h - 1; y++)
+    for (int x = 1; x < w - 1; x++) {
+      const float *m = mask->rgb;
+      double gx = (m[3 * (y * w + x + 1) + 1] - m[3 * (y * w + x - 1) + 1]) / 2, gy = (m[3 * ((y + 1) * w + x) + 1] - m[3 * ((y - 1) * w + x) + 1]) / 2;
+      if (!(hypot(gx, gy) > 0.05)) continue;
+      for (int c = 0; c < 3; c++) { diff += fabs(img[3 * (y * w + x) + c] - ref->rgb[3 * (y * w + x) + c]); sum += ref->rgb[3 * (y * w + x) + c]; }
+      n++;
+    }
+  *rel = sum > 0 ? diff / sum : 1;
+  return n;
+}
+static int gaussian_filter(void) {
+  int rc = against_mitsuba("ortho-gaussian", 256, 16, 0);
+  if (rc) return rc;
+  valo_options o;
+  valo_options_init(&o);
+  o.spp = test_full() ? 4096 : 1024;
+  o.seed = 5;
+  valo_scene *sc;
+  valo_render *r = render_file(DATA "ortho-gaussian.json", &o, &sc);
+  CHECK(r, "render failed or lost samples");
+  float *img = malloc(128 * 80 * 3 * sizeof *img);
+  valo_render_pixels(r, img);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  image gauss, box;
+  valo_error err;
+  CHECK(image_read(DATA "ortho-gaussian-mitsuba.exr", &gauss, &err) == VALO_OK && image_read(DATA "ortho-camera-mitsuba.exr", &box, &err) == VALO_OK,
+        "%s", err.message);
+  double rel_gauss, rel_box;
+  int n = edge_difference(img, &gauss, &box, &rel_gauss);
+  edge_difference(img, &box, &box, &rel_box);
+  fprintf(stderr, "gaussian filter at %d spp, %d silhouette pixels: mean difference %.2f %% from Mitsuba's gaussian, %.2f %% from its box\n", o.spp, n,
+          100 * rel_gauss, 100 * rel_box);
+  free(img);
+  image_free(&gauss);
+  image_free(&box);
+  CHECK(n > 100, "only %d silhouette pixels", n);
+  CHECK(rel_gauss < 0.015 && rel_gauss < 0.5 * rel_box, "silhouette: %.2f %% from Mitsuba's gaussian, %.2f %% from its box", 100 * rel_gauss, 100 * rel_box);
+  return 0;
+}
 /* a diffuse and a rough gold sphere lit only by a map turned 60 degrees: the background
  * pixels check the map's orientation and rotation, the spheres its sampling. 32x32
  * blocks: Mitsuba spreads the map's rows over [0, 1] from centre to centre, valo from
@@ -106,7 +156,7 @@ static int env_spheres(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
-                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"textured_quad", textured_quad},
+                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {NULL, NULL}};

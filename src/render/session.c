@@ -79,6 +79,11 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
     goto fail;
   }
   ss->view_prev = ss->lens.view;
+  if (pixel_filter_make(&ss->filter, o.filter, o.filter_radius != VALO_UNSET ? o.filter_radius : 0)) {
+    st = err_set(err, VALO_ERR_INVALID, "unknown pixel filter \"%s\" (box, tent or gaussian)", o.filter);
+    goto fail;
+  }
+  ss->lens.filter = ss->filter.kind == FILTER_BOX && ss->filter.radius == 0.5f ? NULL : &ss->filter;
   ss->lens.aperture = o.aperture_radius != VALO_UNSET ? (float)o.aperture_radius : c->aperture_radius;
   ss->lens.focus = o.focus_distance != VALO_UNSET ? (float)o.focus_distance : c->focus_distance;
   if (!(ss->lens.focus > 0)) {

@@ -21,9 +21,14 @@ ray camera_ray(const cam_lens *l, int px, int py, sampler *smp) {
   float jx, jy;
   sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
+  float fx = (float)px + jx, fy = (float)py + jy;
+  if (l->filter) {
+    fx = (float)px + 0.5f + pixel_filter_sample(l->filter, jx);
+    fy = (float)py + 0.5f + pixel_filter_sample(l->filter, jy);
+  }
   ray ry;
   vec3 d;
-  cam_view_ray(v, (float)px + jx, (float)py + jy, &ry.o, &d);
+  cam_view_ray(v, fx, fy, &ry.o, &d);
   ry.tmax = INFINITY;
   float lu, lv;
   sampler_set_dim(smp, SDIM_LENS);

@@ -9,6 +9,7 @@
 #include "core/rng.h"
 #include "geometry/accel.h"
 #include "scene/scene.h"
+#include "scene/filter.h"
 
 /* A camera on a film: unit basis and the film's aspect; a perspective camera's tangent of
  * half the vertical field of view, or an orthographic camera's half height in scene
@@ -20,10 +21,12 @@ typedef struct cam_view {
 } cam_view;
 
 /* A frame's camera with its lens: radius 0 is a pinhole; focus is the distance along the
- * view axis of the plane in focus. */
+ * view axis of the plane in focus; and the pixel filter its samples are drawn from (NULL:
+ * the box of one pixel). */
 typedef struct cam_lens {
   cam_view view;
   float aperture, focus;
+  const pixel_filter *filter;
 } cam_lens;
 
 /* The basis of camera c on a width x height film; -1 when up is parallel to the view
@@ -64,8 +67,8 @@ static inline float cam_view_depth(const cam_view *v, vec3 p) {
   return v->ortho_half > 0 ? v3_dot(d, v->fwd) : v3_len(d);
 }
 
-/* The camera ray of pixel (px, py) for one sample: the position in the pixel from the
- * sampler's SDIM_FILM dimensions, the point on the lens from SDIM_LENS (drawn for a
+/* The camera ray of pixel (px, py) for one sample: the position in the pixel (or around
+ * its centre, drawn from the lens's filter) from the sampler's SDIM_FILM dimensions, the point on the lens from SDIM_LENS (drawn for a
  * pinhole too, so streams do not shift); leaves the sampler at SDIM_WAVELENGTH. */
 ray camera_ray(const cam_lens *l, int px, int py, sampler *smp);
 #endif
