@@ -733,9 +733,9 @@ static int orthographic_gltf_camera(void) {
 /* Pixel filters (film.filter): an orthographic view, one scene unit per pixel, of an
  * emitting half-plane whose edge crosses the film at x = 8.3 pixels. With filter
  * importance sampling a pixel whose centre lies d pixels left of the edge sees the share
- * of the filter beyond d: for the box 1/2 - d/(2r) clipped to [0, 1], for the tent and
- * Mitsuba's windowed Gaussian their integrals (the Gaussian's by quadrature here,
- * independent of valo's table). Every row must show that profile. */
+ * of the filter beyond d: for the box 1/2 - d/(2r) clipped to [0, 1], for the tent,
+ * Mitsuba's windowed Gaussian and Cycles' Blackman-Harris their integrals (the last two by
+ * quadrature here, independent of valo's tables). Every row must show that profile. */
 static double filter_share(const char *name, double r, double d) {
   if (d >= r) return 0;
   if (d <= -r) return 1;
@@ -743,7 +743,8 @@ static double filter_share(const char *name, double r, double d) {
   if (!strcmp(name, "tent")) { double t = 1 - fabs(d) / r; return d > 0 ? 0.5 * t * t : 1 - 0.5 * t * t; }
   double sd = r / 4, a = -1 / (2 * sd * sd), bias = exp(a * r * r), all = 0, part = 0;
   for (int j = 0; j < 20000; j++) {
-    double x = -r + (j + 0.5) * 2 * r / 20000, g = exp(a * x * x) - bias;
+    double x = -r + (j + 0.5) * 2 * r / 20000, v = 2 * M_PI * (x / (2 * r) + 0.5);
+    double g = !strcmp(name, "gaussian") ? exp(a * x * x) - bias : 0.35875 - 0.48829 * cos(v) + 0.14128 * cos(2 * v) - 0.01168 * cos(3 * v);
     all += g;
     if (x > d) part += g;
   }
@@ -751,7 +752,7 @@ static double filter_share(const char *name, double r, double d) {
 }
 static int pixel_filter_edge(void) {
   CHECK(scratch_file("halfplane.obj", "v 0.3 -100 -1\nv 100 -100 -1\nv 100 100 -1\nv 0.3 100 -1\nf 1 2 3 4\n"), "cannot write the mesh");
-  static const struct { const char *name; double radius; } fs[] = {{"box", 0.5}, {"box", 1.5}, {"tent", 1}, {"gaussian", 2}, {"gaussian", 1.2}};
+  static const struct { const char *name; double radius; } fs[] = {{"box", 0.5}, {"box", 1.5}, {"tent", 1}, {"gaussian", 2}, {"gaussian", 1.2}, {"blackman-harris", 1.5}};
   for (size_t k = 0; k < sizeof fs / sizeof fs[0]; k++) {
     char json[1024];
     snprintf(json, sizeof json,

@@ -85,10 +85,10 @@ typedef struct valo_options {
   double focus_distance;  /* distance to the plane of focus along the view axis, > 0;
                              VALO_UNSET = the scene's (file cameras: autofocus on the
                              surface at the image centre) */
-  char filter[16];        /* pixel reconstruction filter: "box" (default), "tent" or
-                             "gaussian" (docs/scene-format.md, "film") */
+  char filter[16];        /* pixel reconstruction filter: "box" (default), "tent",
+                             "gaussian" or "blackman-harris" (docs/scene-format.md, "film") */
   double filter_radius;   /* its radius in pixels; VALO_UNSET = the filter's default (box
-                             0.5, tent 1, gaussian 2) */
+                             0.5, tent 1, gaussian 2, blackman-harris 1.5) */
   int frames;             /* > 0: render a sequence of this many frames (the scene's
                              camera animation, or a static camera), each at spp samples
                              per pixel, calling the frame callback after each

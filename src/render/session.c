@@ -80,7 +80,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   }
   ss->view_prev = ss->lens.view;
   if (pixel_filter_make(&ss->filter, o.filter, o.filter_radius != VALO_UNSET ? o.filter_radius : 0)) {
-    st = err_set(err, VALO_ERR_INVALID, "unknown pixel filter \"%s\" (box, tent or gaussian)", o.filter);
+    st = err_set(err, VALO_ERR_INVALID, "unknown pixel filter \"%s\" (box, tent, gaussian or blackman-harris)", o.filter);
     goto fail;
   }
   ss->lens.filter = ss->filter.kind == FILTER_BOX && ss->filter.radius == 0.5f ? NULL : &ss->filter;

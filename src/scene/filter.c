@@ -3,26 +3,37 @@
 #include <math.h>
 #include <string.h>
 
+static const struct { const char *name; filter_kind kind; double radius; } kinds[] = {
+    {"box", FILTER_BOX, 0.5}, {"tent", FILTER_TENT, 1.0}, {"gaussian", FILTER_GAUSSIAN, 2.0}, {"blackman-harris", FILTER_BLACKMAN_HARRIS, 1.5}};
+
 double pixel_filter_default_radius(const char *name) {
-  return !strcmp(name, "box") ? 0.5 : !strcmp(name, "tent") ? 1.0 : !strcmp(name, "gaussian") ? 2.0 : 0.0;
+  for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
+    if (!strcmp(name, kinds[i].name)) return kinds[i].radius;
+  return 0;
 }
 
-/* The windowed Gaussian, unnormalised, at x. */
-static double gaussian(double x, double radius) {
-  double s = radius / 4, a = -1 / (2 * s * s);
-  return fmax(0.0, exp(a * x * x) - exp(a * radius * radius));
+/* A tabulated filter, unnormalised, at x in [-radius, radius]: the windowed Gaussian, or
+ * the four-term Blackman-Harris window across the whole width. */
+static double tabulated(filter_kind kind, double x, double radius) {
+  if (kind == FILTER_GAUSSIAN) {
+    double s = radius / 4, a = -1 / (2 * s * s);
+    return fmax(0.0, exp(a * x * x) - exp(a * radius * radius));
+  }
+  double t = 2 * M_PI * (x / (2 * radius) + 0.5);
+  return fmax(0.0, 0.35875 - 0.48829 * cos(t) + 0.14128 * cos(2 * t) - 0.01168 * cos(3 * t));
 }
 
 int pixel_filter_make(pixel_filter *f, const char *name, double radius) {
   double def = pixel_filter_default_radius(name);
   if (!(def > 0)) return -1;
   memset(f, 0, sizeof *f);
-  f->kind = !strcmp(name, "box") ? FILTER_BOX : !strcmp(name, "tent") ? FILTER_TENT : FILTER_GAUSSIAN;
+  for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
+    if (!strcmp(name, kinds[i].name)) f->kind = kinds[i].kind;
   f->radius = (float)(radius > 0 ? radius : def);
-  if (f->kind == FILTER_GAUSSIAN) {
+  if (f->kind == FILTER_GAUSSIAN || f->kind == FILTER_BLACKMAN_HARRIS) {
     double sum = 0, step = 2.0 * f->radius / FILTER_BINS, acc[FILTER_BINS + 1];
     acc[0] = 0;
-    for (int i = 0; i < FILTER_BINS; i++) acc[i + 1] = (sum += gaussian(-f->radius + (i + 0.5) * step, f->radius));
+    for (int i = 0; i < FILTER_BINS; i++) acc[i + 1] = (sum += tabulated(f->kind, -f->radius + (i + 0.5) * step, f->radius));
     for (int i = 0; i <= FILTER_BINS; i++) f->cdf[i] = (float)(acc[i] / sum);
     f->cdf[FILTER_BINS] = 1;
   }
@@ -35,7 +46,7 @@ float pixel_filter_pdf(const pixel_filter *f, float x) {
   switch (f->kind) {
     case FILTER_BOX: return 0.5f / r;
     case FILTER_TENT: return (1 - ax / r) / r;
-    case FILTER_GAUSSIAN: break;
+    case FILTER_GAUSSIAN: case FILTER_BLACKMAN_HARRIS: break;
   }
   int i = (int)((x + r) / (2 * r) * FILTER_BINS);
   i = i < 0 ? 0 : i >= FILTER_BINS ? FILTER_BINS - 1 : i;
@@ -47,7 +58,7 @@ float pixel_filter_sample(const pixel_filter *f, float u) {
   switch (f->kind) {
     case FILTER_BOX: return (2 * u - 1) * r;
     case FILTER_TENT: return u < 0.5f ? r * (sqrtf(2 * u) - 1) : r * (1 - sqrtf(2 - 2 * u));
-    case FILTER_GAUSSIAN: break;
+    case FILTER_GAUSSIAN: case FILTER_BLACKMAN_HARRIS: break;
   }
   int lo = 0, hi = FILTER_BINS; /* the bin with cdf[lo] <= u < cdf[lo + 1] */
   while (hi - lo > 1) {
