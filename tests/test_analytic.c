@@ -317,6 +317,52 @@ static int envmap_orientation(void) {
   return 0;
 }
 
+/* A spherical camera (camera.type "spherical": equirectangular, longitude 0 along the view
+ * direction growing to the right, latitude 90 degrees at the top) at the centre of a map
+ * of the same layout (u = (x + 0.5)/64 in red, v = (y + 0.5)/32 in green) sees the map
+ * itself: looking down -z (the map's centre) each pixel shows its own u and v; looking
+ * along +x the longitudes move a quarter turn (u + 0.25). The ramps are linear, so the
+ * map's bilinear lookup and the pixel's box average keep them, away from the seam of u
+ * and the poles' half texels. */
+static int spherical_camera(void) {
+  float *px = malloc(sizeof(float) * 64 * 32 * 3);
+  for (int y = 0; y < 32; y++)
+    for (int x = 0; x < 64; x++) {
+      px[3 * (y * 64 + x)] = (x + 0.5f) / 64;
+      px[3 * (y * 64 + x) + 1] = (y + 0.5f) / 32;
+      px[3 * (y * 64 + x) + 2] = 0.5f;
+    }
+  char path[1200];
+  snprintf(path, sizeof path, "%s/ramps.pfm", scratch_dir());
+  valo_error err;
+  CHECK(image_write(path, 64, 32, px, NULL, &err) == VALO_OK, "%s", err.message);
+  free(px);
+  for (int turn = 0; turn < 2; turn++) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"type\": \"spherical\", \"position\": [0,0,0], \"look_at\": [%d,0,%d], \"up\": [0,1,0]},\n"
+             "  \"film\": {\"width\": 64, \"height\": 32}, \"render\": {\"spp\": 16},\n"
+             "  \"environment\": {\"type\": \"map\", \"file\": \"ramps.pfm\"} }\n", turn ? 1 : 0, turn ? 0 : -1);
+    int w, h;
+    float *img = render_json_text(json, NULL, &w, &h);
+    CHECK(img && w == 64 && h == 32, "render failed");
+    double worst = 0;
+    int wx = 0, wy = 0;
+    for (int y = 1; y < 31; y++)
+      for (int x = 0; x < 64; x++) {
+        double u = (x + 0.5) / 64 + 0.25 * turn;
+        u -= floor(u);
+        if (u < 1.5 / 64 || u > 1 - 1.5 / 64) continue; /* the map's seam: bilinear across it */
+        double e = fmax(fabs(img[3 * (y * 64 + x)] - u), fabs(img[3 * (y * 64 + x) + 1] - (y + 0.5) / 32));
+        if (e > worst) { worst = e; wx = x; wy = y; }
+      }
+    fprintf(stderr, "spherical camera looking along %s: largest difference from the map %.4f at (%d, %d)\n", turn ? "+x" : "-z", worst, wx, wy);
+    free(img);
+    CHECK(worst < 0.01, "looking along %s the image differs from the map by %.4f at (%d, %d)", turn ? "+x" : "-z", worst, wx, wy);
+  }
+  return 0;
+}
+
 /* Irradiance from a map: a 64x32 map with a vertical gradient and a hot spot,
  * turned 30 degrees, lights a diffuse quad facing +x (albedo 0.8, nothing else in the
  * scene). Its radiance must be 0.8 E / pi, with E integrated here over the map as the
@@ -964,7 +1010,8 @@ int main(int argc, char **argv) {
                                     {"thin_lens_circle_of_confusion", thin_lens_circle_of_confusion},
                                     {"thin_lens_gltf_camera", thin_lens_gltf_camera},
                                     {"orthographic_camera", orthographic_camera}, {"orthographic_gltf_camera", orthographic_gltf_camera},
-                                    {"pixel_filter_edge", pixel_filter_edge}, {"pixel_filter_cycles", pixel_filter_cycles}, {"thin_lens_restir", thin_lens_restir},
+                                    {"pixel_filter_edge", pixel_filter_edge}, {"pixel_filter_cycles", pixel_filter_cycles},
+                                    {"spherical_camera", spherical_camera}, {"thin_lens_restir", thin_lens_restir},
                                     {"adaptive_sampling", adaptive_sampling}, {"adaptive_unbiased", adaptive_unbiased},
                                     {"adaptive_pays_caustic", adaptive_pays_caustic}, {"auto_framing", auto_framing},
                                     {NULL, NULL}};

@@ -250,11 +250,13 @@ VALO_API int valo_render_rank_stats(const valo_render *r, int k, valo_rank_stats
 /* Interactive rendering (valo view): the camera moves between steps and the film is
  * shown as it fills. A camera: position, the point looked at, the up direction and the
  * vertical field of view in degrees, or an orthographic camera's height in scene units
- * (ortho_height > 0; 0: perspective). */
+ * (ortho_height > 0; 0: perspective); spherical: it sees every direction (equirectangular;
+ * field of view and height unused). */
 typedef struct valo_camera {
   double pos[3], look_at[3], up[3];
   double fov_deg;
   double ortho_height;
+  int spherical;
 } valo_camera;
 VALO_API void valo_render_camera(const valo_render *r, valo_camera *out);
 /* Moves the camera (lens and focus unchanged); the next step should restart the film.

@@ -174,6 +174,7 @@ VALO_API void valo_render_camera(const valo_render *r, valo_camera *o) {
   for (int k = 0; k < 3; k++) { d[k][0] = v[k].x; d[k][1] = v[k].y; d[k][2] = v[k].z; }
   o->fov_deg = c->fov_deg;
   o->ortho_height = c->ortho_height;
+  o->spherical = c->spherical;
 }
 
 VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c, valo_error *err) {
@@ -185,6 +186,7 @@ VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c
   cam.up = v3((float)c->up[0], (float)c->up[1], (float)c->up[2]);
   cam.fov_deg = (float)c->fov_deg;
   cam.ortho_height = (float)c->ortho_height;
+  cam.spherical = c->spherical != 0;
   return session_set_camera(r->ss, &cam, err);
 }
 

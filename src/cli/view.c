@@ -216,7 +216,8 @@ static void cam_zoom(valo_camera *c, double factor) {
 
 static void print_camera(const valo_camera *c) {
   char size[64];
-  if (c->ortho_height > 0) snprintf(size, sizeof size, "\"type\": \"orthographic\", \"height\": %.6g", c->ortho_height);
+  if (c->spherical) snprintf(size, sizeof size, "\"type\": \"spherical\"");
+  else if (c->ortho_height > 0) snprintf(size, sizeof size, "\"type\": \"orthographic\", \"height\": %.6g", c->ortho_height);
   else snprintf(size, sizeof size, "\"fov\": %.6g", c->fov_deg);
   printf("\"camera\": {\"position\": [%.6g, %.6g, %.6g], \"look_at\": [%.6g, %.6g, %.6g], \"up\": [%.6g, %.6g, %.6g], %s}\n",
          c->pos[0], c->pos[1], c->pos[2], c->look_at[0], c->look_at[1], c->look_at[2], c->up[0], c->up[1], c->up[2], size);

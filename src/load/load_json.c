@@ -24,16 +24,20 @@ static valo_status check_view(jctx *c, const char *where, vec3 pos, vec3 look_at
   return VALO_OK;
 }
 
-/* The camera's field of view or height, whichever its kind takes: the other key is an
- * error naming both. */
-static valo_status get_view_size(jctx *c, const cJSON *o, const char *where, int ortho, float *fov_deg, float *height) {
-  const char *wrong = ortho ? "fov" : "height";
-  if (cJSON_GetObjectItemCaseSensitive(o, wrong)) {
+/* The camera's field of view or height, whichever its kind takes (a spherical camera
+ * neither): another is an error naming what the kind takes. */
+static valo_status get_view_size(jctx *c, const cJSON *o, const char *where, const camera *kind, float *fov_deg, float *height) {
+  int ortho = kind->ortho_height > 0;
+  for (int k = 0; k < 2; k++) {
+    const char *key = k ? "height" : "fov";
+    if (!cJSON_GetObjectItemCaseSensitive(o, key) || (!kind->spherical && ortho == k)) continue;
     char w[96];
-    snprintf(w, sizeof w, "%s.%s", where, wrong);
-    return json_bad(c, w, ortho ? "an orthographic camera has no field of view; give its \"height\" in scene units"
-                                : "\"height\" is an orthographic camera's; a perspective camera takes \"fov\" (or give \"type\": \"orthographic\")");
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return json_bad(c, w, kind->spherical ? "a spherical camera sees every direction: it has no field of view or height"
+                          : ortho         ? "an orthographic camera has no field of view; give its \"height\" in scene units"
+                                          : "\"height\" is an orthographic camera's; a perspective camera takes \"fov\" (or give \"type\": \"orthographic\")");
   }
+  if (kind->spherical) return VALO_OK;
   double d = ortho ? *height : *fov_deg;
   if (ortho) { TRY(json_get_num(c, o, "height", where, 1e-6, 1e9, &d)); *height = (float)d; }
   else { TRY(json_get_num(c, o, "fov", where, 1e-3, 179.9, &d)); *fov_deg = (float)d; }
@@ -66,7 +70,7 @@ static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
     TRY(json_get_vec(c, e, "position", where, 0, &k[i].pos));
     TRY(json_get_vec(c, e, "look_at", where, 0, &k[i].look_at));
     TRY(json_get_vec(c, e, "up", where, 0, &k[i].up));
-    TRY(get_view_size(c, e, where, cam->ortho_height > 0, &k[i].fov_deg, &k[i].ortho_height));
+    TRY(get_view_size(c, e, where, cam, &k[i].fov_deg, &k[i].ortho_height));
     TRY(check_view(c, where, k[i].pos, k[i].look_at, k[i].up));
   }
   return VALO_OK;
@@ -95,17 +99,21 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
     return VALO_OK;
   }
   cam->pos = v3(0, 0, 5); cam->look_at = v3(0, 0, 0); cam->up = v3(0, 1, 0);
-  cam->fov_deg = 40; cam->ortho_height = 0; cam->aperture_radius = 0; cam->focus_distance = -1;
+  cam->fov_deg = 40; cam->ortho_height = 0; cam->spherical = 0; cam->aperture_radius = 0; cam->focus_distance = -1;
   const char *type = "perspective";
   TRY(json_get_str(c, o, "type", "camera", &type));
   int ortho = !strcmp(type, "orthographic");
-  if (!ortho && strcmp(type, "perspective")) return json_bad(c, "camera.type", "must be \"perspective\" or \"orthographic\"");
+  cam->spherical = !strcmp(type, "spherical");
+  if (!ortho && !cam->spherical && strcmp(type, "perspective"))
+    return json_bad(c, "camera.type", "must be \"perspective\", \"orthographic\" or \"spherical\"");
   if (ortho) cam->ortho_height = 2; /* the view from -1 to 1, as pbrt's default screen window */
+  if (cam->spherical && cJSON_GetObjectItemCaseSensitive(o, "aperture_radius"))
+    return json_bad(c, "camera.aperture_radius", "a spherical camera has no lens");
   double d;
   TRY(json_get_vec(c, o, "position", "camera", 0, &cam->pos));
   TRY(json_get_vec(c, o, "look_at", "camera", 0, &cam->look_at));
   TRY(json_get_vec(c, o, "up", "camera", 0, &cam->up));
-  TRY(get_view_size(c, o, "camera", ortho, &cam->fov_deg, &cam->ortho_height));
+  TRY(get_view_size(c, o, "camera", cam, &cam->fov_deg, &cam->ortho_height));
   d = 0; TRY(json_get_num(c, o, "aperture_radius", "camera", 0, 1e6, &d)); cam->aperture_radius = (float)d;
   d = -1; TRY(json_get_num(c, o, "focus_distance", "camera", 1e-6, 1e9, &d)); cam->focus_distance = (float)d;
   TRY(check_view(c, "camera", cam->pos, cam->look_at, cam->up));

@@ -85,6 +85,10 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   }
   ss->lens.filter = ss->filter.kind == FILTER_BOX && ss->filter.radius == 0.5f ? NULL : &ss->filter;
   ss->lens.aperture = o.aperture_radius != VALO_UNSET ? (float)o.aperture_radius : c->aperture_radius;
+  if (c->spherical && ss->lens.aperture > 0) {
+    st = err_set(err, VALO_ERR_INVALID, "%s: a spherical camera has no lens (aperture %g)", s->path, (double)ss->lens.aperture);
+    goto fail;
+  }
   ss->lens.focus = o.focus_distance != VALO_UNSET ? (float)o.focus_distance : c->focus_distance;
   if (!(ss->lens.focus > 0)) {
     /* Autofocus (file cameras carry no focus distance): the surface at the image
@@ -273,7 +277,8 @@ valo_status session_set_camera(session *ss, const camera *c, valo_error *err) {
   if (ss->opt.frames > 0) return err_set(err, VALO_ERR_INVALID, "the camera of a sequence (frames) follows the scene's animation");
   if (!(c->ortho_height >= 0 && c->ortho_height < 1e30f))
     return err_set(err, VALO_ERR_INVALID, "orthographic height %g: must be positive and finite (0: a perspective camera)", (double)c->ortho_height);
-  if (!(c->ortho_height > 0) && !(c->fov_deg > 0 && c->fov_deg < 180))
+  if (c->spherical && ss->lens.aperture > 0) return err_set(err, VALO_ERR_INVALID, "a spherical camera has no lens");
+  if (!c->spherical && !(c->ortho_height > 0) && !(c->fov_deg > 0 && c->fov_deg < 180))
     return err_set(err, VALO_ERR_INVALID, "field of view %g: must be in (0, 180) degrees", (double)c->fov_deg);
   camera keep = ss->cam_still;
   ss->cam_still.pos = c->pos;
@@ -281,6 +286,7 @@ valo_status session_set_camera(session *ss, const camera *c, valo_error *err) {
   ss->cam_still.up = c->up;
   ss->cam_still.fov_deg = c->fov_deg;
   ss->cam_still.ortho_height = c->ortho_height;
+  ss->cam_still.spherical = c->spherical;
   if (v3_len(v3_sub(c->look_at, c->pos)) > 0 && !session_set_view(ss, 0)) return VALO_OK;
   ss->cam_still = keep;
   session_set_view(ss, 0);

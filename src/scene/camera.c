@@ -10,6 +10,7 @@ int cam_view_make(const camera *c, int width, int height, cam_view *v) {
   v->up = v3_cross(v->right, v->fwd);
   v->tan_half = tanf(0.5f * c->fov_deg * PI_F / 180.0f);
   v->ortho_half = c->ortho_height > 0 ? 0.5f * c->ortho_height : 0;
+  v->spherical = c->spherical;
   v->width = width;
   v->height = height;
   v->aspect = (float)width / (float)height;

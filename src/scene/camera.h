@@ -12,11 +12,14 @@
 #include "scene/filter.h"
 
 /* A camera on a film: unit basis and the film's aspect; a perspective camera's tangent of
- * half the vertical field of view, or an orthographic camera's half height in scene
- * units (ortho_half > 0; then o is the centre of the plane the rays start from). */
+ * half the vertical field of view, an orthographic camera's half height in scene units
+ * (ortho_half > 0; then o is the centre of the plane the rays start from), or a spherical
+ * camera (equirectangular: the film's x is the longitude from -180 to 180 degrees, 0
+ * along fwd and growing toward right; its y the latitude from 90, along up, to -90). */
 typedef struct cam_view {
   vec3 o, fwd, right, up;
   float tan_half, ortho_half, aspect;
+  int spherical;
   int width, height;
 } cam_view;
 
@@ -38,6 +41,12 @@ int cam_view_make(const camera *c, int width, int height, cam_view *v);
  * point covers. */
 static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, vec3 *d) {
   float ax = 2.0f * fx / (float)v->width - 1.0f, ay = 1.0f - 2.0f * fy / (float)v->height;
+  if (v->spherical) {
+    float phi = ax * PI_F, theta = ay * (0.5f * PI_F), c = cosf(theta);
+    *o = v->o;
+    *d = v3_add(v3_scale(v->up, sinf(theta)), v3_add(v3_scale(v->right, c * sinf(phi)), v3_scale(v->fwd, c * cosf(phi))));
+    return;
+  }
   if (v->ortho_half > 0) {
     *o = v3_add(v->o, v3_add(v3_scale(v->right, ax * v->ortho_half * v->aspect), v3_scale(v->up, ay * v->ortho_half)));
     *d = v->fwd;
@@ -51,6 +60,15 @@ static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, 
  * (or its plane) or off the film. */
 static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
   vec3 d = v3_sub(p, v->o);
+  if (v->spherical) {
+    float len = v3_len(d);
+    if (!(len > 0)) return 0;
+    float phi = atan2f(v3_dot(d, v->right), v3_dot(d, v->fwd)), theta = asinf(clampf(v3_dot(d, v->up) / len, -1, 1));
+    *fx = (phi / (2 * PI_F) + 0.5f) * (float)v->width;
+    *fy = (0.5f - theta / PI_F) * (float)v->height;
+    if (*fx >= (float)v->width) *fx = 0; /* longitude 180 degrees: the film's left edge */
+    return *fx >= 0 && *fy >= 0 && *fy < (float)v->height;
+  }
   float z = v3_dot(d, v->fwd);
   if (!(z > 0)) return 0;
   float hs = v->ortho_half > 0 ? v->ortho_half : z * v->tan_half;

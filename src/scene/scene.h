@@ -74,6 +74,8 @@ typedef struct camera {
   float fov_deg;          /* vertical (a perspective camera) */
   float ortho_height;     /* > 0: orthographic, the view's height in scene units (fov_deg
                              unused); 0: perspective */
+  int spherical;          /* 1: the whole sphere of directions, equirectangular (fov_deg
+                             and ortho_height unused) */
   float aperture_radius, focus_distance;
 } camera;
 
