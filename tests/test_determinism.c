@@ -1,7 +1,8 @@
 /* test_determinism.c — the same seed gives bit-identical images for 1, 2 and 7 threads
  * (pixels and the EXR file bytes), on a self-contained scene exercising every material
  * and light type; a different seed gives a different image. Cancelling keeps the finished
- * passes (cancel_keeps_passes, cancel_mid_pass). */
+ * passes (cancel_keeps_passes, cancel_mid_pass). A crop window renders that part of the
+ * frame's image bit for bit (crop_is_part_of_frame). */
 #include "harness.h"
 #include "image/image_io.h"
 #include <math.h>
@@ -54,6 +55,63 @@ static int threads_bit_identical(void) {
   CHECK(memcmp(a, c, n) == 0, "1 and 7 threads differ");
   CHECK(memcmp(a, d, n) != 0, "a different seed gave the same image");
   free(a); free(b); free(c); free(d);
+  return 0;
+}
+
+/* --crop / film.crop_*: the film is a window of the frame, and each of its pixels takes the
+ * frame pixel's random numbers, so a crop is that part of the whole image bit for bit:
+ * pixels and depth AOV, for the perspective camera with the Gaussian filter, and for
+ * orthographic and spherical cameras (their rays offset by the window's corner). Given
+ * alone, crop_x runs to the frame's right edge. */
+static int crop_is_part_of_frame(void) {
+  static const char *const cams[3] = {"", "\"type\": \"orthographic\", \"height\": 3, ", "\"type\": \"spherical\", "};
+  for (int k = 0; k < 3; k++) {
+    char json[4096];
+    const char *at = strstr(scene_json, "\"position\": [0,1,4]");
+    CHECK(at, "the scene's camera");
+    snprintf(json, sizeof json, "%.*s%s%s", (int)(at - scene_json), scene_json, cams[k], at);
+    if (k) { char *fov = strstr(json, ", \"fov\": 45"); CHECK(fov, "fov"); memmove(fov, fov + 11, strlen(fov + 11) + 1); }
+    const char *path = scratch_file("crop.json", json);
+    valo_options o;
+    valo_options_init(&o);
+    o.aovs = 1;
+    o.threads = 2;
+    snprintf(o.filter, sizeof o.filter, "%s", k ? "box" : "gaussian");
+    valo_scene *sc;
+    valo_render *full = render_file(path, &o, &sc);
+    CHECK(full, "render failed");
+    valo_scene_destroy(sc);
+    o.crop_x = 13; o.crop_y = 7; o.crop_width = 20; o.crop_height = 25;
+    o.threads = 3;
+    valo_render *part = render_file(path, &o, &sc);
+    CHECK(part, "crop render failed");
+    valo_scene_destroy(sc);
+    valo_stats st;
+    valo_render_stats(part, &st);
+    CHECK(st.width == 20 && st.height == 25, "the crop's image is %dx%d", st.width, st.height);
+    float *a = malloc(48 * 40 * 3 * sizeof *a), *b = malloc(20 * 25 * 3 * sizeof *b);
+    valo_error err;
+    for (int layer = 0; layer < 2; layer++) {
+      CHECK(valo_render_layer(full, layer ? "depth" : "", a, &err) == VALO_OK && valo_render_layer(part, layer ? "depth" : "", b, &err) == VALO_OK,
+            "%s", err.message);
+      int differ = 0;
+      for (int y = 0; y < 25; y++) differ += memcmp(&b[3 * (y * 20)], &a[3 * ((y + 7) * 48 + 13)], 20 * 3 * sizeof *a) != 0;
+      CHECK(!differ, "camera %d, %s: %d rows of the crop differ from the frame's", k, layer ? "depth" : "image", differ);
+    }
+    valo_render_destroy(part);
+    o.crop_x = 40; o.crop_y = o.crop_width = o.crop_height = VALO_UNSET;
+    part = render_file(path, &o, &sc);
+    CHECK(part, "crop render failed");
+    valo_scene_destroy(sc);
+    valo_render_stats(part, &st);
+    CHECK(st.width == 8 && st.height == 40, "crop_x 40 alone gives %dx%d, not the frame's last 8 columns", st.width, st.height);
+    valo_render_pixels(part, b);
+    valo_render_pixels(full, a);
+    for (int y = 0; y < 40; y++) CHECK(!memcmp(&b[3 * (y * 8)], &a[3 * (y * 48 + 40)], 8 * 3 * sizeof *a), "row %d of the last columns differs", y);
+    valo_render_destroy(part);
+    valo_render_destroy(full);
+    free(a); free(b);
+  }
   return 0;
 }
 
@@ -230,7 +288,7 @@ static int cancel_mid_pass(void) {
 }
 
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"exr_bytes_identical", exr_bytes_identical},
+  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"crop_is_part_of_frame", crop_is_part_of_frame}, {"exr_bytes_identical", exr_bytes_identical},
                                     {"adaptive_threads_identical", adaptive_threads_identical},
                                     {"cancel_keeps_passes", cancel_keeps_passes}, {"cancel_mid_pass", cancel_mid_pass}, {NULL, NULL}};
   return test_main(argc, argv, cases);

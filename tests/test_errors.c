@@ -441,6 +441,15 @@ static int absurd_resolution(void) {
   const char *p = write_file("bigfilm.json", "{ \"film\": {\"width\": 1000000000, \"height\": 10}, \"shapes\": [{\"type\": \"sphere\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("bigfilm.json"); SAID("film.width"); SAID("out of range"); NO_SANITIZER();
+  /* a crop window: malformed is a usage error, one past the frame is refused naming both */
+  EXPECT_FAIL(2, "render", obj, "--crop", "1,2,3");
+  SAID("--crop"); NO_SANITIZER();
+  EXPECT_FAIL(2, "render", obj, "--crop", "0,0,0,5");
+  EXPECT_FAIL(1, "render", obj, "--res", "64x48", "--crop", "60,0,8,8", "-o", scratch_path("crop.png"));
+  SAID("crop window 60,0,8,8 does not fit in the 64x48 frame"); NO_SANITIZER();
+  p = write_file("crop.json", "{ \"film\": {\"width\": 32, \"height\": 32, \"crop_y\": 40}, \"shapes\": [{\"type\": \"sphere\"}] }\n");
+  EXPECT_FAIL(1, "render", p, "-o", scratch_path("crop2.png"));
+  SAID("does not fit in the 32x32 frame"); NO_SANITIZER();
   return 0;
 }
 

@@ -85,6 +85,10 @@ typedef struct valo_options {
   double focus_distance;  /* distance to the plane of focus along the view axis, > 0;
                              VALO_UNSET = the scene's (file cameras: autofocus on the
                              surface at the image centre) */
+  int crop_x, crop_y, crop_width, crop_height; /* render only this window of the width x
+                             height frame (pixels from its top-left corner; the image is
+                             the window); VALO_UNSET: none (x, y: 0; width, height: to the
+                             frame's edge when the other fields are given) */
   char filter[16];        /* pixel reconstruction filter: "box" (default), "tent",
                              "gaussian" or "blackman-harris" (docs/scene-format.md, "film") */
   double filter_radius;   /* its radius in pixels; VALO_UNSET = the filter's default (box

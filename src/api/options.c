@@ -29,7 +29,7 @@ static void init_target(opt_target target, void *o) {
     case OPT_INT64: *(int64_t *)f = (int64_t)d->unset; break;
     case OPT_REAL: *(double *)f = d->unset; break;
     case OPT_FLOAT: *(float *)f = (float)d->unset; break;
-    case OPT_SIZE: case OPT_NAME: case OPT_PARAMS: break;
+    case OPT_SIZE: case OPT_RECT: case OPT_NAME: case OPT_PARAMS: break;
     }
   }
 }
@@ -44,7 +44,7 @@ static void default_target(opt_target target, void *o) {
     case OPT_FLOAT: *(float *)f = (float)d->def; break;
     case OPT_INT: case OPT_FLAG: case OPT_CHOICE: *(int *)f = (int)d->def; break;
     case OPT_INT64: *(int64_t *)f = (int64_t)d->def; break;
-    case OPT_SIZE: case OPT_PARAMS: break;
+    case OPT_SIZE: case OPT_RECT: case OPT_PARAMS: break;
     }
   }
 }
@@ -112,6 +112,16 @@ valo_status options_resolve(const valo_options *file, const valo_options *caller
   for (const option_decl *d = option_table; d->info.flag || d->info.json; d++) option_default(d, &o);
   if (o.threads == VALO_UNSET) o.threads = threads_available();
   if (o.aovs == VALO_UNSET) o.aovs = 0;
+  if (o.crop_x != VALO_UNSET || o.crop_y != VALO_UNSET || o.crop_width != VALO_UNSET || o.crop_height != VALO_UNSET) {
+    /* the crop window: what is not given starts at 0 and runs to the frame's edge */
+    if (o.crop_x == VALO_UNSET) o.crop_x = 0;
+    if (o.crop_y == VALO_UNSET) o.crop_y = 0;
+    if (o.crop_width == VALO_UNSET) o.crop_width = o.width - o.crop_x;
+    if (o.crop_height == VALO_UNSET) o.crop_height = o.height - o.crop_y;
+    if (o.crop_width < 1 || o.crop_height < 1 || o.crop_x + o.crop_width > o.width || o.crop_y + o.crop_height > o.height)
+      return err_set(err, VALO_ERR_INVALID, "the crop window %d,%d,%d,%d does not fit in the %dx%d frame", o.crop_x, o.crop_y, o.crop_width,
+                     o.crop_height, o.width, o.height);
+  }
   if ((double)o.width * o.height * o.spp > MAX_PIXEL_SAMPLES)
     return err_set(err, VALO_ERR_INVALID, "%dx%d at %d spp is more than %.0e samples", o.width, o.height, o.spp, MAX_PIXEL_SAMPLES);
   const integrator_ops *integ = integrator_find(o.integrator);

@@ -35,6 +35,16 @@ const option_decl option_table[] = {
      .unset = VALO_UNSET, .range_text = "a whole number from 1 to 16384"},
     {INFO(NULL, NULL, "film.height", "film height in pixels (default 256)"), R(height), .type = OPT_INT, .lo = 1, .hi = 16384, .def = 256,
      .unset = VALO_UNSET, .range_text = "a whole number from 1 to 16384"},
+    {INFO("--crop", "X,Y,W,H", NULL, "render only the W x H window at pixel (X, Y) of the --res frame;\nthe image is the window"),
+     R(crop_x), .type = OPT_RECT, .lo = 0, .hi = 16384, .keep_unset = 1, .unset = VALO_UNSET, .range_text = "X,Y,W,H in pixels"},
+    {INFO(NULL, NULL, "film.crop_x", "the crop window's left column"), R(crop_x), .type = OPT_INT, .lo = 0, .hi = 16383, .keep_unset = 1,
+     .unset = VALO_UNSET, .range_text = "a whole number from 0 to 16383"},
+    {INFO(NULL, NULL, "film.crop_y", "the crop window's top row"), R(crop_y), .type = OPT_INT, .lo = 0, .hi = 16383, .keep_unset = 1,
+     .unset = VALO_UNSET, .range_text = "a whole number from 0 to 16383"},
+    {INFO(NULL, NULL, "film.crop_width", "the crop window's width"), R(crop_width), .type = OPT_INT, .lo = 1, .hi = 16384, .keep_unset = 1,
+     .unset = VALO_UNSET, .range_text = "a whole number from 1 to 16384"},
+    {INFO(NULL, NULL, "film.crop_height", "the crop window's height"), R(crop_height), .type = OPT_INT, .lo = 1, .hi = 16384, .keep_unset = 1,
+     .unset = VALO_UNSET, .range_text = "a whole number from 1 to 16384"},
     {INFO("--filter", "NAME", "film.filter",
           "pixel filter: box (default, one pixel wide), tent, gaussian\n(Mitsuba's windowed Gaussian, standard deviation radius/4)\n"
           "or blackman-harris (Cycles' default)"),
@@ -169,6 +179,15 @@ valo_status option_set(const option_decl *d, const char *value, valo_options *ro
     *(int *)f = d->choice_base + k;
     return VALO_OK;
   }
+  case OPT_RECT: {
+    int r[4];
+    char extra;
+    if (!value || sscanf(value, "%d,%d,%d,%d%c", &r[0], &r[1], &r[2], &r[3], &extra) != 4 || r[0] < 0 || r[1] < 0 || r[2] < 1 || r[3] < 1 ||
+        r[0] >= d->hi || r[1] >= d->hi || r[2] > d->hi || r[3] > d->hi)
+      return bad_value(d, value ? value : "", err);
+    memcpy(f, r, sizeof r); /* x, y, width, height: adjacent ints in valo_options */
+    return VALO_OK;
+  }
   case OPT_SIZE: {
     int w = 0, h = 0;
     char extra;
@@ -192,7 +211,7 @@ valo_status option_set(const option_decl *d, const char *value, valo_options *ro
 
 static double number_of(const option_decl *d, const void *f) {
   switch (d->type) {
-  case OPT_INT: case OPT_FLAG: case OPT_CHOICE: case OPT_SIZE: return *(const int *)f;
+  case OPT_INT: case OPT_FLAG: case OPT_CHOICE: case OPT_SIZE: case OPT_RECT: return *(const int *)f;
   case OPT_INT64: return (double)*(const int64_t *)f;
   case OPT_REAL: return *(const double *)f;
   case OPT_FLOAT: return *(const float *)f;
@@ -217,7 +236,7 @@ void option_copy(const option_decl *d, valo_options *dst, const valo_options *sr
     snprintf(t + used, d->size - used, "%s%s", used ? " " : "", s);
     return;
   }
-  memcpy(t, s, d->type == OPT_SIZE ? 2 * sizeof(int) : d->size);
+  memcpy(t, s, d->type == OPT_SIZE ? 2 * sizeof(int) : d->type == OPT_RECT ? 4 * sizeof(int) : d->size);
 }
 
 void option_default(const option_decl *d, valo_options *o) {
@@ -229,7 +248,7 @@ void option_default(const option_decl *d, valo_options *o) {
   case OPT_INT64: *(int64_t *)f = (int64_t)d->def; break;
   case OPT_REAL: *(double *)f = d->def; break;
   case OPT_FLOAT: *(float *)f = (float)d->def; break;
-  case OPT_SIZE: case OPT_PARAMS: break;
+  case OPT_SIZE: case OPT_RECT: case OPT_PARAMS: break;
   }
 }
 
@@ -246,7 +265,7 @@ valo_status option_check(const option_decl *d, const valo_options *o, valo_error
     if (!(v >= d->lo && v <= d->hi)) return err_set(err, VALO_ERR_INVALID, "%s: %g is out of range (%s)", what, v, d->range_text);
     return VALO_OK;
   }
-  case OPT_CHOICE: case OPT_FLAG: case OPT_SIZE: case OPT_PARAMS: return VALO_OK;
+  case OPT_CHOICE: case OPT_FLAG: case OPT_SIZE: case OPT_RECT: case OPT_PARAMS: return VALO_OK;
   }
   return VALO_OK;
 }

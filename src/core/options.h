@@ -20,6 +20,7 @@ typedef enum opt_type {
   OPT_CHOICE,  /* int: index of the value in `names`, plus choice_base */
   OPT_FLAG,    /* int set to `hi` by the flag alone (no value) */
   OPT_SIZE,    /* "WxH" into width and height (two ints from offset) */
+  OPT_RECT,    /* "X,Y,W,H" into four ints from offset */
   OPT_PARAMS   /* char[size]: "name=value" entries, appended */
 } opt_type;
 

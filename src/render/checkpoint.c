@@ -64,6 +64,7 @@ static void options_text(const session *ss, char *out, size_t cap) {
     case OPT_REAL: snprintf(v, sizeof v, "%.17g", *(const double *)f); break;
     case OPT_FLOAT: snprintf(v, sizeof v, "%.9g", (double)*(const float *)f); break;
     case OPT_SIZE: snprintf(v, sizeof v, "%dx%d", ((const int *)f)[0], ((const int *)f)[1]); break;
+    case OPT_RECT: snprintf(v, sizeof v, "%d,%d,%d,%d", ((const int *)f)[0], ((const int *)f)[1], ((const int *)f)[2], ((const int *)f)[3]); break;
     case OPT_NAME: case OPT_PARAMS: snprintf(v, sizeof v, "%.*s", (int)d->size, f); break;
     }
     int k = snprintf(out + n, cap - n, "%s %s\n", d->info.flag ? d->info.flag : d->info.json, v);

@@ -16,7 +16,13 @@ static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2)
 int session_set_view(session *ss, int f) {
   camera c = ss->opt.frames > 0 ? scene_camera_at(ss->s, &ss->cam_still, (float)f) : ss->cam_still;
   ss->view_frame = f;
-  return cam_view_make(&c, ss->opt.width, ss->opt.height, &ss->lens.view);
+  cam_view *v = &ss->lens.view;
+  int bad = cam_view_make(&c, ss->frame_w, ss->frame_h, v);
+  v->x0 = ss->crop_x;
+  v->y0 = ss->crop_y;
+  v->film_w = ss->opt.width;
+  v->film_h = ss->opt.height;
+  return bad;
 }
 
 int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget) {
@@ -27,11 +33,19 @@ int session_report_progress(valo_progress_fn progress, void *user, double frac, 
 valo_status session_create(const scene *s, const valo_options *opts, const integrator_ops *integ, const double *params, float ao_dist,
                            session **out, valo_error *err) {
   *out = NULL;
-  const valo_options o = *opts;
+  /* A crop window is the film: opt.width and height are its size from here on, and the
+   * camera sees the whole frame. */
+  valo_options o = *opts;
+  int frame_w = o.width, frame_h = o.height, crop = o.crop_width > 0 && o.crop_height > 0;
+  if (crop) { o.width = o.crop_width; o.height = o.crop_height; }
   session *ss = calloc(1, sizeof *ss);
   if (!ss) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   ss->s = s;
   ss->opt = o;
+  ss->frame_w = frame_w;
+  ss->frame_h = frame_h;
+  ss->crop_x = crop ? o.crop_x : 0;
+  ss->crop_y = crop ? o.crop_y : 0;
   ss->integ = integ;
   memcpy(ss->param, params, sizeof ss->param);
   ss->ao_dist = ao_dist;
@@ -72,7 +86,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->ctx.sampler_kind = ss->sampler_kind;
   ss->ctx.prep = &ss->prep;
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
-  ss->cam_still = scene_camera_fit(s, (float)o.width / (float)o.height);
+  ss->cam_still = scene_camera_fit(s, (float)frame_w / (float)frame_h);
   const camera *c = &ss->cam_still;
   if (session_set_view(ss, 0)) {
     st = err_set(err, VALO_ERR_INVALID, "%s: camera up vector is parallel to the view direction", s->path);

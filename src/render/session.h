@@ -59,6 +59,9 @@ struct session {
   ckpt_state resume;       /* the state a resumed render goes on from (owns first, fin) */
   int resumed;
   int view_frame;          /* the frame whose camera ss->lens holds */
+  int frame_w, frame_h;    /* the camera's frame; the film (opt.width x opt.height) is its
+                              window at (crop_x, crop_y): the whole frame without a crop */
+  int crop_x, crop_y;
   int stepped;             /* rendered by session_step (valo view): image-wide frames as a sequence's */
   struct dist_state *dist; /* rank 0 under MPI: the other ranks' state (render/dist.c) */
   rank_stats *ranks;       /* rank 0 under MPI, after a run: every rank's share, nranks of them */

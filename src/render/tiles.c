@@ -16,8 +16,10 @@ typedef struct pass_job {
 
 void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts) {
   uint64_t pix = (uint64_t)y * (uint64_t)ss->opt.width + (uint64_t)x;
+  /* the random numbers of the frame's pixel, so that a crop is that part of the frame's image */
+  uint64_t frame_pix = (uint64_t)(y + ss->crop_y) * (uint64_t)ss->frame_w + (uint64_t)(x + ss->crop_x);
   for (int si = s0; si < s1; si++) {
-    sampler smp = sampler_make_kind((uint64_t)ss->opt.seed, pix, (uint64_t)si, ss->sampler_kind);
+    sampler smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
     ray ry = camera_ray(&ss->lens, x, y, &smp);
     ts->rays++;
     if (ss->film.aov) aov_record(ss, ry, &ss->film.aov[AOV_FLOATS * pix], &smp, ts);

@@ -11,8 +11,9 @@ int cam_view_make(const camera *c, int width, int height, cam_view *v) {
   v->tan_half = tanf(0.5f * c->fov_deg * PI_F / 180.0f);
   v->ortho_half = c->ortho_height > 0 ? 0.5f * c->ortho_height : 0;
   v->spherical = c->spherical;
-  v->width = width;
-  v->height = height;
+  v->width = v->film_w = width;
+  v->height = v->film_h = height;
+  v->x0 = v->y0 = 0;
   v->aspect = (float)width / (float)height;
   return (!v3_finite(v->right) || !(v3_len2(v->right) > 0.5f)) ? -1 : 0;
 }
@@ -22,6 +23,8 @@ ray camera_ray(const cam_lens *l, int px, int py, sampler *smp) {
   float jx, jy;
   sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
+  px += v->x0;
+  py += v->y0;
   float fx = (float)px + jx, fy = (float)py + jy;
   if (l->filter) {
     fx = (float)px + 0.5f + pixel_filter_sample(l->filter, jx);

@@ -20,7 +20,8 @@ typedef struct cam_view {
   vec3 o, fwd, right, up;
   float tan_half, ortho_half, aspect;
   int spherical;
-  int width, height;
+  int width, height;      /* the frame */
+  int x0, y0, film_w, film_h; /* the window of it the film holds (a crop; else the frame) */
 } cam_view;
 
 /* A frame's camera with its lens: radius 0 is a pinhole; focus is the distance along the
@@ -32,11 +33,11 @@ typedef struct cam_lens {
   const pixel_filter *filter;
 } cam_lens;
 
-/* The basis of camera c on a width x height film; -1 when up is parallel to the view
- * direction. */
+/* The basis of camera c on a width x height frame, all of it on the film; -1 when up is
+ * parallel to the view direction. */
 int cam_view_make(const camera *c, int width, int height, cam_view *v);
 
-/* The pinhole ray through film point (fx, fy): unit direction *d from *o. An
+/* The pinhole ray through frame point (fx, fy): unit direction *d from *o. An
  * orthographic camera's rays all run along fwd, from the point of its plane that the film
  * point covers. */
 static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, vec3 *d) {
@@ -56,8 +57,14 @@ static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, 
   *o = v->o;
   *d = v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
 }
-/* Film point where p is seen (the inverse of cam_view_ray); 0 when p is behind the camera
- * (or its plane) or off the film. */
+/* Film point where p is seen (the inverse of cam_view_ray, less the window's corner); 0
+ * when p is behind the camera (or its plane) or off the film. */
+/* Frame point (fx, fy) to film point: 1 when it lies on the film. */
+static inline int cam_view_window(const cam_view *v, float *fx, float *fy) {
+  *fx -= (float)v->x0;
+  *fy -= (float)v->y0;
+  return *fx >= 0 && *fy >= 0 && *fx < (float)v->film_w && *fy < (float)v->film_h;
+}
 static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
   vec3 d = v3_sub(p, v->o);
   if (v->spherical) {
@@ -66,8 +73,8 @@ static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *
     float phi = atan2f(v3_dot(d, v->right), v3_dot(d, v->fwd)), theta = asinf(clampf(v3_dot(d, v->up) / len, -1, 1));
     *fx = (phi / (2 * PI_F) + 0.5f) * (float)v->width;
     *fy = (0.5f - theta / PI_F) * (float)v->height;
-    if (*fx >= (float)v->width) *fx = 0; /* longitude 180 degrees: the film's left edge */
-    return *fx >= 0 && *fy >= 0 && *fy < (float)v->height;
+    if (*fx >= (float)v->width) *fx = 0; /* longitude 180 degrees: the frame's left edge */
+    return cam_view_window(v, fx, fy);
   }
   float z = v3_dot(d, v->fwd);
   if (!(z > 0)) return 0;
@@ -75,7 +82,7 @@ static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *
   float sx = v3_dot(d, v->right) / (hs * v->aspect), sy = v3_dot(d, v->up) / hs;
   *fx = (sx + 1.0f) * 0.5f * (float)v->width;
   *fy = (1.0f - sy) * 0.5f * (float)v->height;
-  return *fx >= 0 && *fy >= 0 && *fx < (float)v->width && *fy < (float)v->height;
+  return cam_view_window(v, fx, fy);
 }
 
 /* How far the camera is from p: its distance from the pinhole, or from an orthographic
@@ -85,7 +92,7 @@ static inline float cam_view_depth(const cam_view *v, vec3 p) {
   return v->ortho_half > 0 ? v3_dot(d, v->fwd) : v3_len(d);
 }
 
-/* The camera ray of pixel (px, py) for one sample: the position in the pixel (or around
+/* The camera ray of film pixel (px, py) for one sample: the position in the pixel (or around
  * its centre, drawn from the lens's filter) from the sampler's SDIM_FILM dimensions, the point on the lens from SDIM_LENS (drawn for a
  * pinhole too, so streams do not shift); leaves the sampler at SDIM_WAVELENGTH. */
 ray camera_ray(const cam_lens *l, int px, int py, sampler *smp);
