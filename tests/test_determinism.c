@@ -77,15 +77,13 @@ static int crop_is_part_of_frame(void) {
     o.aovs = 1;
     o.threads = 2;
     snprintf(o.filter, sizeof o.filter, "%s", k ? "box" : "gaussian");
-    valo_scene *sc;
+    valo_scene *sc, *sc_part; /* each render reads its scene until it is destroyed */
     valo_render *full = render_file(path, &o, &sc);
     CHECK(full, "render failed");
-    valo_scene_destroy(sc);
     o.crop_x = 13; o.crop_y = 7; o.crop_width = 20; o.crop_height = 25;
     o.threads = 3;
-    valo_render *part = render_file(path, &o, &sc);
+    valo_render *part = render_file(path, &o, &sc_part);
     CHECK(part, "crop render failed");
-    valo_scene_destroy(sc);
     valo_stats st;
     valo_render_stats(part, &st);
     CHECK(st.width == 20 && st.height == 25, "the crop's image is %dx%d", st.width, st.height);
@@ -99,17 +97,19 @@ static int crop_is_part_of_frame(void) {
       CHECK(!differ, "camera %d, %s: %d rows of the crop differ from the frame's", k, layer ? "depth" : "image", differ);
     }
     valo_render_destroy(part);
+    valo_scene_destroy(sc_part);
     o.crop_x = 40; o.crop_y = o.crop_width = o.crop_height = VALO_UNSET;
-    part = render_file(path, &o, &sc);
+    part = render_file(path, &o, &sc_part);
     CHECK(part, "crop render failed");
-    valo_scene_destroy(sc);
     valo_render_stats(part, &st);
     CHECK(st.width == 8 && st.height == 40, "crop_x 40 alone gives %dx%d, not the frame's last 8 columns", st.width, st.height);
     valo_render_pixels(part, b);
     valo_render_pixels(full, a);
     for (int y = 0; y < 40; y++) CHECK(!memcmp(&b[3 * (y * 8)], &a[3 * (y * 48 + 40)], 8 * 3 * sizeof *a), "row %d of the last columns differs", y);
     valo_render_destroy(part);
+    valo_scene_destroy(sc_part);
     valo_render_destroy(full);
+    valo_scene_destroy(sc);
     free(a); free(b);
   }
   return 0;
