@@ -88,7 +88,10 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
   for (int i = 0; i < n; i++) {
     v3 c;
     for (;;) {
-      c = mk(lo.x + (hi.x - lo.x) * rnd(), lo.y + (hi.y - lo.y) * rnd(), lo.z + (hi.z - lo.z) * rnd());
+      /* one draw per statement: the order of a call's arguments is unspecified, and the
+       * committed scenes take z, y, x (gcc's order) */
+      double uz = rnd(), uy = rnd(), ux = rnd();
+      c = mk(lo.x + (hi.x - lo.x) * ux, lo.y + (hi.y - lo.y) * uy, lo.z + (hi.z - lo.z) * uz);
       int inside = 0;
       for (int k = 0; k < nb; k++)
         if (c.x > blo[k].x - edge && c.x < bhi[k].x + edge && c.y > blo[k].y - edge && c.y < bhi[k].y + edge && c.z > blo[k].z - edge &&
@@ -98,7 +101,8 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
     double th = tilt * sqrt(rnd()), ph = 2 * PI * rnd();
     v3 nn = nrm(mk(sin(th) * cos(ph), -cos(th), sin(th) * sin(ph)));
     double rot = 2 * PI * rnd(), R, G, B;
-    hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
+    double sat = 0.1 + 0.4 * rnd(), hue = rnd(); /* saturation first: the same order */
+    hsv(hue, sat, 1, &R, &G, &B);
     double L = L0 * exp(log(30.0) * rnd());
     lamp(obj, mtl, i, c, nn, edge, rot, R * L, G * L, B * L);
   }
@@ -159,7 +163,8 @@ static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, dou
     memcpy(placed[i], tri, sizeof tri);
     face_of[i] = face;
     double R, G, B;
-    hsv(rnd(), 0.1 + 0.4 * rnd(), 1, &R, &G, &B);
+    double sat = 0.1 + 0.4 * rnd(), hue = rnd();
+    hsv(hue, sat, 1, &R, &G, &B);
     int level = (int)(3 * rnd());
     double L = L0 * pow(20.0, 0.5 * level);
     lamp(obj, mtl, i, c, nn, edge, rot, R * L, G * L, B * L);
