@@ -84,8 +84,8 @@ static valo_status parse_camera(jctx *c, const cJSON *o) {
   const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
   if (ff && !cJSON_IsBool(ff)) return json_bad(c, "camera.from_file", "must be true or false");
   if (cJSON_IsTrue(ff)) {
-    /* The first shape file with a camera supplies position, orientation and fov; the
-     * lens (and optionally fov) come from here. */
+    /* The first shape file with a camera supplies its type, position, orientation and fov
+     * (or height); the lens (and optionally fov or height) come from here. */
     if (cJSON_GetObjectItemCaseSensitive(o, "position") || cJSON_GetObjectItemCaseSensitive(o, "look_at") ||
         cJSON_GetObjectItemCaseSensitive(o, "up") || cJSON_GetObjectItemCaseSensitive(o, "type"))
       return json_bad(c, "camera", "\"from_file\" takes the type, position, look_at and up from the file; give only fov (or an "

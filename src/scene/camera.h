@@ -1,8 +1,9 @@
-/* camera.h — owns camera rays: the basis of one frame's perspective or orthographic camera
- * (cam_view: from the scene's camera, or its keyframes at frame f), the ray through a film
- * point, the film point where a world point is seen, and the thin lens (cam_lens) that
- * every integrator's camera rays go through — the per-ray tile loop's and ReSTIR's
- * G-buffer alike. It sits in the scene model, below both. Film coordinates are pixels
+/* camera.h — owns camera rays: the basis of one frame's perspective, orthographic or
+ * spherical camera (cam_view: from the scene's camera, or its keyframes at frame f), the
+ * ray through a film point, the film point where a world point is seen, the crop window
+ * the film holds of the frame, and the thin lens and pixel filter (cam_lens) that every
+ * integrator's camera rays go through — the per-ray tile loop's and ReSTIR's G-buffer
+ * alike. It sits in the scene model, below both. Film and frame coordinates are pixels
  * from the top-left corner (x right, y down). */
 #ifndef VALO_CAMERA_H
 #define VALO_CAMERA_H
@@ -38,8 +39,8 @@ typedef struct cam_lens {
 int cam_view_make(const camera *c, int width, int height, cam_view *v);
 
 /* The pinhole ray through frame point (fx, fy): unit direction *d from *o. An
- * orthographic camera's rays all run along fwd, from the point of its plane that the film
- * point covers. */
+ * orthographic camera's rays all run along fwd, from the point of its plane that the frame
+ * point covers; a spherical camera's leave o in every direction. */
 static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, vec3 *d) {
   float ax = 2.0f * fx / (float)v->width - 1.0f, ay = 1.0f - 2.0f * fy / (float)v->height;
   if (v->spherical) {
@@ -57,14 +58,14 @@ static inline void cam_view_ray(const cam_view *v, float fx, float fy, vec3 *o, 
   *o = v->o;
   *d = v3_norm(v3_add(v->fwd, v3_add(v3_scale(v->right, sx), v3_scale(v->up, sy))));
 }
-/* Film point where p is seen (the inverse of cam_view_ray, less the window's corner); 0
- * when p is behind the camera (or its plane) or off the film. */
 /* Frame point (fx, fy) to film point: 1 when it lies on the film. */
 static inline int cam_view_window(const cam_view *v, float *fx, float *fy) {
   *fx -= (float)v->x0;
   *fy -= (float)v->y0;
   return *fx >= 0 && *fy >= 0 && *fx < (float)v->film_w && *fy < (float)v->film_h;
 }
+/* Film point where p is seen (the inverse of cam_view_ray, less the window's corner); 0
+ * when p is behind the camera (or its plane) or off the film. */
 static inline int cam_view_project(const cam_view *v, vec3 p, float *fx, float *fy) {
   vec3 d = v3_sub(p, v->o);
   if (v->spherical) {
@@ -92,8 +93,9 @@ static inline float cam_view_depth(const cam_view *v, vec3 p) {
   return v->ortho_half > 0 ? v3_dot(d, v->fwd) : v3_len(d);
 }
 
-/* The camera ray of film pixel (px, py) for one sample: the position in the pixel (or around
- * its centre, drawn from the lens's filter) from the sampler's SDIM_FILM dimensions, the point on the lens from SDIM_LENS (drawn for a
- * pinhole too, so streams do not shift); leaves the sampler at SDIM_WAVELENGTH. */
+/* The camera ray of film pixel (px, py) for one sample: the position in the pixel (or
+ * around its centre, drawn from the lens's filter) from the sampler's SDIM_FILM
+ * dimensions, the point on the lens from SDIM_LENS (drawn for a pinhole too, so streams
+ * do not shift); leaves the sampler at SDIM_WAVELENGTH. */
 ray camera_ray(const cam_lens *l, int px, int py, sampler *smp);
 #endif
