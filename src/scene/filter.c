@@ -6,10 +6,11 @@
 static const struct { const char *name; filter_kind kind; double radius; } kinds[] = {
     {"box", FILTER_BOX, 0.5}, {"tent", FILTER_TENT, 1.0}, {"gaussian", FILTER_GAUSSIAN, 2.0}, {"blackman-harris", FILTER_BLACKMAN_HARRIS, 1.5}};
 
-double pixel_filter_default_radius(const char *name) {
+/* The table's entry for a filter's name, or -1. */
+static int find_kind(const char *name) {
   for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
-    if (!strcmp(name, kinds[i].name)) return kinds[i].radius;
-  return 0;
+    if (!strcmp(name, kinds[i].name)) return (int)i;
+  return -1;
 }
 
 /* A tabulated filter, unnormalised, at x in [-radius, radius]: the windowed Gaussian, or
@@ -24,12 +25,11 @@ static double tabulated(filter_kind kind, double x, double radius) {
 }
 
 int pixel_filter_make(pixel_filter *f, const char *name, double radius) {
-  double def = pixel_filter_default_radius(name);
-  if (!(def > 0)) return -1;
+  int k = find_kind(name);
+  if (k < 0) return -1;
   memset(f, 0, sizeof *f);
-  for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
-    if (!strcmp(name, kinds[i].name)) f->kind = kinds[i].kind;
-  f->radius = (float)(radius > 0 ? radius : def);
+  f->kind = kinds[k].kind;
+  f->radius = (float)(radius > 0 ? radius : kinds[k].radius);
   if (f->kind == FILTER_GAUSSIAN || f->kind == FILTER_BLACKMAN_HARRIS) {
     double sum = 0, step = 2.0 * f->radius / FILTER_BINS, acc[FILTER_BINS + 1];
     acc[0] = 0;

@@ -25,8 +25,6 @@ typedef struct pixel_filter {
  * pixels (<= 0: the filter's default: 0.5, 1 and 2 as Mitsuba's, 1.5 as Cycles'); -1 for
  * another name. */
 int pixel_filter_make(pixel_filter *f, const char *name, double radius);
-/* The default radius of the filter named so, or 0 for another name. */
-double pixel_filter_default_radius(const char *name);
 /* The normalised 1D filter at offset x (its integral over [-radius, radius] is 1): the
  * density of pixel_filter_sample. */
 float pixel_filter_pdf(const pixel_filter *f, float x);
