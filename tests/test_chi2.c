@@ -9,6 +9,7 @@
 #include "harness.h"
 #include "material/bsdf.h"
 #include "material/fresnel.h"
+#include "material/medium.h"
 #include "light/light.h"
 #include "scene/envmap.h"
 #include "core/alias.h"
@@ -23,7 +24,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 56
+#define CHI2_TESTS 61
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -883,6 +884,88 @@ static int pixel_filters(void) {
   return rc;
 }
 
+/* ---- participating media */
+/* The Henyey-Greenstein phase function: samples against its density for forward,
+ * backward and isotropic lobes around an oblique wo; each sample's pdf must be the
+ * phase value (its weight 1). */
+typedef struct phase_ctx { float g; vec3 wo; } phase_ctx;
+static int phase_sf(void *c, sampler *s, vec3 *d) {
+  phase_ctx *x = c;
+  float u1 = sampler_1d(s), u2 = sampler_1d(s);
+  float pdf = phase_hg_sample(x->wo, x->g, u1, u2, d);
+  float want = phase_hg(v3_dot(x->wo, *d), x->g);
+  if (!(fabsf(pdf - want) <= 1e-3f * want + 1e-6f)) g_sample_mismatch++;
+  return 1;
+}
+static double phase_pf(void *c, vec3 d) { phase_ctx *x = c; return phase_hg(v3_dot(x->wo, v3_norm(d)), x->g); }
+static int hg_phase(void) {
+  static const float gs[] = {0, 0.3f, -0.6f, 0.9f};
+  int rc = 0;
+  for (int k = 0; k < 4; k++) {
+    phase_ctx c = {gs[k], v3_norm(v3(0.3f, -0.5f, 0.8f))};
+    char what[64];
+    snprintf(what, sizeof what, "Henyey-Greenstein g = %.1f", (double)gs[k]);
+    rc |= run_chi2(what, &c, phase_sf, phase_pf);
+  }
+  return rc;
+}
+/* Free-flight distances (medium_sample_distance): in a grey medium the distances up to a
+ * surface at tmax against sigma_t exp(-sigma_t t), and the surface's share against
+ * exp(-sigma_t tmax); in a chromatic one, per channel, the weights' means against
+ * transmittance to the surface and 1 - that (the probability of an event before it):
+ * picking the channel by MIS must be unbiased for every channel. */
+static int free_flight(void) {
+  enum { CELLS = 64 };
+  const float tmax = 1.5f;
+  medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, "grey"};
+  double obs[CELLS + 1] = {0}, ex[CELLS + 1];
+  long n = nsamples();
+  double st = 1.2;
+  for (long i = 0; i < n; i++) {
+    sampler s = sampler_make(17, (uint64_t)i, 0);
+    float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
+    rgb w;
+    if (medium_sample_distance(&grey, uc, ud, tmax, &t, &w)) {
+      int c = (int)(t / tmax * CELLS);
+      obs[c < CELLS ? c : CELLS - 1] += 1;
+      CHECK(fabsf(w.r - 0.8f / 1.2f) < 1e-5f, "grey event weight %g, want albedo %g", (double)w.r, 0.8 / 1.2);
+    } else {
+      obs[CELLS] += 1;
+      CHECK(fabsf(w.r - 1) < 1e-5f, "grey surface weight %g, want 1", (double)w.r);
+    }
+  }
+  for (int c = 0; c < CELLS; c++) ex[c] = n * (exp(-st * tmax * c / CELLS) - exp(-st * tmax * (c + 1) / CELLS));
+  ex[CELLS] = n * exp(-st * tmax);
+  int rc = chi2_check("free-flight distances, grey medium", obs, ex, CELLS + 1);
+
+  medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, "col"};
+  rgb sig_t = medium_sigma_t(&col);
+  double pass[3] = {0}, event[3] = {0}, pass2[3] = {0}, event2[3] = {0};
+  for (long i = 0; i < n; i++) {
+    sampler s = sampler_make(18, (uint64_t)i, 0);
+    float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
+    rgb w;
+    int ev = medium_sample_distance(&col, uc, ud, tmax, &t, &w);
+    float wv[3] = {w.r, w.g, w.b}, sa[3] = {col.sigma_s.r, col.sigma_s.g, col.sigma_s.b}, stv[3] = {sig_t.r, sig_t.g, sig_t.b};
+    for (int c = 0; c < 3; c++) {
+      /* an event's weight sigma_s Tr / pdf, times sigma_t / sigma_s, estimates P(event) */
+      double x = ev ? wv[c] * stv[c] / sa[c] : wv[c];
+      double *acc = ev ? event : pass, *acc2 = ev ? event2 : pass2;
+      acc[c] += x;
+      acc2[c] += x * x;
+    }
+  }
+  for (int c = 0; c < 3; c++) {
+    double stc = c == 0 ? sig_t.r : c == 1 ? sig_t.g : sig_t.b, tr = exp(-stc * tmax);
+    double mp = pass[c] / n, me = event[c] / n;
+    double sp = sqrt((pass2[c] / n - mp * mp) / n), se = sqrt((event2[c] / n - me * me) / n);
+    fprintf(stderr, "free flight, channel %d: surface %.5f (want %.5f, sd %.5f), events %.5f (want %.5f, sd %.5f)\n", c, mp, tr, sp, me, 1 - tr, se);
+    CHECK(fabs(mp - tr) < 5 * sp + 1e-6, "channel %d: surface weight mean %g, transmittance %g", c, mp, tr);
+    CHECK(fabs(me - (1 - tr)) < 5 * se + 1e-6, "channel %d: event weight mean %g, want %g", c, me, 1 - tr);
+  }
+  return rc;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"diffuse", diffuse},
                                     {"phong", phong},
@@ -898,6 +981,6 @@ int main(int argc, char **argv) {
                                     {"pbr_metallic_roughness", pbr_metallic_roughness},
                                     {"sobol_sampler", sobol_sampler},
                                     {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection},
-                                    {"pixel_filters", pixel_filters}, {NULL, NULL}};
+                                    {"pixel_filters", pixel_filters}, {"hg_phase", hg_phase}, {"free_flight", free_flight}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -126,6 +126,32 @@ static int wrong_type(void) {
   return 0;
 }
 
+/* Participating media: each mistake names its key; a medium an integrator cannot
+ * render is refused by name (exit 1). */
+static int bad_media(void) {
+  static const struct { const char *name, *json, *said1, *said2; } cases[] = {
+      {"med1.json", "{ \"media\": {\"fog\": {\"type\": \"heterogeneous\"}} }", "media.fog", "homogeneous"},
+      {"med2.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"sigma_a\": -1}} }", "media.fog.sigma_a", "not be negative"},
+      {"med3.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"g\": 1}} }", "media.fog.g", "-0.999"},
+      {"med4.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"density\": 1}} }", "media.fog", "unknown key \"density\""},
+      {"med5.json", "{ \"shapes\": [{\"type\": \"sphere\", \"interior\": \"smoke\"}] }", "shapes[0].interior", "\"smoke\" is not defined"},
+      {"med6.json", "{ \"camera\": {\"medium\": \"smoke\"} }", "camera.medium", "\"smoke\" is not defined"},
+      {"med7.json", "{ \"materials\": {\"edge\": {\"type\": \"null\", \"emission\": 1}} }", "materials.edge", "unknown key \"emission\""},
+      {"med8.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"scale\": 1e300}} }", "media.fog.scale", "1e+09"},
+      {"med9.json", "{ \"media\": [1] }", "media", "object of named media"},
+  };
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    const char *p = write_file(cases[k].name, cases[k].json);
+    EXPECT_FAIL(1, "render", p);
+    SAID(cases[k].name); SAID(cases[k].said1); SAID(cases[k].said2); NO_SANITIZER();
+  }
+  const char *p = write_file("med10.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\"}}, \"materials\": {\"e\": {\"type\": \"null\"}},"
+                                           " \"shapes\": [{\"type\": \"sphere\", \"material\": \"e\", \"interior\": \"fog\"}] }");
+  EXPECT_FAIL(1, "render", p, "--integrator", "vpl", "-o", scratch_path("med10.png"));
+  SAID("med10.json"); SAID("path integrator only"); SAID("vpl"); NO_SANITIZER();
+  return 0;
+}
+
 static int unsupported_format(void) {
   const char *p = write_file("garbage.xyz1", "this is not a mesh\n\x01\x02\x03");
   EXPECT_FAIL(1, "render", p);
@@ -715,7 +741,7 @@ int main(int argc, char **argv) {
                                     {"malformed_json", malformed_json},
                                     {"unknown_key", unknown_key},
                                     {"wrong_type", wrong_type},
-                                    {"unsupported_format", unsupported_format},
+                                    {"bad_media", bad_media}, {"unsupported_format", unsupported_format},
                                     {"index_out_of_range", index_out_of_range},
                                     {"nan_vertices", nan_vertices},
                                     {"bad_ply", bad_ply},

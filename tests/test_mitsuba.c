@@ -93,6 +93,11 @@ static int sun_light(void) { return against_mitsuba("sun-light", 256, 16, 0); }
 /* An orthographic camera (camera.type): the diffuse sphere under the lamp on a film of
  * aspect 1.6, against Mitsuba's "orthographic" sensor scaled to the same view. */
 static int ortho_camera(void) { return against_mitsuba("ortho-camera", 256, 16, 0); }
+/* Participating media against Mitsuba's volpath: the ball filled with a chromatic
+ * scattering medium (forward HG lobe) behind a null boundary, and rough glass filled
+ * with an absorbing one (Beer-Lambert colour). */
+static int smoke_ball(void) { return against_mitsuba("smoke-ball", 512, 16, 0); }
+static int absorbing_glass(void) { return against_mitsuba("absorbing-glass", 1536, 32, 0); }
 
 /* The Gaussian pixel filter (film.filter) against Mitsuba's, on the same view: the image
  * as above, and on the silhouette's pixels (where the box reference's green changes by
@@ -156,7 +161,7 @@ static int env_spheres(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
-                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
+                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"smoke_ball", smoke_ball}, {"absorbing_glass", absorbing_glass}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {NULL, NULL}};

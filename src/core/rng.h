@@ -128,6 +128,9 @@ enum {
   SDIM_BSDF_DIR = 3,    /*   2D: direction */
   SDIM_ROULETTE = 4,    /*   1D: Russian roulette */
   SDIM_PER_BOUNCE = 5,
+  SDIM_MEDIUM = 0x20000000, /* path through media: 1D + 1D per free-flight sample k
+                              (channel, distance) at SDIM_MEDIUM + 2k, k < SDIM_MEDIUM_MAX */
+  SDIM_MEDIUM_MAX = 0x1000000,
   SDIM_AOV = 0x40000000, /* 2D: the ao AOV's direction (beside any integrator) */
   SDIM_EXTRA = 0x40000100 /* integrator-specific streams start here (ao, photon gathering) */
 };

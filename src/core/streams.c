@@ -9,6 +9,7 @@ const stream_use stream_uses[] = {
     {"pixel", "lens", SDIM_LENS, SDIM_LENS + 1},
     {"pixel", "wavelength", SDIM_WAVELENGTH, SDIM_WAVELENGTH + 1},
     {"pixel", "path bounces and the walk through delta lobes", SDIM_BOUNCE0, BOUNCES_END},
+    {"pixel", "free-flight distances in media", SDIM_MEDIUM, SDIM_MEDIUM + 2 * SDIM_MEDIUM_MAX},
     {"pixel", "ao AOV", SDIM_AOV, SDIM_AOV + 1},
     {"pixel", "ao integrator", SDIM_AO, SDIM_AO + 1},
     {"pixel", "restir-gi direction", SDIM_RESTIR_GI_DIR, SDIM_RESTIR_GI_DIR + 2},

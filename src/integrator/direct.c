@@ -3,32 +3,38 @@
 #include "core/sampling.h"
 #include <math.h>
 
-int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
-  vec3 d0 = v3_sub(p_to, it->p);
-  vec3 o = offset_origin_isect(it, d0);
+ray segment_ray(vec3 o, vec3 from, vec3 p_to, vec3 n_to) {
   vec3 target = p_to;
   if (v3_len2(n_to) > 0) {
     vec3 err = v3_scale(v3_abs(p_to), fp_gamma(7));
-    target = offset_origin(p_to, err, n_to, v3_neg(d0));
+    target = offset_origin(p_to, err, n_to, v3_sub(from, p_to));
   }
   ray r;
   r.o = o;
   r.d = v3_sub(target, o);
   r.tmax = 1 - 1e-4f;
+  return r;
+}
+
+int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
+  ray r = segment_ray(offset_origin_isect(it, v3_sub(p_to, it->p)), it->p, p_to, n_to);
   ts->rays++;
   return accel_occluded(c->acc, &r);
 }
 
-int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                  thread_stats *ts, int mis, direct_sample *out) {
+uint32_t direct_light_sample(const render_ctx *c, vec3 p, sampler *smp, float *pmf, light_li *ls) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
+  uint32_t li = light_select(&c->ls, c->s, p, ul, pmf);
+  if (li == UINT32_MAX || !light_sample(c->s, &c->s->lights[li], p, u1, u2, ls)) return UINT32_MAX;
+  return li;
+}
+
+int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                             thread_stats *ts, int mis, direct_sample *out) {
   float pmf;
-  uint32_t li = light_select(&c->ls, c->s, it->p, ul, &pmf);
-  if (li == UINT32_MAX) return 0;
-  const light *l = &c->s->lights[li];
   light_li ls;
-  if (!light_sample(c->s, l, it->p, u1, u2, &ls)) return 0;
+  if (direct_light_sample(c, it->p, smp, &pmf, &ls) == UINT32_MAX) return 0;
   vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
   rgb f = bsdf_eval(b, wo_l, wi_l);
   ts->surface_samples++;
@@ -40,14 +46,21 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
   if (refl_l != refl_g || v3_dot(ls.wi, it->ng) == 0) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
   float bpdf = (ls.delta || !mis) ? 0 : bsdf_pdf(b, wo_l, wi_l);
   if (!isfinite(bpdf)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; return 0; }
-  if (ctx_segment_blocked(c, it, ls.p_light, ls.n_light, ts)) return 0;
   float light_pdf = pmf * ls.pdf;
   float w = (ls.delta || !mis) ? 1.0f : power_heuristic(light_pdf, bpdf);
   out->f_cos = c3_scale(f, fabsf(wi_l.z));
   out->Li = ls.L;
   out->scale = w / light_pdf;
   out->wi = ls.wi;
+  out->p_light = ls.p_light;
+  out->n_light = ls.n_light;
+  out->far = isinf(ls.dist);
   return 1;
+}
+
+int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                  thread_stats *ts, int mis, direct_sample *out) {
+  return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) && !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts);
 }
 
 static rgb direct_rgb(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

@@ -8,9 +8,16 @@ static inline int ctx_intersect(const render_ctx *c, const ray *r, hit *h, threa
   ts->rays++;
   return accel_intersect(c->acc, r, h);
 }
-/* Is the segment from it (leaving towards p_to) blocked? p_to is offset too when n_to is
- * non-zero (a point on a surface). */
+/* The shadow ray from `from` (leaving at o, its offset origin) to p_to, which is offset
+ * towards `from` too when n_to is non-zero (a point on a surface): direction p_to - o,
+ * tmax just short of 1. */
+ray segment_ray(vec3 o, vec3 from, vec3 p_to, vec3 n_to);
+/* Is the segment from it (leaving towards p_to) blocked? (segment_ray from it's offset
+ * origin) */
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);
+/* Picks a light for point p (the sampler's next 1D value) and samples it (the next 2D):
+ * returns its index with *pmf and *ls, or UINT32_MAX when nothing came out. */
+uint32_t direct_light_sample(const render_ctx *c, vec3 p, sampler *smp, float *pmf, light_li *ls);
 /* Probability that estimate_direct picks light index li at shading point p. */
 static inline float ctx_light_pmf(const render_ctx *c, uint32_t li, vec3 p) { return light_select_pmf(&c->ls, c->s, li, p); }
 
@@ -23,9 +30,14 @@ rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const f
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
-typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi; } direct_sample;
+typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi, p_light, n_light; int far; } direct_sample;
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out);
+/* sample_direct without the shadow ray: the caller tests the segment to out->p_light
+ * (out->n_light; out->far: the light is at infinity) itself (through media:
+ * path_media.c). */
+int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                             thread_stats *ts, int mis, direct_sample *out);
 /* The same estimate with weight 1 (light sampling alone): for integrators that never
  * count emission found by BSDF-sampled rays at non-specular vertices. */
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

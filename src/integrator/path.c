@@ -3,7 +3,8 @@
  * and BSDF sampling, delta lights and specular lobes handled without MIS, and unbiased
  * Russian roulette (digest 000: divide by the continuation probability). Emission found
  * by BSDF-sampled rays is MIS-weighted against the NEE that could have found it, so
- * nothing is counted twice. */
+ * nothing is counted twice. Scenes with participating media or null surfaces take the
+ * walk of path_media.c. */
 #include "integrator/path_common.h"
 #include "integrator/integrator.h"
 #include "core/sampling.h"
@@ -40,7 +41,9 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
   return L;
 }
 
-static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return path_radiance(c, r, smp, ts, 1); }
+static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
+  return c->s->has_media ? path_radiance_media(c, r, smp, ts, 1) : path_radiance(c, r, smp, ts, 1);
+}
 
 const integrator_ops integrator_path = {
     .name = "path",

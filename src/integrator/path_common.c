@@ -25,24 +25,32 @@ static float path_emission_weight(const render_ctx *c, const path_state *st, int
   return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)lid, st->prev_p) * light_pdf_area(&s->lights[lid], st->prev_p, it->p, it->ng));
 }
 
-int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
+void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *st, const hit *h, const isect *it, rgb *Le, float *w) {
   const scene *s = c->s;
-  hit h;
   *Le = c3(0, 0, 0);
   *w = 1;
-  if (!ctx_intersect(c, r, &h, ts)) {
+  if (!h) {
     if (c->ls.env_index >= 0) {
       *Le = light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
       *w = path_emission_weight(c, st, 1, r->d, -1, NULL);
     }
-    return 0;
+    return;
   }
-  isect_from_hit(s, r, &h, it);
-  int32_t lid = s->tri_light[h.tri];
+  int32_t lid = s->tri_light[h->tri];
   if (lid >= 0) {
     *Le = light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
     if (!c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
   }
+}
+
+int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
+  hit h;
+  if (!ctx_intersect(c, r, &h, ts)) {
+    path_vertex_emission(c, r, st, NULL, NULL, Le, w);
+    return 0;
+  }
+  isect_from_hit(c->s, r, &h, it);
+  path_vertex_emission(c, r, st, &h, it, Le, w);
   return 1;
 }
 

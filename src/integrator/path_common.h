@@ -28,6 +28,9 @@ static inline path_state path_state_start(vec3 origin) { path_state st = {1, 0, 
  * environment; black if none) and *w its MIS weight (power heuristic) against the
  * next-event estimation that could have found the same light. */
 int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w);
+/* The emission part of path_trace_vertex for a ray traced by the caller: h is its hit
+ * (it filled from it) or NULL when it escaped. */
+void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *st, const hit *h, const isect *it, rgb *Le, float *w);
 /* Samples the BSDF at it to continue the path: on success returns 1 with the weight
  * f |cos| / pdf in *weight, the state updated and *r the next ray. 0 ends the path
  * (no direction, or one on which shading and geometric normals disagree). */
@@ -46,5 +49,8 @@ float path_roulette(const path_state *st, float max_beta, int depth, sampler *sm
  * count_first_emission, the emission of the surface r hits first is left out (what that
  * surface reflects: bias compensation in vpl.c). */
 rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission);
+/* path_radiance through participating media and null surfaces (path_media.c): what
+ * `path` renders when the scene has any (scene.has_media). */
+rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission);
 
 #endif

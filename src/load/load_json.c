@@ -78,8 +78,9 @@ static valo_status parse_keyframes(jctx *c, const cJSON *a, const camera *cam) {
 
 static valo_status parse_camera(jctx *c, const cJSON *o) {
   static const char *const keys[] = {"type", "position", "look_at", "up", "fov", "height", "aperture_radius", "focus_distance",
-                                     "from_file", "keyframes", NULL};
+                                     "from_file", "keyframes", "medium", NULL};
   TRY(json_check_keys(c, o, "camera", keys));
+  TRY(json_get_medium(c, o, "medium", "camera", &c->s->cam_medium));
   camera *cam = &c->s->cam;
   const cJSON *ff = cJSON_GetObjectItemCaseSensitive(o, "from_file");
   if (ff && !cJSON_IsBool(ff)) return json_bad(c, "camera.from_file", "must be true or false");
@@ -224,11 +225,22 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
-                                     "proximity", NULL};
+                                     "proximity", "interior", "exterior", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
+  int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
+  TRY(json_get_medium(c, o, "interior", where, &inside));
+  TRY(json_get_medium(c, o, "exterior", where, &outside));
   valo_status st = parse_shape_geometry(c, o, where, mfirst, mend);
   if (st) return st;
+  if (inside != MEDIUM_KEEP || outside != MEDIUM_KEEP) {
+    /* A medium boundary: the side not named is vacuum. */
+    shape_media *q = realloc(c->s->shape_media, (c->s->nshape_media + 1) * sizeof *q);
+    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    c->s->shape_media = q;
+    shape_media sm = {first, c->s->ntris, inside == MEDIUM_KEEP ? MEDIUM_NONE : inside, outside == MEDIUM_KEEP ? MEDIUM_NONE : outside};
+    q[c->s->nshape_media++] = sm;
+  }
   const cJSON *px = cJSON_GetObjectItemCaseSensitive(o, "proximity");
   if (!px) return VALO_OK;
   char w2[96];
@@ -384,10 +396,12 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
   }
   free(text);
   valo_status st = VALO_OK;
-  static const char *const keys[] = {"camera", "film", "render", "shapes", "materials", "lights", "environment", NULL};
+  static const char *const keys[] = {"camera", "film", "render", "shapes", "materials", "media", "lights", "environment", NULL};
 #undef TRY
 #define TRY(x) do { st = (x); if (st) goto done; } while (0)
   TRY(json_check_keys(&c, root, "(top level)", keys));
+  const cJSON *media = cJSON_GetObjectItemCaseSensitive(root, "media");
+  if (media) TRY(json_parse_media(&c, media));
   const cJSON *cam = cJSON_GetObjectItemCaseSensitive(root, "camera");
   if (cam) TRY(parse_camera(&c, cam));
   const cJSON *film = cJSON_GetObjectItemCaseSensitive(root, "film");

@@ -27,6 +27,11 @@ void json_resolve_path(const jctx *c, const char *rel, char *out, size_t n);
 void json_line_col(const char *text, const char *at, int *line, int *col);
 /* Materials (load_json_material.c): the material object `o` named `name`. */
 valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, material *m);
+/* The top-level "media" object: adds each named medium to the scene. */
+valo_status json_parse_media(jctx *c, const cJSON *o);
+/* The medium named by key `key` of o (a string naming one of "media"): *med stays as it
+ * is when the key is absent. */
+valo_status json_get_medium(jctx *c, const cJSON *o, const char *key, const char *where, int32_t *med);
 
 #define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 

@@ -1,5 +1,6 @@
-/* load_json_material.c — owns the JSON scene format's materials (docs/scene-format.md,
- * "materials"): types, colours or texture maps, conductor presets and spectra, maps. */
+/* load_json_material.c — owns the JSON scene format's materials and media
+ * (docs/scene-format.md, "materials", "media"): types, colours or texture maps,
+ * conductor presets and spectra, maps; homogeneous media and their names. */
 #include "load/load_json_internal.h"
 #include "core/error.h"
 #include "core/spectrum.h"
@@ -108,7 +109,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor, pbr)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor, pbr, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -118,6 +119,13 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
+  if (!strcmp(type, "null")) {
+    /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
+    static const char *const k_null[] = {"type", NULL};
+    TRY(json_check_keys(c, o, where, k_null));
+    m->type = MAT_NULL;
+    return VALO_OK;
+  }
   if (!strcmp(type, "pbr")) {
     TRY(json_check_keys(c, o, where, k_pbr));
     m->type = MAT_PBR;
@@ -178,7 +186,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "eta", where, &m->eta));
     TRY(json_get_rgb(c, o, "k", where, &m->k));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));
@@ -193,3 +201,50 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   return VALO_OK;
 }
 
+
+valo_status json_parse_media(jctx *c, const cJSON *o) {
+  if (!cJSON_IsObject(o)) return json_bad(c, "media", "must be an object of named media");
+  for (const cJSON *e = o->child; e; e = e->next) {
+    char where[256];
+    snprintf(where, sizeof where, "media.%s", e->string);
+    if (!cJSON_IsObject(e)) return json_bad(c, where, "must be an object");
+    static const char *const keys[] = {"type", "sigma_a", "sigma_s", "scale", "g", NULL};
+    TRY(json_check_keys(c, e, where, keys));
+    const char *type = NULL;
+    TRY(json_get_str(c, e, "type", where, &type));
+    if (!type || strcmp(type, "homogeneous")) return json_bad(c, where, "needs \"type\": \"homogeneous\" (the one kind of medium)");
+    for (uint32_t i = 0; i < c->s->nmedia; i++)
+      if (!strcmp(c->s->media[i].name, e->string)) return json_bad(c, where, "a medium of this name is already defined");
+    medium m;
+    memset(&m, 0, sizeof m);
+    snprintf(m.name, sizeof m.name, "%s", e->string);
+    m.sigma_a = c3(1, 1, 1);
+    m.sigma_s = c3(1, 1, 1);
+    double scale = 1, g = 0;
+    TRY(json_get_rgb(c, e, "sigma_a", where, &m.sigma_a));
+    TRY(json_get_rgb(c, e, "sigma_s", where, &m.sigma_s));
+    TRY(json_get_num(c, e, "scale", where, 0, 1e9, &scale));
+    TRY(json_get_num(c, e, "g", where, -0.999, 0.999, &g));
+    m.sigma_a = c3_scale(m.sigma_a, (float)scale);
+    m.sigma_s = c3_scale(m.sigma_s, (float)scale);
+    m.g = (float)g;
+    if (!c3_finite(m.sigma_a) || !c3_finite(m.sigma_s)) return json_bad(c, where, "sigma_a and sigma_s times scale must be finite");
+    medium *q = realloc(c->s->media, (c->s->nmedia + 1) * sizeof *q);
+    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    c->s->media = q;
+    q[c->s->nmedia++] = m;
+  }
+  return VALO_OK;
+}
+
+valo_status json_get_medium(jctx *c, const cJSON *o, const char *key, const char *where, int32_t *med) {
+  const char *name = NULL;
+  TRY(json_get_str(c, o, key, where, &name));
+  if (!name) return VALO_OK;
+  for (uint32_t i = 0; i < c->s->nmedia; i++)
+    if (!strcmp(c->s->media[i].name, name)) { *med = (int32_t)i; return VALO_OK; }
+  char w[300], msg[200];
+  snprintf(w, sizeof w, "%s.%s", where, key);
+  snprintf(msg, sizeof msg, "medium \"%.100s\" is not defined in \"media\"", name);
+  return json_bad(c, w, msg);
+}

@@ -27,6 +27,7 @@ bsdf bsdf_from_material(const material *m) {
   b.p_first = 1;
   switch (m->type) {
   case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
+  case MAT_NULL: b.type = BSDF_DIFFUSE; b.kd = c3(0, 0, 0); break; /* path passes it by; nothing else sees it */
   case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_MIRROR: b.type = BSDF_MIRROR; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
@@ -293,6 +294,7 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_DIELECTRIC: return c3(1, 1, 1);
   case MAT_CONDUCTOR: return fresnel_conductor(fabsf(cos_o), m->eta, m->k);
   case MAT_PBR: return m->kd;
+  case MAT_NULL: break;
   }
   return c3(0, 0, 0);
 }

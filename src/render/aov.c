@@ -20,9 +20,17 @@ int aov_kind_of(const char *output, size_t *plen) {
 
 void aov_record(const session *ss, ray ry, float *acc, sampler *smp, thread_stats *ts) {
   hit h;
-  if (!ctx_intersect(&ss->ctx, &ry, &h, ts)) return;
   isect it;
-  isect_from_hit(ss->s, &ry, &h, &it);
+  float before = 0; /* the distance to the last null surface passed (they have no AOVs) */
+  for (int crossed = 0;; crossed++) {
+    if (!ctx_intersect(&ss->ctx, &ry, &h, ts)) return;
+    isect_from_hit(ss->s, &ry, &h, &it);
+    if (it.m->type != MAT_NULL) break;
+    if (crossed == 256) return;
+    before += h.t * v3_len(ry.d);
+    ry.o = offset_origin_isect(&it, ry.d);
+    ry.tmax = INFINITY;
+  }
   bsdf b = bsdf_at(ss->s, &it);
   material tm = *it.m;
   tm.kd = b.kd;
@@ -31,7 +39,7 @@ void aov_record(const session *ss, ray ry, float *acc, sampler *smp, thread_stat
   vec3 n = v3_faceforward(it.ns, v3_neg(ry.d));
   acc[AOV_ALBEDO] += a.r; acc[AOV_ALBEDO + 1] += a.g; acc[AOV_ALBEDO + 2] += a.b;
   acc[AOV_NORMAL] += n.x; acc[AOV_NORMAL + 1] += n.y; acc[AOV_NORMAL + 2] += n.z;
-  acc[AOV_DEPTH] += h.t * v3_len(ry.d);
+  acc[AOV_DEPTH] += before + h.t * v3_len(ry.d);
   if (!(ss->opt.aovs & VALO_AOVS_AO)) return;
   vec3 dir;
   sampler_set_dim(smp, SDIM_AOV);

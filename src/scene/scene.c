@@ -12,6 +12,7 @@ scene *scene_new(const char *path) {
   scene *s = calloc(1, sizeof *s);
   if (!s) return NULL;
   snprintf(s->path, sizeof s->path, "%s", path ? path : "");
+  s->cam_medium = MEDIUM_NONE;
   return s;
 }
 
@@ -19,6 +20,7 @@ void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
+  free(s->media); free(s->shape_media); free(s->tri_media);
   envmap_destroy(s->env_map);
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
   free(s->tex);
@@ -214,6 +216,26 @@ static int compute_tangents(scene *s) {
   return 0;
 }
 
+/* Per-triangle media from the shapes that bound them; has_media when any medium or null
+ * surface is there to render. */
+static valo_status commit_media(scene *s, valo_error *err) {
+  free(s->tri_media);
+  s->tri_media = NULL;
+  s->has_media = s->nmedia > 0;
+  for (uint32_t m = 0; m < s->nmats && !s->has_media; m++) s->has_media = s->mats[m].type == MAT_NULL;
+  if (!s->nshape_media) return VALO_OK;
+  s->tri_media = malloc((size_t)s->ntris * 2 * sizeof(int32_t));
+  if (!s->tri_media) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  for (uint32_t t = 0; t < 2 * s->ntris; t++) s->tri_media[t] = MEDIUM_KEEP;
+  for (uint32_t i = 0; i < s->nshape_media; i++)
+    for (uint32_t t = s->shape_media[i].first; t < s->shape_media[i].end && t < s->ntris; t++) {
+      s->tri_media[2 * t] = s->shape_media[i].interior;
+      s->tri_media[2 * t + 1] = s->shape_media[i].exterior;
+    }
+  return VALO_OK;
+}
+#define TRY_ST(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
+
 valo_status scene_commit(scene *s, valo_error *err) {
   if (s->ntris == 0 && s->nlights == 0 && !s->has_env)
     return err_set(err, VALO_ERR_INVALID, "%s: the scene has no geometry and no lights", s->path);
@@ -244,6 +266,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
     s->tri_light[t] = (int32_t)s->nlights;
     if (scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   }
+  TRY_ST(commit_media(s, err));
   int any_normal_map = 0;
   for (uint32_t m = 0; m < s->nmats; m++) any_normal_map |= s->mats[m].tex_normal >= 0;
   if (any_normal_map) {

@@ -15,7 +15,8 @@ typedef enum mat_type {
   MAT_MIRROR,      /* kd/pi + ideal mirror ks, no Fresnel (MTL illum 5; JSON mirror: kd=0) */
   MAT_DIELECTRIC,  /* smooth dielectric, index ior */
   MAT_CONDUCTOR,   /* smooth conductor, complex index eta + i k per channel */
-  MAT_PBR          /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
+  MAT_PBR,         /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
+  MAT_NULL         /* no surface: rays pass straight through (a medium's boundary) */
 } mat_type;
 
 typedef struct material {
@@ -50,6 +51,15 @@ typedef struct material {
  * between points, constant beyond the ends (core/spectrum.h tab_eval). */
 #define NK_MAX 256
 typedef struct nk_curve { int n; float nm[NK_MAX], eta[NK_MAX], k[NK_MAX]; } nk_curve;
+
+/* A homogeneous participating medium (JSON "media"): absorption and scattering
+ * coefficients per unit length (RGB, scale applied) and the Henyey-Greenstein g. */
+typedef struct medium { rgb sigma_a, sigma_s; float g; char name[64]; } medium;
+#define MEDIUM_NONE (-1)  /* vacuum */
+#define MEDIUM_KEEP (-2)  /* tri_media: the triangle is no medium boundary */
+/* The media of one JSON shape's triangles [first, end): inside (against the winding
+ * normal) and outside (MEDIUM_NONE: vacuum). */
+typedef struct shape_media { uint32_t first, end; int32_t interior, exterior; } shape_media;
 
 typedef enum light_type { LIGHT_AREA, LIGHT_POINT, LIGHT_SPOT, LIGHT_DIRECTIONAL, LIGHT_ENV } light_type;
 typedef struct light {
@@ -131,6 +141,15 @@ typedef struct scene {
   int cam_auto;            /* the camera was framed automatically (scene_camera_fit) */
   shape_ao *shape_ao;      /* per-shape proximity-AO settings (JSON "proximity"), sorted by first */
   uint32_t nshape_ao;
+  medium *media;           /* participating media (JSON "media"), nmedia of them */
+  uint32_t nmedia;
+  shape_media *shape_media;/* shapes that bound media, in triangle order */
+  uint32_t nshape_media;
+  int32_t *tri_media;      /* after commit, when a shape bounds a medium: 2 per triangle,
+                              interior and exterior medium (MEDIUM_KEEP: no boundary);
+                              else NULL */
+  int32_t cam_medium;      /* the medium around the camera (JSON camera.medium), or MEDIUM_NONE */
+  int has_media;           /* after commit: media or null surfaces (path renders them) */
   bbox bounds;
   vec3 center;
   float radius;
@@ -161,6 +180,12 @@ int material_has_maps(const material *m);
 valo_status scene_commit(scene *s, valo_error *err);
 /* The proximity-AO settings of the JSON shape triangle t belongs to (NULL: none). */
 const shape_ao *scene_shape_ao(const scene *s, uint32_t t);
+/* The medium a ray in medium `cur` is in after crossing triangle t (winding normal ng)
+ * in direction d: the triangle's interior or exterior when it bounds a medium, else cur. */
+static inline int32_t scene_medium_after(const scene *s, uint32_t t, vec3 ng, vec3 d, int32_t cur) {
+  if (!s->tri_media || s->tri_media[2 * t] == MEDIUM_KEEP) return cur;
+  return s->tri_media[2 * t + (v3_dot(d, ng) < 0 ? 0 : 1)];
+}
 /* Geometric (unnormalised cross product) normal of triangle t. */
 static inline vec3 scene_tri_ng(const scene *s, uint32_t t) {
   const uint32_t *i = &s->idx[3 * t];

@@ -1,0 +1,134 @@
+/* path_media.c — owns the path integrator's walk through participating media and null
+ * surfaces (pbrt-v3's VolPathIntegrator, Mitsuba 3's volpath, for homogeneous media):
+ * free-flight sampling with MIS over the RGB channels (material/medium.h) between
+ * surfaces; at a scattering point next-event estimation with the Henyey-Greenstein phase
+ * function, MIS-weighted against phase sampling, and phase sampling to continue. Rays
+ * pass null surfaces without a vertex (no depth, no MIS state), changing medium where a
+ * shape bounds one; shadow rays do the same and carry the transmittance of every medium
+ * they cross, so next-event estimation and MIS work as in path.c (the weights use the
+ * directional pdfs: both strategies carry the same transmittance). */
+#include "integrator/path_common.h"
+#include "integrator/integrator.h"
+#include "material/medium.h"
+#include "core/sampling.h"
+
+/* A ray crossing more null surfaces than this in one segment is taken to be stuck (an
+ * offset that failed) and ends, as a blocked shadow ray. */
+#define NULL_CROSSINGS_MAX 256
+
+/* Transmittance along the segment r (to r.o + r.d, up to r.tmax) starting in medium
+ * med: the product of each crossed medium's Beer-Lambert term, 0 when a surface that is
+ * not null blocks it. far: the light lies at infinity (environment, directional), so a
+ * medium the segment ends in goes on for ever. */
+static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int far, thread_stats *ts) {
+  const scene *s = c->s;
+  rgb tr = c3(1, 1, 1);
+  vec3 target = v3_add(r.o, r.d);
+  for (int k = 0; k < NULL_CROSSINGS_MAX; k++) {
+    hit h;
+    int found = ctx_intersect(c, &r, &h, ts);
+    if (med >= 0) tr = c3_mul(tr, medium_tr(&s->media[med], found ? h.t * v3_len(r.d) : far ? INFINITY : r.tmax * v3_len(r.d)));
+    if (!found) return tr;
+    if (s->mats[s->tri_mat[h.tri]].type != MAT_NULL) return c3(0, 0, 0);
+    isect it;
+    isect_from_hit(s, &r, &h, &it);
+    med = scene_medium_after(s, h.tri, it.ng, r.d, med);
+    r.o = offset_origin_isect(&it, r.d);
+    r.d = v3_sub(target, r.o);
+    r.tmax = 1 - 1e-4f;
+  }
+  return c3(0, 0, 0);
+}
+
+/* Next-event estimation at a scattering point p of medium med (HG g) for viewer
+ * direction wo, MIS-weighted (power heuristic) against phase sampling. */
+static rgb medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sampler *smp, thread_stats *ts) {
+  float pmf;
+  light_li ls;
+  if (direct_light_sample(c, p, smp, &pmf, &ls) == UINT32_MAX) return c3(0, 0, 0);
+  float f = phase_hg(v3_dot(wo, ls.wi), c->s->media[med].g), light_pdf = pmf * ls.pdf;
+  if (!(f > 0) || !(light_pdf > 0)) return c3(0, 0, 0);
+  rgb tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), ts);
+  if (c3_black(tr)) return c3(0, 0, 0);
+  float w = ls.delta ? 1.0f : power_heuristic(light_pdf, f);
+  return c3_scale(c3_mul(ls.L, tr), f * w / light_pdf);
+}
+
+rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
+  const scene *s = c->s;
+  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
+  path_state st = path_state_start(r.o);
+  int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
+  int32_t med = s->cam_medium;
+  uint32_t flight = 0; /* free-flight samples drawn so far (their dimensions) */
+  for (int depth = 0;; depth++) {
+    /* To the next vertex: a scattering point, a surface that is not null, or away. */
+    isect it;
+    hit h;
+    int found = 0, scattered = 0, crossings = 0;
+    vec3 mp = r.o;
+    for (;;) {
+      found = ctx_intersect(c, &r, &h, ts);
+      if (med >= 0) {
+        float dlen = v3_len(r.d), t;
+        rgb w;
+        sampler_set_dim(smp, SDIM_MEDIUM + 2 * (flight++ % SDIM_MEDIUM_MAX));
+        float uc = sampler_1d(smp), ud = sampler_1d(smp);
+        scattered = medium_sample_distance(&s->media[med], uc, ud, found ? h.t * dlen : INFINITY, &t, &w);
+        beta = c3_mul(beta, w);
+        if (c3_black(beta)) return L;
+        if (scattered) { mp = v3_add(r.o, v3_scale(r.d, t / dlen)); break; }
+      }
+      if (!found) break;
+      isect_from_hit(s, &r, &h, &it);
+      if (it.m->type != MAT_NULL) break;
+      med = scene_medium_after(s, h.tri, it.ng, r.d, med);
+      r.o = offset_origin_isect(&it, r.d);
+      r.tmax = INFINITY;
+      if (++crossings > NULL_CROSSINGS_MAX) return L;
+    }
+    if (scattered) {
+      if (depth >= max_depth) break;
+      vec3 wo = v3_neg(v3_norm(r.d)), wi;
+      float g = s->media[med].g, u1, u2;
+      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
+      L = c3_add(L, c3_mul(beta, medium_direct(c, mp, wo, med, smp, ts)));
+      sampler_set_dim(smp, sdim_bounce(depth, SDIM_BSDF_DIR));
+      sampler_2d(smp, &u1, &u2);
+      float pdf = phase_hg_sample(wo, g, u1, u2, &wi); /* weight phase / pdf = 1 */
+      st.specular = 0;
+      st.prev_pdf = pdf;
+      st.prev_p = mp;
+      r.o = mp;
+      r.d = wi;
+      r.tmax = INFINITY;
+    } else {
+      rgb Le;
+      float w;
+      path_vertex_emission(c, &r, &st, found ? &h : NULL, found ? &it : NULL, &Le, &w);
+      if (!c3_black(Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
+      if (!found || depth >= max_depth) break;
+      vec3 wo = v3_neg(r.d), ng = it.ng; /* the winding normal: shading_frame may turn it->ng */
+      bsdf b = bsdf_at(s, &it);
+      frame fr = shading_frame(&it, &b, wo);
+      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
+      direct_sample d;
+      if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, &it, &b, &fr, wo, smp, ts, 1, &d)) {
+        ray sr = segment_ray(offset_origin_isect(&it, v3_sub(d.p_light, it.p)), it.p, d.p_light, d.n_light);
+        rgb tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, ts);
+        L = c3_add(L, c3_mul(beta, c3_scale(c3_mul(c3_mul(d.f_cos, d.Li), tr), d.scale)));
+      }
+      rgb weight;
+      sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
+      if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
+      med = scene_medium_after(s, it.tri, ng, r.d, med);
+      beta = c3_mul(beta, weight);
+    }
+    if (c3_black(beta) || !c3_finite(beta)) break;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
+    float survive = path_roulette(&st, c3_max(beta), depth, smp);
+    if (survive == 0) break;
+    beta = c3_scale(beta, survive);
+  }
+  return L;
+}

@@ -1,0 +1,202 @@
+/* test_media.c — participating media and null surfaces against analytic results: a
+ * white furnace of a scattering medium (from outside its null boundary and with the
+ * camera inside), Beer-Lambert transmittance through an absorbing sphere pixel by pixel,
+ * null surfaces that change nothing (AOVs see through them), and the integrators that
+ * refuse media. Mitsuba 3's
+ * volpath is the independent reference in test_mitsuba (smoke_ball, absorbing_glass);
+ * the sampling routines are in test_chi2 (hg_phase, free_flight). */
+#include "harness.h"
+#include "valo/valo.h"
+#include "image/image_io.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A null sphere of radius 1 filled with `medium` (JSON), in a uniform environment of
+ * radiance 1, seen by `camera` (JSON). */
+static float *media_render(const char *camera, const char *medium, int spp, int res, const valo_options *opt) {
+  char json[2048];
+  snprintf(json, sizeof json,
+           "{ \"camera\": %s,\n"
+           "  \"film\": {\"width\": %d, \"height\": %d}, \"render\": {\"spp\": %d, \"seed\": 3},\n"
+           "  \"media\": {\"m\": %s},\n"
+           "  \"materials\": {\"edge\": {\"type\": \"null\"}},\n"
+           "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 5, \"material\": \"edge\", \"interior\": \"m\"}],\n"
+           "  \"environment\": {\"type\": \"constant\", \"radiance\": 1} }\n",
+           camera, res, res, spp, medium);
+  int w, h;
+  return render_json_text(json, opt, &w, &h);
+}
+
+/* Every channel's mean over the image must be 1 within 5 standard errors (estimated
+ * from the pixels' spread: chromatic media give heavy-tailed pixels) plus 0.2 %. */
+static int furnace_check(const char *what, const float *px, int n) {
+  CHECK(px, "%s: render failed", what);
+  double sum[3] = {0}, sum2[3] = {0};
+  for (int i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++) {
+      CHECK(isfinite(px[3 * i + c]) && px[3 * i + c] >= 0, "%s: pixel %d not finite", what, i);
+      sum[c] += px[3 * i + c];
+      sum2[c] += (double)px[3 * i + c] * px[3 * i + c];
+    }
+  for (int c = 0; c < 3; c++) {
+    double m = sum[c] / n, se = sqrt(fmax(0, sum2[c] / n - m * m) / n);
+    fprintf(stderr, "%s: channel %d mean %.5f (expect 1, standard error %.5f)\n", what, c, m, se);
+    CHECK(fabs(m - 1) < 5 * se + 0.002, "%s: channel %d mean %g, not 1", what, c, m);
+  }
+  return 0;
+}
+
+/* Albedo 1, chromatic sigma_s, forward and backward lobes: the medium neither adds nor
+ * removes light, so every pixel is 1 in expectation, whether the camera looks at the
+ * sphere from outside or sits inside the medium (camera.medium). The channels scatter
+ * at different rates, so this holds only if picking a channel for free-flight sampling
+ * is weighted right (medium.h). */
+static int medium_furnace(void) {
+  static const char *const media[] = {"{\"type\": \"homogeneous\", \"sigma_a\": 0, \"sigma_s\": [1, 2, 4], \"g\": 0.7}",
+                                      "{\"type\": \"homogeneous\", \"sigma_a\": 0, \"sigma_s\": [3, 1, 0.5], \"g\": -0.4}"};
+  int spp = test_full() ? 1024 : 256;
+  for (int k = 0; k < 2; k++) {
+    float *px = media_render("{\"position\": [0, 0, 3.2], \"look_at\": [0, 0, 0], \"fov\": 45}", media[k], spp, 32, NULL);
+    int rc = furnace_check(k ? "furnace, backward lobe, from outside" : "furnace, forward lobe, from outside", px, 32 * 32);
+    free(px);
+    if (rc) return rc;
+  }
+  float *px = media_render("{\"position\": [0, 0, 0.2], \"look_at\": [0, 0, -1], \"fov\": 90, \"medium\": \"m\"}", media[0], spp, 32, NULL);
+  int rc = furnace_check("furnace, camera inside the medium", px, 32 * 32);
+  free(px);
+  return rc;
+}
+
+/* A purely absorbing sphere of radius 1 seen by an orthographic camera against the
+ * environment: each pixel is exp(-sigma_a * chord), the chord 2 sqrt(1 - r^2) at the
+ * pixel's distance r from the axis (the icosphere's facets lie within 2e-4 of the
+ * sphere). The film is box-filtered, so a pixel averages the chord over its square;
+ * pixels are compared where that average and the centre's value agree to 0.1 %. */
+static int beer_lambert(void) {
+  const int res = 48, spp = test_full() ? 1024 : 256;
+  const double sa[3] = {0.25, 0.8, 2.0}, half = 1.2; /* view height 2.4 */
+  char medium[256];
+  snprintf(medium, sizeof medium, "{\"type\": \"homogeneous\", \"sigma_a\": [%g, %g, %g], \"sigma_s\": 0}", sa[0], sa[1], sa[2]);
+  float *px = media_render("{\"type\": \"orthographic\", \"height\": 2.4, \"position\": [0, 0, 3], \"look_at\": [0, 0, 0]}", medium, spp, res, NULL);
+  CHECK(px, "render failed");
+  double worst = 0, sum_err[3] = {0};
+  int n = 0;
+  for (int y = 0; y < res; y++)
+    for (int x = 0; x < res; x++) {
+      double want[3] = {0}, centre[3];
+      for (int sy = 0; sy < 8; sy++)
+        for (int sx = 0; sx < 8; sx++) {
+          double u = (x + (sx + 0.5) / 8) / res * 2 * half - half, v = (y + (sy + 0.5) / 8) / res * 2 * half - half;
+          double r2 = u * u + v * v, chord = r2 < 1 ? 2 * sqrt(1 - r2) : 0;
+          for (int c = 0; c < 3; c++) want[c] += exp(-sa[c] * chord) / 64;
+        }
+      double u = (x + 0.5) / res * 2 * half - half, v = (y + 0.5) / res * 2 * half - half, r2 = u * u + v * v;
+      for (int c = 0; c < 3; c++) centre[c] = exp(-sa[c] * (r2 < 1 ? 2 * sqrt(1 - r2) : 0));
+      int smooth = r2 < 0.8 || r2 > 1.2;
+      for (int c = 0; c < 3; c++) smooth &= fabs(centre[c] - want[c]) < 1e-3 * want[c];
+      if (!smooth) continue;
+      n++;
+      for (int c = 0; c < 3; c++) {
+        double e = (px[3 * (y * res + x) + c] - want[c]) / want[c];
+        sum_err[c] += e;
+        if (fabs(e) > worst) worst = fabs(e);
+      }
+    }
+  free(px);
+  fprintf(stderr, "beer-lambert: %d pixels, mean relative error %.4f %.4f %.4f, worst pixel %.3f\n", n, sum_err[0] / n, sum_err[1] / n,
+          sum_err[2] / n, worst);
+  CHECK(n > res * res / 4, "only %d pixels compared", n);
+  for (int c = 0; c < 3; c++) CHECK(fabs(sum_err[c] / n) < 0.01, "channel %d: mean error %.4f", c, sum_err[c] / n);
+  /* each sample passes (weight Tr / mean Tr) or is absorbed (0): a pixel's noise is
+   * that of a coin, largest in the densest channel */
+  CHECK(worst < (test_full() ? 0.25 : 0.5), "worst pixel off by %.3f", worst);
+  return 0;
+}
+
+/* A null sphere that bounds no medium is not there: the Cornell-like scene with and
+ * without one around the diffuse ball agrees within its noise (the null scene goes
+ * through the media walk, the other through path's own). */
+static int null_surface_invisible(void) {
+  const char *fmt = "{ \"camera\": {\"position\": [0, 1, 4], \"look_at\": [0, 0.5, 0], \"fov\": 40},\n"
+                    "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": %d, \"seed\": 4},\n"
+                    "  \"materials\": {\"ball\": {\"type\": \"diffuse\", \"reflectance\": 0.6}, \"edge\": {\"type\": \"null\"},\n"
+                    "                 \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 10}},\n"
+                    "  \"shapes\": [{\"type\": \"sphere\", \"center\": [0, 0.5, 0], \"radius\": 0.5, \"material\": \"ball\"},\n"
+                    "             {\"type\": \"sphere\", \"center\": [0.5, 2.5, 0], \"radius\": 0.3, \"material\": \"lamp\"}%s],\n"
+                    "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.2} }\n";
+  char a[2048], b[2048];
+  int spp = test_full() ? 1024 : 256, w, h;
+  snprintf(a, sizeof a, fmt, spp, "");
+  snprintf(b, sizeof b, fmt, spp, ", {\"type\": \"sphere\", \"center\": [0, 0.5, 0], \"radius\": 0.8, \"material\": \"edge\"}");
+  float *pa = render_json_text(a, NULL, &w, &h), *pb = render_json_text(b, NULL, &w, &h);
+  CHECK(pa && pb, "render failed");
+  cmp_result cr;
+  compare_images(pb, pa, w, h, 8, &cr);
+  free(pa);
+  free(pb);
+  fprintf(stderr, "null sphere: mean differences %.3f%% %.3f%% %.3f%%, worst 8x8 block %.2f%%\n", 100 * cr.mean_err[0], 100 * cr.mean_err[1],
+          100 * cr.mean_err[2], 100 * cr.worst_block);
+  for (int c = 0; c < 3; c++) CHECK(cr.mean_err[c] < 0.01, "channel %d differs by %.2f%%", c, 100 * cr.mean_err[c]);
+  CHECK(cr.worst_block < 0.05, "a block differs by %.2f%%", 100 * cr.worst_block);
+  return 0;
+}
+
+/* AOVs describe the first surface that is not null: a plane seen through a smoke-filled
+ * null sphere has the plane's albedo, normal and depth (3) at the centre. */
+static int aovs_through_null(void) {
+  CHECK(scratch_file("media_plane.obj", "v -5 -5 0\nv -5 5 0\nv 5 5 0\nv 5 -5 0\nf 1 2 3 4\n"), "write");
+  const char *path = scratch_file("media_aov.json",
+      "{ \"camera\": {\"position\": [0,0,3], \"look_at\": [0,0,0], \"fov\": 30},\n"
+      "  \"film\": {\"width\": 9, \"height\": 9}, \"render\": {\"spp\": 8},\n"
+      "  \"media\": {\"smoke\": {\"type\": \"homogeneous\", \"sigma_a\": 0.5, \"sigma_s\": 2}},\n"
+      "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": [0.2,0.4,0.6]}, \"edge\": {\"type\": \"null\"}},\n"
+      "  \"shapes\": [{\"file\": \"media_plane.obj\", \"material\": \"m\"},\n"
+      "             {\"type\": \"sphere\", \"center\": [0,0,1.5], \"radius\": 0.8, \"material\": \"edge\", \"interior\": \"smoke\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0,2,2], \"intensity\": 1}] }\n");
+  valo_options o;
+  valo_options_init(&o);
+  o.aovs = 1;
+  valo_scene *sc;
+  valo_render *r = render_file(path, &o, &sc);
+  CHECK(r, "render failed");
+  const char *names[3] = {"albedo", "normal", "depth"};
+  image im[3];
+  for (int k = 0; k < 3; k++) CHECK(read_aov(r, names[k], &im[k]) == 0, "cannot write or read the %s AOV", names[k]);
+  const float *a = &im[0].rgb[3 * (4 * 9 + 4)], *n = &im[1].rgb[3 * (4 * 9 + 4)], *d = &im[2].rgb[3 * (4 * 9 + 4)];
+  fprintf(stderr, "centre: albedo %g %g %g, normal %g %g %g, depth %g\n", a[0], a[1], a[2], n[0], n[1], n[2], d[0]);
+  CHECK(fabsf(a[0] - 0.2f) < 1e-5f && fabsf(a[1] - 0.4f) < 1e-5f && fabsf(a[2] - 0.6f) < 1e-5f, "albedo (%g %g %g)", a[0], a[1], a[2]);
+  CHECK(fabsf(n[2] - 1) < 1e-5f, "normal (%g %g %g)", n[0], n[1], n[2]);
+  CHECK(fabsf(d[0] - 3) < 0.01f, "centre depth %g, expected 3", d[0]);
+  for (int k = 0; k < 3; k++) image_free(&im[k]);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return 0;
+}
+
+/* Only path renders media: the others and spectral mode are refused, naming why. */
+static int media_need_path(void) {
+  static const char *const others[] = {"whitted", "distribution", "restir-di", "vpl", "photon", "ao"};
+  const char *medium = "{\"type\": \"homogeneous\", \"sigma_a\": 0.1, \"sigma_s\": 1}";
+  for (size_t k = 0; k <= sizeof others / sizeof others[0]; k++) {
+    valo_options o;
+    valo_options_init(&o);
+    if (k < sizeof others / sizeof others[0]) snprintf(o.integrator, sizeof o.integrator, "%s", others[k]);
+    else o.spectral = 1;
+    fprintf(stderr, "%s: ", k < sizeof others / sizeof others[0] ? others[k] : "path --spectral");
+    float *px = media_render("{\"position\": [0, 0, 3.2], \"look_at\": [0, 0, 0]}", medium, 1, 8, &o);
+    CHECK(!px, "rendered a scene with media");
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"medium_furnace", medium_furnace},
+                                    {"beer_lambert", beer_lambert},
+                                    {"null_surface_invisible", null_surface_invisible},
+                                    {"aovs_through_null", aovs_through_null},
+                                    {"media_need_path", media_need_path},
+                                    {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
