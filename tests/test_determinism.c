@@ -2,7 +2,8 @@
  * (pixels and the EXR file bytes), on a self-contained scene exercising every material
  * and light type; a different seed gives a different image. Cancelling keeps the finished
  * passes (cancel_keeps_passes, cancel_mid_pass). A crop window renders that part of the
- * frame's image bit for bit (crop_is_part_of_frame). */
+ * frame's image bit for bit (crop_is_part_of_frame). The walk through participating
+ * media too (media_threads_identical, scenes/cornell-media.json). */
 #include "harness.h"
 #include "image/image_io.h"
 #include <math.h>
@@ -63,6 +64,33 @@ static int threads_bit_identical(void) {
  * pixels and depth AOV, for the perspective camera with the Gaussian filter, and for
  * orthographic and spherical cameras (their rays offset by the window's corner). Given
  * alone, crop_x runs to the frame's right edge. */
+static int media_threads_identical(void) {
+  float *px[2];
+  int w = 0, h = 0;
+  for (int k = 0; k < 2; k++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.threads = k ? 3 : 1;
+    o.width = 40; o.height = 32; o.spp = 8;
+    valo_scene *sc;
+    valo_render *r = render_file(VALO_SOURCE_DIR "/scenes/cornell-media.json", &o, &sc);
+    CHECK(r, "render failed");
+    valo_stats st;
+    valo_render_stats(r, &st);
+    w = st.width; h = st.height;
+    px[k] = malloc((size_t)w * h * 3 * sizeof(float));
+    valo_render_pixels(r, px[k]);
+    valo_render_destroy(r);
+    valo_scene_destroy(sc);
+  }
+  double sum = 0;
+  for (int i = 0; i < w * h * 3; i++) sum += px[0][i];
+  CHECK(sum > 0, "image is black");
+  CHECK(memcmp(px[0], px[1], (size_t)w * h * 3 * sizeof(float)) == 0, "1 and 3 threads differ");
+  free(px[0]); free(px[1]);
+  return 0;
+}
+
 static int crop_is_part_of_frame(void) {
   static const char *const cams[3] = {"", "\"type\": \"orthographic\", \"height\": 3, ", "\"type\": \"spherical\", "};
   for (int k = 0; k < 3; k++) {
@@ -288,7 +316,7 @@ static int cancel_mid_pass(void) {
 }
 
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"crop_is_part_of_frame", crop_is_part_of_frame}, {"exr_bytes_identical", exr_bytes_identical},
+  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"crop_is_part_of_frame", crop_is_part_of_frame}, {"media_threads_identical", media_threads_identical}, {"exr_bytes_identical", exr_bytes_identical},
                                     {"adaptive_threads_identical", adaptive_threads_identical},
                                     {"cancel_keeps_passes", cancel_keeps_passes}, {"cancel_mid_pass", cancel_mid_pass}, {NULL, NULL}};
   return test_main(argc, argv, cases);
