@@ -93,6 +93,15 @@ MEDIUM_SCENES = {
     "smoke-ball": {"boundary": {"type": "null"}, "sigma_a": [0.3, 0.3, 0.3], "sigma_s": [3.0, 1.8, 0.9], "g": 0.5},
     "absorbing-glass": {"boundary": {"type": "dielectric", "ior": 1.5, "roughness": 0.3}, "sigma_a": [0.3, 1.2, 3.0], "sigma_s": [0, 0, 0], "g": 0},
 }
+# A cloud: the ball's null boundary around a grid medium (valo's "grid" medium, Mitsuba's
+# heterogeneous medium with a gridvolume) whose density, a few Gaussian blobs on 32^3
+# texels (GRID_FILE, written here), fills the ball's bounding box; grey extinction of
+# GRID_SCALE times the density with a chromatic albedo (valo: sigma_s = albedo x scale,
+# sigma_a = (1 - albedo) x scale). Both look the grid up trilinearly with texel centres
+# at (i + 0.5) / 32 of the box, clamped at its edge texels.
+GRID_SCENES = {"cloud-grid": {"albedo": [0.95, 0.8, 0.6], "scale": 12.0, "g": 0.3}}
+GRID_FILE, GRID_N = "cloud.vol", 32
+GRID_LO, GRID_HI = [-0.55, 0.0, -0.55], [0.55, 1.1, 0.55]
 # A quad textured with an sRGB PNG under a uniform white environment (radiance = albedo):
 # quadrants red, green, blue, yellow from the image's top-left, so a flipped u or v shows.
 TEXTURE_SCENES = {"textured-quad": "quad-texture.png"}
@@ -206,6 +215,32 @@ def mitsuba_medium(m):
             "phase": {"type": "hg", "g": m["g"]}}
 
 
+def cloud_density(x, y, z):
+    blobs = [((0.0, 0.55, 0.0), 0.09, 1.0), ((0.22, 0.7, 0.1), 0.03, 0.8), ((-0.2, 0.4, -0.1), 0.04, 0.7)]
+    return sum(a * math.exp(-((x - c[0]) ** 2 + (y - c[1]) ** 2 + (z - c[2]) ** 2) / w) for c, w, a in blobs)
+
+
+def write_grid():
+    vals = []
+    for k in range(GRID_N):
+        for j in range(GRID_N):
+            for i in range(GRID_N):
+                p = [GRID_LO[a] + (GRID_HI[a] - GRID_LO[a]) * (t + 0.5) / GRID_N for a, t in enumerate((i, j, k))]
+                vals.append(cloud_density(*p))
+    with open(os.path.join(OUT, GRID_FILE), "wb") as f:
+        f.write(b"VOL" + bytes([3]) + struct.pack("<5i", 1, GRID_N, GRID_N, GRID_N, 1) + struct.pack("<6f", *GRID_LO, *GRID_HI))
+        f.write(struct.pack("<%df" % len(vals), *vals))
+
+
+def grid_json(name, m):
+    j = valo_json(name, {"type": "null"})
+    sc, al = m["scale"], m["albedo"]
+    j["media"] = {"cloud": {"type": "grid", "file": GRID_FILE, "sigma_s": [a * sc for a in al], "sigma_a": [(1 - a) * sc for a in al],
+                            "g": m["g"], "bounds_min": GRID_LO, "bounds_max": GRID_HI}}
+    j["shapes"][0]["interior"] = "cloud"
+    return j
+
+
 def env_json(name, mats):
     return {"camera": {"position": [0, 0, 4.2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": 40},
             "film": {"width": 128, "height": 64}, "render": {"spp": 64},
@@ -278,6 +313,15 @@ def scene_dict(mi, name, mat, spp):
         d["sensor"] = sensor(mi, mat["camera"], ORTHO_W, ORTHO_H, spp)
         d["sensor"]["film"]["rfilter"] = {"type": mat["filter"]}
         return d, ORTHO_W, ORTHO_H
+    if name in GRID_SCENES:
+        d, w, h = scene_dict(mi, "gold-rough", {"type": "null"}, spp)
+        d["integrator"] = dict(INTEGRATOR, type="volpath")
+        ext = [GRID_HI[a] - GRID_LO[a] for a in range(3)]
+        d["ball"]["interior"] = {"type": "heterogeneous", "albedo": {"type": "rgb", "value": mat["albedo"]}, "scale": mat["scale"],
+                                 "sigma_t": {"type": "gridvolume", "filename": os.path.join(OUT, GRID_FILE),
+                                             "to_world": T().translate(GRID_LO) @ T().scale(ext)},
+                                 "phase": {"type": "hg", "g": mat["g"]}}
+        return d, w, h
     if name in MEDIUM_SCENES:
         d, w, h = scene_dict(mi, "gold-rough", mat["boundary"], spp)
         d["integrator"] = dict(INTEGRATOR, type="volpath")
@@ -354,10 +398,11 @@ def main():
         INTEGRATOR = {"type": "path", "max_depth": a.max_depth + 1, "rr_depth": 1000}
         SUFFIX = "-depth%d" % a.max_depth
     write_meshes()
+    write_grid()
     for tex in TEXTURE_SCENES.values():
         write_texture(os.path.join(OUT, tex))
     kinds = [(SCENES, valo_json), (ENV_SCENES, env_json), (TEXTURE_SCENES, texture_json), (LIGHT_SCENES, light_json),
-             (CAMERA_SCENES, camera_json), (MEDIUM_SCENES, medium_json)]
+             (CAMERA_SCENES, camera_json), (MEDIUM_SCENES, medium_json), (GRID_SCENES, grid_json)]
     for table, to_json in kinds:
         for name, what in table.items():
             with open(os.path.join(OUT, name + ".json"), "w") as f:
@@ -366,7 +411,7 @@ def main():
     import mitsuba as mi
     mi.set_variant(a.variant)
     for name, mat in (list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()) +
-                      list(CAMERA_SCENES.items()) + list(MEDIUM_SCENES.items())):
+                      list(CAMERA_SCENES.items()) + list(MEDIUM_SCENES.items()) + list(GRID_SCENES.items())):
         if not a.only or a.only == name:
             render(mi, name, mat, a.spp, a.seed)
 

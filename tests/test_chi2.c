@@ -917,7 +917,7 @@ static int hg_phase(void) {
 static int free_flight(void) {
   enum { CELLS = 64 };
   const float tmax = 1.5f;
-  medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, "grey"};
+  medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, NULL, "grey"};
   double obs[CELLS + 1] = {0}, ex[CELLS + 1];
   long n = nsamples();
   double st = 1.2;
@@ -938,7 +938,7 @@ static int free_flight(void) {
   ex[CELLS] = n * exp(-st * tmax);
   int rc = chi2_check("free-flight distances, grey medium", obs, ex, CELLS + 1);
 
-  medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, "col"};
+  medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, NULL, "col"};
   rgb sig_t = medium_sigma_t(&col);
   double pass[3] = {0}, event[3] = {0}, pass2[3] = {0}, event2[3] = {0};
   for (long i = 0; i < n; i++) {

@@ -129,6 +129,23 @@ static int wrong_type(void) {
 /* Participating media: each mistake names its key; a medium an integrator cannot
  * render is refused by name (exit 1). */
 static int bad_media(void) {
+  /* grids of 2 x 2 x 2: one cut short, one right (for med15, whose fault is its box),
+   * one with a negative density */
+  unsigned char vol[4 + 20 + 24 + 32];
+  int32_t head[5] = {1, 2, 2, 2, 1};
+  float box[6] = {0, 0, 0, 1, 1, 1}, d[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  memcpy(vol, "VOL\3", 4); memcpy(vol + 4, head, 20); memcpy(vol + 24, box, 24); memcpy(vol + 48, d, 32);
+  FILE *f = fopen(scratch_path("short.vol"), "wb");
+  CHECK(f && fwrite(vol, 1, sizeof vol - 8, f) == sizeof vol - 8, "write");
+  fclose(f);
+  f = fopen(scratch_path("ok.vol"), "wb");
+  CHECK(f && fwrite(vol, 1, sizeof vol, f) == sizeof vol, "write");
+  fclose(f);
+  d[5] = -1;
+  memcpy(vol + 48, d, 32);
+  f = fopen(scratch_path("neg.vol"), "wb");
+  CHECK(f && fwrite(vol, 1, sizeof vol, f) == sizeof vol, "write");
+  fclose(f);
   static const struct { const char *name, *json, *said1, *said2; } cases[] = {
       {"med1.json", "{ \"media\": {\"fog\": {\"type\": \"heterogeneous\"}} }", "media.fog", "homogeneous"},
       {"med2.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"sigma_a\": -1}} }", "media.fog.sigma_a", "not be negative"},
@@ -139,6 +156,13 @@ static int bad_media(void) {
       {"med7.json", "{ \"materials\": {\"edge\": {\"type\": \"null\", \"emission\": 1}} }", "materials.edge", "unknown key \"emission\""},
       {"med8.json", "{ \"media\": {\"fog\": {\"type\": \"homogeneous\", \"scale\": 1e300}} }", "media.fog.scale", "1e+09"},
       {"med9.json", "{ \"media\": [1] }", "media", "object of named media"},
+      {"med11.json", "{ \"media\": {\"c\": {\"type\": \"grid\"}} }", "media.c", "needs \"file\""},
+      {"med12.json", "{ \"media\": {\"c\": {\"type\": \"grid\", \"file\": \"none.vol\"}} }", "media.c.file", "none.vol"},
+      {"med13.json", "{ \"media\": {\"c\": {\"type\": \"grid\", \"file\": \"short.vol\"}} }", "short.vol", "ends before its 2 x 2 x 2 values"},
+      {"med14.json", "{ \"media\": {\"c\": {\"type\": \"grid\", \"file\": \"neg.vol\"}} }", "neg.vol", "not negative"},
+      {"med15.json", "{ \"media\": {\"c\": {\"type\": \"grid\", \"file\": \"ok.vol\", \"bounds_min\": [0,0,0], \"bounds_max\": [1,0,1]}} }",
+       "media.c", "bounds_min < bounds_max"},
+      {"med16.json", "{ \"media\": {\"c\": {\"type\": \"homogeneous\", \"file\": \"a.vol\"}} }", "media.c", "unknown key \"file\""},
   };
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
     const char *p = write_file(cases[k].name, cases[k].json);

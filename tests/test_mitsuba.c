@@ -97,6 +97,9 @@ static int ortho_camera(void) { return against_mitsuba("ortho-camera", 256, 16, 
  * scattering medium (forward HG lobe) behind a null boundary, and rough glass filled
  * with an absorbing one (Beer-Lambert colour). */
 static int smoke_ball(void) { return against_mitsuba("smoke-ball", 512, 16, 0); }
+/* A grid medium (a cloud of Gaussian blobs on 32^3 texels, chromatic albedo) behind the
+ * ball's null boundary, against Mitsuba's heterogeneous medium and gridvolume. */
+static int cloud_grid(void) { return against_mitsuba("cloud-grid", 512, 16, 0); }
 static int absorbing_glass(void) { return against_mitsuba("absorbing-glass", 1536, 32, 0); }
 
 /* The Gaussian pixel filter (film.filter) against Mitsuba's, on the same view: the image
@@ -161,7 +164,7 @@ static int env_spheres(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
                                     {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
-                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"smoke_ball", smoke_ball}, {"absorbing_glass", absorbing_glass}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
+                                    {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"smoke_ball", smoke_ball}, {"absorbing_glass", absorbing_glass}, {"cloud_grid", cloud_grid}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {NULL, NULL}};

@@ -20,14 +20,19 @@
  * med: the product of each crossed medium's Beer-Lambert term, 0 when a surface that is
  * not null blocks it. far: the light lies at infinity (environment, directional), so a
  * medium the segment ends in goes on for ever. */
-static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int far, thread_stats *ts) {
+static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int far, uint64_t key, thread_stats *ts) {
   const scene *s = c->s;
   rgb tr = c3(1, 1, 1);
   vec3 target = v3_add(r.o, r.d);
   for (int k = 0; k < NULL_CROSSINGS_MAX; k++) {
     hit h;
     int found = ctx_intersect(c, &r, &h, ts);
-    if (med >= 0) tr = c3_mul(tr, medium_tr(&s->media[med], found ? h.t * v3_len(r.d) : far ? INFINITY : r.tmax * v3_len(r.d)));
+    if (med >= 0) {
+      float dl = v3_len(r.d);
+      float len = found ? h.t * dl : far ? INFINITY : r.tmax * dl;
+      tr = c3_mul(tr, medium_transmittance(&s->media[med], r.o, v3_scale(r.d, 1 / dl), len, rng_mix64(key + (uint64_t)k)));
+      if (c3_black(tr)) return tr;
+    }
     if (!found) return tr;
     if (s->mats[s->tri_mat[h.tri]].type != MAT_NULL) return c3(0, 0, 0);
     isect it;
@@ -42,17 +47,22 @@ static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int fa
 
 /* Next-event estimation at a scattering point p of medium med (HG g) for viewer
  * direction wo, MIS-weighted (power heuristic) against phase sampling. */
-static rgb medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sampler *smp, thread_stats *ts) {
+static rgb medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sampler *smp, uint64_t key, thread_stats *ts) {
   float pmf;
   light_li ls;
   if (direct_light_sample(c, p, smp, &pmf, &ls) == UINT32_MAX) return c3(0, 0, 0);
   float f = phase_hg(v3_dot(wo, ls.wi), c->s->media[med].g), light_pdf = pmf * ls.pdf;
   if (!(f > 0) || !(light_pdf > 0)) return c3(0, 0, 0);
-  rgb tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), ts);
+  rgb tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), key, ts);
   if (c3_black(tr)) return c3(0, 0, 0);
   float w = ls.delta ? 1.0f : power_heuristic(light_pdf, f);
   return c3_scale(c3_mul(ls.L, tr), f * w / light_pdf);
 }
+
+/* The key of a tracking walk's random numbers: hashed from the camera sample's key
+ * (distinct per pixel, sample index and seed) and the walk's number n (free flights
+ * count up from 0, shadow rays down from ~0 by depth). */
+static uint64_t walk_key(const sampler *smp, uint32_t n) { return rng_mix64(smp->key ^ (0x6d65646961ULL + (uint64_t)n * 0xd1b54a32d192ed03ULL)); }
 
 rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
   const scene *s = c->s;
@@ -60,7 +70,8 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
   path_state st = path_state_start(r.o);
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
   int32_t med = s->cam_medium;
-  uint32_t flight = 0; /* free-flight samples drawn so far (their dimensions) */
+  uint32_t flight = 0; /* free-flight samples drawn so far (their dimensions), and the
+                          key of each tracking walk's own random numbers (grid media) */
   for (int depth = 0;; depth++) {
     /* To the next vertex: a scattering point, a surface that is not null, or away. */
     isect it;
@@ -74,10 +85,11 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
         rgb w;
         sampler_set_dim(smp, SDIM_MEDIUM + 2 * (flight++ % SDIM_MEDIUM_MAX));
         float uc = sampler_1d(smp), ud = sampler_1d(smp);
-        scattered = medium_sample_distance(&s->media[med], uc, ud, found ? h.t * dlen : INFINITY, &t, &w);
+        vec3 dir = v3_scale(r.d, 1 / dlen);
+        scattered = medium_sample(&s->media[med], r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w);
         beta = c3_mul(beta, w);
         if (c3_black(beta)) return L;
-        if (scattered) { mp = v3_add(r.o, v3_scale(r.d, t / dlen)); break; }
+        if (scattered) { mp = v3_add(r.o, v3_scale(dir, t)); break; }
       }
       if (!found) break;
       isect_from_hit(s, &r, &h, &it);
@@ -92,7 +104,7 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
       vec3 wo = v3_neg(v3_norm(r.d)), wi;
       float g = s->media[med].g, u1, u2;
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-      L = c3_add(L, c3_mul(beta, medium_direct(c, mp, wo, med, smp, ts)));
+      L = c3_add(L, c3_mul(beta, medium_direct(c, mp, wo, med, smp, walk_key(smp, ~(uint32_t)depth), ts)));
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_BSDF_DIR));
       sampler_2d(smp, &u1, &u2);
       float pdf = phase_hg_sample(wo, g, u1, u2, &wi); /* weight phase / pdf = 1 */
@@ -115,7 +127,7 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
       direct_sample d;
       if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, &it, &b, &fr, wo, smp, ts, 1, &d)) {
         ray sr = segment_ray(offset_origin_isect(&it, v3_sub(d.p_light, it.p)), it.p, d.p_light, d.n_light);
-        rgb tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, ts);
+        rgb tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, walk_key(smp, ~(uint32_t)depth), ts);
         L = c3_add(L, c3_mul(beta, c3_scale(c3_mul(c3_mul(d.f_cos, d.Li), tr), d.scale)));
       }
       rgb weight;

@@ -4,6 +4,7 @@
 #include "load/load_json_internal.h"
 #include "core/error.h"
 #include "core/spectrum.h"
+#include "scene/volume.h"
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -202,17 +203,43 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
 }
 
 
+/* A grid medium's density: "file" (Mitsuba's .vol) placed in its own box or in
+ * [bounds_min, bounds_max]. */
+static valo_status parse_grid(jctx *c, const cJSON *e, const char *where, medium *m) {
+  const char *file = NULL;
+  TRY(json_get_str(c, e, "file", where, &file));
+  if (!file) return json_bad(c, where, "a grid medium needs \"file\" (a .vol density grid)");
+  char full[2048];
+  json_resolve_path(c, file, full, sizeof full);
+  valo_error gerr;
+  if (density_grid_load(full, &m->grid, &gerr)) {
+    char w[300];
+    snprintf(w, sizeof w, "%s.file", where);
+    return json_bad(c, w, gerr.message);
+  }
+  vec3 lo = m->grid->box.lo, hi = m->grid->box.hi;
+  valo_status st = json_get_vec(c, e, "bounds_min", where, 0, &lo);
+  if (!st) st = json_get_vec(c, e, "bounds_max", where, 0, &hi);
+  if (!st && !(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) st = json_bad(c, where, "the grid's box needs bounds_min < bounds_max on every axis");
+  if (st) { density_grid_free(m->grid); m->grid = NULL; return st; }
+  m->grid->box.lo = lo;
+  m->grid->box.hi = hi;
+  return VALO_OK;
+}
+
 valo_status json_parse_media(jctx *c, const cJSON *o) {
   if (!cJSON_IsObject(o)) return json_bad(c, "media", "must be an object of named media");
   for (const cJSON *e = o->child; e; e = e->next) {
     char where[256];
     snprintf(where, sizeof where, "media.%s", e->string);
     if (!cJSON_IsObject(e)) return json_bad(c, where, "must be an object");
-    static const char *const keys[] = {"type", "sigma_a", "sigma_s", "scale", "g", NULL};
-    TRY(json_check_keys(c, e, where, keys));
     const char *type = NULL;
     TRY(json_get_str(c, e, "type", where, &type));
-    if (!type || strcmp(type, "homogeneous")) return json_bad(c, where, "needs \"type\": \"homogeneous\" (the one kind of medium)");
+    int grid = type && !strcmp(type, "grid");
+    if (!type || (!grid && strcmp(type, "homogeneous"))) return json_bad(c, where, "needs a \"type\": \"homogeneous\" or \"grid\"");
+    static const char *const keys[] = {"type", "sigma_a", "sigma_s", "scale", "g", NULL};
+    static const char *const gkeys[] = {"type", "sigma_a", "sigma_s", "scale", "g", "file", "bounds_min", "bounds_max", NULL};
+    TRY(json_check_keys(c, e, where, grid ? gkeys : keys));
     for (uint32_t i = 0; i < c->s->nmedia; i++)
       if (!strcmp(c->s->media[i].name, e->string)) return json_bad(c, where, "a medium of this name is already defined");
     medium m;
@@ -229,8 +256,9 @@ valo_status json_parse_media(jctx *c, const cJSON *o) {
     m.sigma_s = c3_scale(m.sigma_s, (float)scale);
     m.g = (float)g;
     if (!c3_finite(m.sigma_a) || !c3_finite(m.sigma_s)) return json_bad(c, where, "sigma_a and sigma_s times scale must be finite");
+    if (grid) TRY(parse_grid(c, e, where, &m));
     medium *q = realloc(c->s->media, (c->s->nmedia + 1) * sizeof *q);
-    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    if (!q) { density_grid_free(m.grid); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
     c->s->media = q;
     q[c->s->nmedia++] = m;
   }

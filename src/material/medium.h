@@ -1,8 +1,11 @@
-/* medium.h — owns what a homogeneous participating medium does to a ray: the
- * Henyey-Greenstein phase function (value and sampling), free-flight distance sampling
+/* medium.h — owns what a participating medium does to a ray: the Henyey-Greenstein phase
+ * function (value and sampling); in a homogeneous medium free-flight distance sampling
  * with single-sample MIS over the RGB channels (pbrt-v3's HomogeneousMedium::Sample) and
- * transmittance (Beer-Lambert). Directions follow pbrt: wo points back along the path,
- * so forward scattering (g > 0) sends wi close to -wo. */
+ * transmittance (Beer-Lambert); in a grid medium (medium.c) spectral tracking (Kutz et
+ * al. 2017: delta tracking against one majorant, null and real collisions chosen in
+ * proportion to their throughput-weighted coefficients) and ratio tracking. Directions
+ * follow pbrt: wo points back along the path, so forward scattering (g > 0) sends wi
+ * close to -wo. */
 #ifndef VALO_MEDIUM_H
 #define VALO_MEDIUM_H
 #include "core/sampling.h"
@@ -59,4 +62,13 @@ static inline int medium_sample_distance(const medium *m, float uc, float ud, fl
   *weight = p > 0 ? c3_scale(tr, 1 / p) : c3(0, 0, 0);
   return 0;
 }
+
+/* Where a ray from o along unit d in medium m first scatters before the surface at
+ * tmax (INFINITY: none), as medium_sample_distance: homogeneous media from (uc, ud),
+ * grid media by spectral tracking inside the grid's box with random numbers hashed
+ * from key (their count varies). */
+int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight);
+/* Transmittance from o along unit d over length len (INFINITY: for ever): exact in a
+ * homogeneous medium, by ratio tracking (random numbers from key) in a grid. */
+rgb medium_transmittance(const medium *m, vec3 o, vec3 d, float len, uint64_t key);
 #endif

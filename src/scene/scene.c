@@ -3,6 +3,7 @@
 #include "scene/scene.h"
 #include "core/error.h"
 #include "scene/envmap.h"
+#include "scene/volume.h"
 #include "image/texture.h"
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +21,7 @@ void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
+  for (uint32_t i = 0; i < s->nmedia; i++) density_grid_free(s->media[i].grid);
   free(s->media); free(s->shape_media); free(s->tri_media);
   envmap_destroy(s->env_map);
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
