@@ -7,6 +7,9 @@
  * Streams:
  *   pixel         sampler_make_kind(seed, pixel, sample index): every camera sample, and
  *                 restir's per-pixel choices (sample index = frame)
+ *   medium walks  rng_mix64(the pixel stream's key ^ the walk's number): the tracking
+ *                 walks of grid media (path_media.c walk_key), whose count of random
+ *                 numbers varies, hashed rather than taken from a dimension
  *   pixel child   sampler_child(pixel stream, j, n): final gathering (photon), per-light
  *                 cones (vsl), compensation and sampled shadow rays (vpl), RIS
  *                 candidates (restir), restir-gi's path from its sample point
