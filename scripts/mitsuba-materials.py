@@ -54,6 +54,7 @@ SCENES = {
     "copper-smooth": {"type": "conductor", **COPPER},
     "glass-rough": {"type": "dielectric", "ior": 1.5, "roughness": 0.3},
     "glass-smooth": {"type": "dielectric", "ior": 1.5},
+    "thin-glass": {"type": "thindielectric", "ior": 1.5},
     # glTF metallic-roughness, fully metallic: valo's metal lobe is Schlick's Fresnel on the
     # base colour with GGX, as Mitsuba's principled BSDF at metallic 1 (its other lobes off).
     # Not the dielectric part: principled's specular layer (metallic 0, black base) uses the
@@ -254,6 +255,8 @@ def mitsuba_bsdf(mat):
     r = mat.get("roughness", 0)
     if mat["type"] == "null":
         return {"type": "null"}
+    if mat["type"] == "thindielectric":
+        return {"type": "thindielectric", "int_ior": mat["ior"], "ext_ior": 1.0}
     if mat["type"] == "conductor":
         if "spectrum" in mat:
             sp = mat["spectrum"]

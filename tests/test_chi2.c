@@ -476,6 +476,28 @@ static int delta_lobes(void) {
       double sigma = sqrt(n * F * (1 - F)) + 1e-9;
       CHECK(fabs(refl - n * F) <= 6 * sigma + 1e-9, "side %d angle %g: %ld reflections, expected %.1f", side, angles[a], refl, n * F);
     }
+  /* A thin pane: reflects 2R / (1 + R) of the light (both faces and every bounce between
+   * them, R the single face's Fresnel term), from either side, and passes the rest
+   * straight on. 2R/(1+R) is written here, not taken from bsdf.c's sum. */
+  m.type = MAT_THIN_DIELECTRIC;
+  b = bsdf_from_material(&m);
+  for (int side = 0; side < 2; side++)
+    for (int a = 0; a < 4; a++) {
+      float th = angles[a] * (float)M_PI / 180;
+      vec3 wo = v3(sinf(th), 0, side ? -cosf(th) : cosf(th));
+      float R1 = fresnel_dielectric(fabsf(wo.z), 1.5f), R = 2 * R1 / (1 + R1);
+      long n = 200000, refl = 0;
+      for (long i = 0; i < n; i++) {
+        sampler s = sampler_make(8, (uint64_t)i, 0);
+        bsdf_sample bs;
+        CHECK(bsdf_sample_dir(&b, wo, sampler_1d(&s), 0.5f, 0.5f, &bs) && bs.delta, "thin dielectric sample failed");
+        CHECK(bs.weight.r == 1 && bs.eta_scale == 1, "thin dielectric weight %g, eta scale %g", bs.weight.r, bs.eta_scale);
+        if (bs.wi.z * wo.z > 0) refl++;
+        else CHECK(v3_len(v3_add(bs.wi, wo)) < 1e-6f, "a thin pane bent the ray");
+      }
+      double sigma = sqrt(n * R * (1 - R)) + 1e-9;
+      CHECK(fabs(refl - n * R) <= 6 * sigma + 1e-9, "thin, side %d angle %g: %ld reflections, expected %.1f", side, angles[a], refl, n * R);
+    }
   /* Normal incidence, n = 1.5: F = 0.04. Beyond the critical angle: F = 1. */
   CHECK(fabsf(fresnel_dielectric(1, 1.5f) - 0.04f) < 1e-6f, "F(0) = %g", fresnel_dielectric(1, 1.5f));
   CHECK(fresnel_dielectric(-0.3f, 1.5f) == 1.0f, "no total internal reflection");

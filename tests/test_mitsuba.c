@@ -67,6 +67,9 @@ static int gold_rough(void) { return against_mitsuba("gold-rough", 512, 16, 0); 
 static int copper_smooth(void) { return against_mitsuba("copper-smooth", 1024, 16, 0); }
 static int glass_rough(void) { return against_mitsuba("glass-rough", 1536, 16, 0); }
 static int glass_smooth(void) { return against_mitsuba("glass-smooth", 1024, 32, 0); }
+/* a thin pane bent into a ball (Mitsuba's thindielectric): reflection of both faces,
+ * light passing straight through */
+static int thin_glass(void) { return against_mitsuba("thin-glass", 1024, 32, 0); }
 /* an sRGB PNG on an OBJ quad (UVs from the file) under a uniform white sky: decoding,
  * filtering and the orientation of u and v */
 static int textured_quad(void) { return against_mitsuba("textured-quad", 64, 16, 0); }
@@ -163,7 +166,7 @@ static int env_spheres(void) {
 
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"gold_rough", gold_rough}, {"copper_smooth", copper_smooth}, {"glass_rough", glass_rough},
-                                    {"glass_smooth", glass_smooth}, {"env_spheres", env_spheres},
+                                    {"glass_smooth", glass_smooth}, {"thin_glass", thin_glass}, {"env_spheres", env_spheres},
                                     {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"smoke_ball", smoke_ball}, {"absorbing_glass", absorbing_glass}, {"cloud_grid", cloud_grid}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},

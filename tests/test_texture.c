@@ -349,7 +349,7 @@ static char *uv_sphere_obj(int n) {
   return t;
 }
 
-/* The stress scene: rough glass (roughness 0.3 and 0.01) and a near-mirror
+/* The stress scene: rough glass (roughness 0.3 and 0.01), a thin pane and a near-mirror
  * rough metal, all under a normal map of random normals tilted up to 70 degrees, on a
  * normal-mapped floor seen at grazing angles, lit by a small area light and an
  * environment. Every integrator must finish it with no NaN, infinite or negative sample
@@ -380,11 +380,13 @@ static int stress_no_nan(void) {
       "    \"glass\": {\"type\": \"dielectric\", \"ior\": 1.5, \"roughness\": 0.3, \"normal_map\": \"rough-nmap.png\"},\n"
       "    \"sharp\": {\"type\": \"dielectric\", \"ior\": 1.5, \"roughness\": 0.01, \"normal_map\": \"rough-nmap.png\"},\n"
       "    \"metal\": {\"type\": \"conductor\", \"preset\": \"Au\", \"roughness\": 0.02, \"normal_map\": \"rough-nmap.png\"},\n"
+      "    \"pane\": {\"type\": \"thindielectric\", \"ior\": 1.5, \"normal_map\": \"rough-nmap.png\"},\n"
       "    \"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.6, \"normal_map\": \"rough-nmap.png\"},\n"
       "    \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 40}},\n"
       "  \"shapes\": [{\"file\": \"usphere.obj\", \"material\": \"glass\", \"transform\": {\"translate\": [-1.3, 1, 0]}},\n"
       "             {\"file\": \"usphere.obj\", \"material\": \"sharp\", \"transform\": {\"translate\": [1.3, 1, 0]}},\n"
       "             {\"file\": \"usphere.obj\", \"material\": \"metal\", \"transform\": {\"scale\": 0.6, \"translate\": [0, 0.6, 1.5]}},\n"
+      "             {\"file\": \"usphere.obj\", \"material\": \"pane\", \"transform\": {\"scale\": 0.5, \"translate\": [0, 1.7, -1]}},\n"
       "             {\"file\": \"sfloor.obj\", \"material\": \"floor\"},\n"
       "             {\"file\": \"slamp.obj\", \"material\": \"lamp\"}],\n"
       "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.3} }\n";

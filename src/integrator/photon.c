@@ -104,7 +104,7 @@ static valo_status photon_create(const render_ctx *c, void **out, valo_error *er
   if (!ps) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   for (uint32_t i = 0; i < c->s->nmats && !ps->has_specular; i++) {
     bsdf b = bsdf_from_material(&c->s->mats[i]);
-    ps->has_specular = b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR;
+    ps->has_specular = b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR || b.type == BSDF_THIN_DIELECTRIC;
   }
   float rg = 0.1f * c->s->radius, rc = 0.025f * c->s->radius;
   ps->r2cap_global = rg * rg;

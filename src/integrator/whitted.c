@@ -38,6 +38,14 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
     }
     break;
   }
+  case BSDF_THIN_DIELECTRIC: {
+    float R = fresnel_dielectric(fabsf(wo_l.z), b.eta);
+    if (R < 1) R += (1 - R) * (1 - R) * R / (1 - R * R);
+    k_refl = c3(R, R, R);
+    k_refr = c3(1 - R, 1 - R, 1 - R);
+    refr_l = v3_neg(wo_l);
+    break;
+  }
   }
   if (!c3_black(k_refl) && (wo_l.z != 0)) {
     vec3 wi = v3_norm(frame_to_world(&fr, refl_l));

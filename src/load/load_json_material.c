@@ -110,13 +110,14 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, conductor, pbr, null)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_thin[] = {"type", "ior", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
@@ -169,6 +170,12 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
+  } else if (!strcmp(type, "thindielectric")) {
+    TRY(json_check_keys(c, o, where, k_thin));
+    m->type = MAT_THIN_DIELECTRIC;
+    double ior = 1.5;
+    TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
+    m->ior = (float)ior;
   } else if (!strcmp(type, "conductor")) {
     TRY(json_check_keys(c, o, where, k_conductor));
     m->type = MAT_CONDUCTOR;
@@ -187,7 +194,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "eta", where, &m->eta));
     TRY(json_get_rgb(c, o, "k", where, &m->k));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, conductor, pbr, null)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));

@@ -31,6 +31,7 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_MIRROR: b.type = BSDF_MIRROR; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
+  case MAT_THIN_DIELECTRIC: b.type = BSDF_THIN_DIELECTRIC; break;
   case MAT_CONDUCTOR: b.type = BSDF_CONDUCTOR; break;
   case MAT_PBR: {
     b.type = BSDF_PBR;
@@ -56,7 +57,7 @@ int bsdf_has_smooth(const bsdf *b) {
   switch (b->type) {
   case BSDF_DIFFUSE: case BSDF_PHONG: return 1;
   case BSDF_MIRROR: return b->p_first > 0;
-  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: return 0;
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: return 1;
   }
   return 0;
@@ -150,7 +151,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
     float lobe = ca > 0 ? (b->exponent + 2) * (0.5f * INV_PI_F) * powf(ca, b->exponent) : 0;
     return c3_add(c3_scale(b->kd, INV_PI_F), c3_scale(b->ks, lobe));
   }
-  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: return c3(0, 0, 0);
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return c3(0, 0, 0);
   case BSDF_PBR: return pbr_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
@@ -170,7 +171,7 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_MIRROR: return b->p_first * cosine_hemisphere_pdf(wi.z);
   case BSDF_PHONG:
     return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * phong_lobe_pdf(phong_cos_alpha(wo, wi), b->exponent);
-  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: return 0;
+  case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_PBR: return pbr_pdf(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
@@ -224,6 +225,17 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     s->weight = conductor_F(b, wo.z);
     s->pdf = 0;
     s->delta = 1;
+    return 1;
+  }
+  case BSDF_THIN_DIELECTRIC: {
+    /* Both faces of a pane, light bouncing between them summed (pbrt-v4's
+     * ThinDielectricBxDF): R' = R + T^2 R / (1 - R^2), the rest passes straight on. */
+    float R = fresnel_dielectric(fabsf(wo.z), b->eta);
+    if (R < 1) R += (1 - R) * (1 - R) * R / (1 - R * R);
+    s->pdf = 0;
+    s->delta = 1;
+    s->wi = ulobe < R ? v3(-wo.x, -wo.y, wo.z) : v3_neg(wo);
+    s->weight = c3(1, 1, 1);
     return 1;
   }
   case BSDF_DIELECTRIC: {
@@ -291,7 +303,7 @@ rgb material_albedo(const material *m, float cos_o) {
   switch (m->type) {
   case MAT_DIFFUSE: return m->kd;
   case MAT_PHONG: case MAT_MIRROR: return c3_add(m->kd, m->ks);
-  case MAT_DIELECTRIC: return c3(1, 1, 1);
+  case MAT_DIELECTRIC: case MAT_THIN_DIELECTRIC: return c3(1, 1, 1);
   case MAT_CONDUCTOR: return fresnel_conductor(fabsf(cos_o), m->eta, m->k);
   case MAT_PBR: return m->kd;
   case MAT_NULL: break;

@@ -10,7 +10,7 @@
 
 typedef enum bsdf_type {
   BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR,
-  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR
+  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR, BSDF_THIN_DIELECTRIC
 } bsdf_type;
 
 typedef struct bsdf {
@@ -49,5 +49,7 @@ int bsdf_has_smooth(const bsdf *b);
  * reflectance at cos_o for conductors, white for glass. */
 rgb material_albedo(const material *m, float cos_o);
 /* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
-static inline int bsdf_transmits(const bsdf *b) { return b->type == BSDF_DIELECTRIC || b->type == BSDF_ROUGH_DIELECTRIC; }
+static inline int bsdf_transmits(const bsdf *b) {
+  return b->type == BSDF_DIELECTRIC || b->type == BSDF_ROUGH_DIELECTRIC || b->type == BSDF_THIN_DIELECTRIC;
+}
 #endif

@@ -16,7 +16,8 @@ typedef enum mat_type {
   MAT_DIELECTRIC,  /* smooth dielectric, index ior */
   MAT_CONDUCTOR,   /* smooth conductor, complex index eta + i k per channel */
   MAT_PBR,         /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
-  MAT_NULL         /* no surface: rays pass straight through (a medium's boundary) */
+  MAT_NULL,        /* no surface: rays pass straight through (a medium's boundary) */
+  MAT_THIN_DIELECTRIC /* a thin pane of glass, index ior: reflects as both faces do, transmits without bending */
 } mat_type;
 
 typedef struct material {
