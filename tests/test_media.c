@@ -8,6 +8,7 @@
 #include "harness.h"
 #include "valo/valo.h"
 #include "image/image_io.h"
+#include "scene/volume.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -187,6 +188,50 @@ static int grid_medium(void) {
   return 0;
 }
 
+/* The .vol reader and the lookup: a 4 x 3 x 2 grid of v = x + 10 y + 100 z (texel
+ * indices) in the box [0, 4] x [0, 3] x [0, 2], so texel (i, j, k) is centred at
+ * (i + 0.5, j + 0.5, k + 0.5): exact at the centres, linear between them, the edge
+ * texel's value within half a texel of the box's face, 0 outside; uint8 values / 255. */
+static int grid_lookup(void) {
+  for (int enc = 1; enc <= 3; enc += 2) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/lookup%d.vol", scratch_dir(), enc);
+    FILE *f = fopen(path, "wb");
+    CHECK(f, "write");
+    int32_t head[5] = {enc, 4, 3, 2, 1};
+    float box[6] = {0, 0, 0, 4, 3, 2};
+    fwrite("VOL\3", 1, 4, f);
+    fwrite(head, 4, 5, f);
+    fwrite(box, 4, 6, f);
+    for (int k = 0; k < 2; k++)
+      for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 4; i++) {
+          float v = (float)(i + 10 * j + 100 * k);
+          unsigned char b = (unsigned char)v;
+          if (enc == 1) fwrite(&v, 4, 1, f);
+          else fwrite(&b, 1, 1, f);
+        }
+    fclose(f);
+    density_grid *g;
+    valo_error err;
+    CHECK(density_grid_load(path, &g, &err) == VALO_OK, "%s", err.message);
+    float unit = enc == 1 ? 1 : 1 / 255.0f;
+    CHECK(fabsf(g->dmax - 123 * unit) < 1e-6f, "largest density %g", (double)g->dmax);
+    struct { vec3 p; float want; } at[] = {
+        {{0.5f, 0.5f, 0.5f}, 0}, {{3.5f, 2.5f, 1.5f}, 123}, {{1.5f, 0.5f, 0.5f}, 1},              /* centres */
+        {{1.0f, 0.5f, 0.5f}, 0.5f}, {{2.0f, 1.0f, 1.0f}, 1.5f + 5 + 50}, {{1.25f, 2.0f, 0.75f}, 0.75f + 15 + 25}, /* between */
+        {{0.1f, 0.2f, 0.3f}, 0}, {{3.9f, 2.9f, 1.9f}, 123},                                     /* edge texels */
+        {{-0.01f, 1, 1}, -1}, {{4.01f, 1, 1}, -1}, {{1, 1, 2.5f}, -1}};                          /* outside: 0 */
+    for (size_t q = 0; q < sizeof at / sizeof at[0]; q++) {
+      float got = density_grid_at(g, at[q].p), want = at[q].want < 0 ? 0 : at[q].want * unit;
+      CHECK(fabsf(got - want) < 1e-4f * (1 + want), "encoding %d: density at (%g, %g, %g) is %g, want %g", enc, (double)at[q].p.x,
+            (double)at[q].p.y, (double)at[q].p.z, (double)got, (double)want);
+    }
+    density_grid_free(g);
+  }
+  return 0;
+}
+
 /* A null sphere that bounds no medium is not there: the Cornell-like scene with and
  * without one around the diffuse ball agrees within its noise (the null scene goes
  * through the media walk, the other through path's own). */
@@ -267,6 +312,7 @@ int main(int argc, char **argv) {
   static const test_case cases[] = {{"medium_furnace", medium_furnace},
                                     {"beer_lambert", beer_lambert},
                                     {"grid_medium", grid_medium},
+                                    {"grid_lookup", grid_lookup},
                                     {"null_surface_invisible", null_surface_invisible},
                                     {"aovs_through_null", aovs_through_null},
                                     {"media_need_path", media_need_path},
