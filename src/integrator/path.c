@@ -32,11 +32,7 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
     if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
     beta = c3_mul(beta, weight);
-    if (c3_black(beta) || !c3_finite(beta)) break;
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
-    float survive = path_roulette(&st, c3_max(beta), depth, smp);
-    if (survive == 0) break;
-    beta = c3_scale(beta, survive);
+    if (!path_survive(&st, &beta, depth, smp)) break;
   }
   return L;
 }

@@ -44,6 +44,17 @@ int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, 
  * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
  * survival, 0 to end the path. */
 float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp);
+/* The end of a bounce of an RGB path: 0 when the throughput *beta is black or not
+ * finite or Russian roulette (its dimension of this depth) ends the path; otherwise 1
+ * with *beta divided by the survival probability. */
+static inline int path_survive(const path_state *st, rgb *beta, int depth, sampler *smp) {
+  if (c3_black(*beta) || !c3_finite(*beta)) return 0;
+  sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
+  float survive = path_roulette(st, c3_max(*beta), depth, smp);
+  if (survive == 0) return 0;
+  *beta = c3_scale(*beta, survive);
+  return 1;
+}
 
 /* The path tracer's estimate (path.c) of the radiance arriving along r; without
  * count_first_emission, the emission of the surface r hits first is left out (what that
