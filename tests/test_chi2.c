@@ -939,7 +939,7 @@ static int hg_phase(void) {
 static int free_flight(void) {
   enum { CELLS = 64 };
   const float tmax = 1.5f;
-  medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, NULL, "grey"};
+  medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, NULL, {0, 0, 0}, "grey"};
   double obs[CELLS + 1] = {0}, ex[CELLS + 1];
   long n = nsamples();
   double st = 1.2;
@@ -947,7 +947,8 @@ static int free_flight(void) {
     sampler s = sampler_make(17, (uint64_t)i, 0);
     float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
     rgb w;
-    if (medium_sample_distance(&grey, uc, ud, tmax, &t, &w)) {
+    rgb trp;
+    if (medium_sample_distance(&grey, uc, ud, tmax, &t, &w, &trp)) {
       int c = (int)(t / tmax * CELLS);
       obs[c < CELLS ? c : CELLS - 1] += 1;
       CHECK(fabsf(w.r - 0.8f / 1.2f) < 1e-5f, "grey event weight %g, want albedo %g", (double)w.r, 0.8 / 1.2);
@@ -960,14 +961,15 @@ static int free_flight(void) {
   ex[CELLS] = n * exp(-st * tmax);
   int rc = chi2_check("free-flight distances, grey medium", obs, ex, CELLS + 1);
 
-  medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, NULL, "col"};
+  medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, NULL, {0, 0, 0}, "col"};
   rgb sig_t = medium_sigma_t(&col);
   double pass[3] = {0}, event[3] = {0}, pass2[3] = {0}, event2[3] = {0};
   for (long i = 0; i < n; i++) {
     sampler s = sampler_make(18, (uint64_t)i, 0);
     float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
     rgb w;
-    int ev = medium_sample_distance(&col, uc, ud, tmax, &t, &w);
+    rgb trp;
+    int ev = medium_sample_distance(&col, uc, ud, tmax, &t, &w, &trp);
     float wv[3] = {w.r, w.g, w.b}, sa[3] = {col.sigma_s.r, col.sigma_s.g, col.sigma_s.b}, stv[3] = {sig_t.r, sig_t.g, sig_t.b};
     for (int c = 0; c < 3; c++) {
       /* an event's weight sigma_s Tr / pdf, times sigma_t / sigma_s, estimates P(event) */

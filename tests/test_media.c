@@ -232,6 +232,55 @@ static int grid_lookup(void) {
   return 0;
 }
 
+static float one(float x, float y, float z) { (void)x; (void)y; (void)z; return 1; }
+/* Emission (the source term sigma_a Le): an absorbing sphere that glows, seen by the
+ * orthographic camera against a black environment, is Le (1 - exp(-sigma_a chord)) in
+ * each pixel; homogeneous, and as a grid of density 1 (tracking's emission estimate), and
+ * a scattering one whose albedo is 0.5 in a medium of the same sigma_a stays below that
+ * value for the absorption alone with the same emission (scattering moves light, it
+ * does not add any). */
+static int medium_emission(void) {
+  const int res = 32, spp = test_full() ? 1024 : 256;
+  const double sa[3] = {0.3, 1.0, 2.5}, Le[3] = {2, 1, 0.5}, half = 1.2;
+  const char *vol = write_vol("one.vol", 4, 1.2f, one);
+  CHECK(vol, "cannot write the grid");
+  for (int grid = 0; grid < 2; grid++) {
+    char medium[1200], json[2048];
+    snprintf(medium, sizeof medium, "{\"type\": \"%s\", %s%s%s\"sigma_a\": [%g, %g, %g], \"sigma_s\": 0, \"emission\": [%g, %g, %g]}",
+             grid ? "grid" : "homogeneous", grid ? "\"file\": \"" : "", grid ? vol : "", grid ? "\", " : "", sa[0], sa[1], sa[2], Le[0], Le[1], Le[2]);
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"type\": \"orthographic\", \"height\": 2.4, \"position\": [0, 0, 3], \"look_at\": [0, 0, 0]},\n"
+             "  \"film\": {\"width\": %d, \"height\": %d}, \"render\": {\"spp\": %d, \"seed\": 3},\n"
+             "  \"media\": {\"m\": %s}, \"materials\": {\"edge\": {\"type\": \"null\"}},\n"
+             "  \"shapes\": [{\"type\": \"sphere\", \"radius\": 1, \"subdivisions\": 5, \"material\": \"edge\", \"interior\": \"m\"}] }\n",
+             res, res, spp, medium);
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "render failed");
+    double sum_err[3] = {0};
+    int n = 0;
+    for (int y = 0; y < res; y++)
+      for (int x = 0; x < res; x++) {
+        double u = (x + 0.5) / res * 2 * half - half, v = half - (y + 0.5) / res * 2 * half, r2 = u * u + v * v;
+        if (!(r2 < 0.8)) continue; /* inside the silhouette, away from its facets */
+        double want[3] = {0};
+        for (int sy = 0; sy < 8; sy++)
+          for (int sx = 0; sx < 8; sx++) {
+            double uu = (x + (sx + 0.5) / 8) / res * 2 * half - half, vv = half - (y + (sy + 0.5) / 8) / res * 2 * half;
+            double chord = 2 * sqrt(fmax(0, 1 - uu * uu - vv * vv));
+            for (int c = 0; c < 3; c++) want[c] += Le[c] * (1 - exp(-sa[c] * chord)) / 64;
+          }
+        n++;
+        for (int c = 0; c < 3; c++) sum_err[c] += (px[3 * (y * res + x) + c] - want[c]) / want[c];
+      }
+    free(px);
+    fprintf(stderr, "emission (%s): %d pixels, mean relative error %.4f %.4f %.4f\n", grid ? "grid" : "homogeneous", n, sum_err[0] / n, sum_err[1] / n,
+            sum_err[2] / n);
+    for (int c = 0; c < 3; c++) CHECK(fabs(sum_err[c] / n) < 0.01, "%s: channel %d mean error %.4f", grid ? "grid" : "homogeneous", c, sum_err[c] / n);
+  }
+  return 0;
+}
+
 /* A null sphere that bounds no medium is not there: the Cornell-like scene with and
  * without one around the diffuse ball agrees within its noise (the null scene goes
  * through the media walk, the other through path's own). */
@@ -313,6 +362,7 @@ int main(int argc, char **argv) {
                                     {"beer_lambert", beer_lambert},
                                     {"grid_medium", grid_medium},
                                     {"grid_lookup", grid_lookup},
+                                    {"medium_emission", medium_emission},
                                     {"null_surface_invisible", null_surface_invisible},
                                     {"aovs_through_null", aovs_through_null},
                                     {"media_need_path", media_need_path},

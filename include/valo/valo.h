@@ -136,7 +136,7 @@ VALO_API void valo_load_options_init(valo_load_options *o);
  * at all gets a warning that the image will be black. */
 VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_options *lo, valo_scene **out, valo_error *err);
 /* Non-zero when the loaded scene has at least one light (emissive triangle, point, spot or
- * directional light, or a non-black environment). */
+ * directional light, a non-black environment, or a medium that glows). */
 VALO_API int valo_scene_has_light(const valo_scene *scene);
 VALO_API void valo_scene_destroy(valo_scene *scene);
 /* The options the scene file itself asks for (unset fields stay VALO_UNSET). */

@@ -31,7 +31,11 @@ VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_er
   return valo_scene_load_with(path, NULL, out, err);
 }
 
-VALO_API int valo_scene_has_light(const valo_scene *vs) { return vs->s->nlights > 0; }
+VALO_API int valo_scene_has_light(const valo_scene *vs) {
+  for (uint32_t i = 0; i < vs->s->nmedia; i++)
+    if (!c3_black(vs->s->media[i].Le) && !c3_black(vs->s->media[i].sigma_a)) return 1; /* a glowing medium */
+  return vs->s->nlights > 0;
+}
 
 VALO_API void valo_scene_destroy(valo_scene *vs) {
   if (!vs) return;

@@ -82,11 +82,12 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
       found = ctx_intersect(c, &r, &h, ts);
       if (med >= 0) {
         float dlen = v3_len(r.d), t;
-        rgb w;
+        rgb w, emit;
         sampler_set_dim(smp, SDIM_MEDIUM + 2 * (flight++ % SDIM_MEDIUM_MAX));
         float uc = sampler_1d(smp), ud = sampler_1d(smp);
         vec3 dir = v3_scale(r.d, 1 / dlen);
-        scattered = medium_sample(&s->media[med], r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w);
+        scattered = medium_sample(&s->media[med], r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w, &emit);
+        if (!c3_black(s->media[med].Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_mul(c3_mul(beta, emit), s->media[med].Le));
         beta = c3_mul(beta, w);
         if (c3_black(beta)) return L;
         if (scattered) { mp = v3_add(r.o, v3_scale(dir, t)); break; }

@@ -244,8 +244,8 @@ valo_status json_parse_media(jctx *c, const cJSON *o) {
     TRY(json_get_str(c, e, "type", where, &type));
     int grid = type && !strcmp(type, "grid");
     if (!type || (!grid && strcmp(type, "homogeneous"))) return json_bad(c, where, "needs a \"type\": \"homogeneous\" or \"grid\"");
-    static const char *const keys[] = {"type", "sigma_a", "sigma_s", "scale", "g", NULL};
-    static const char *const gkeys[] = {"type", "sigma_a", "sigma_s", "scale", "g", "file", "bounds_min", "bounds_max", NULL};
+    static const char *const keys[] = {"type", "sigma_a", "sigma_s", "scale", "g", "emission", NULL};
+    static const char *const gkeys[] = {"type", "sigma_a", "sigma_s", "scale", "g", "emission", "file", "bounds_min", "bounds_max", NULL};
     TRY(json_check_keys(c, e, where, grid ? gkeys : keys));
     for (uint32_t i = 0; i < c->s->nmedia; i++)
       if (!strcmp(c->s->media[i].name, e->string)) return json_bad(c, where, "a medium of this name is already defined");
@@ -259,6 +259,7 @@ valo_status json_parse_media(jctx *c, const cJSON *o) {
     TRY(json_get_rgb(c, e, "sigma_s", where, &m.sigma_s));
     TRY(json_get_num(c, e, "scale", where, 0, 1e9, &scale));
     TRY(json_get_num(c, e, "g", where, -0.999, 0.999, &g));
+    TRY(json_get_rgb(c, e, "emission", where, &m.Le));
     m.sigma_a = c3_scale(m.sigma_a, (float)scale);
     m.sigma_s = c3_scale(m.sigma_s, (float)scale);
     m.g = (float)g;

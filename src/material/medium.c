@@ -25,8 +25,14 @@ static int box_span(const density_grid *g, vec3 o, vec3 d, float len, float *t0,
 static inline float hashed_u(uint64_t key, uint32_t k) { return rng_to_float((uint32_t)(rng_mix64(key + (uint64_t)k * 0x9e3779b97f4a7c15ULL) >> 32)); }
 static float majorant(const medium *m) { return m->grid->dmax * c3_max(medium_sigma_t(m)); }
 
-int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight) {
-  if (!m->grid) return medium_sample_distance(m, uc, ud, tmax, t, weight);
+int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight, rgb *emit) {
+  *emit = c3(0, 0, 0);
+  if (!m->grid) {
+    rgb trp;
+    int ev = medium_sample_distance(m, uc, ud, tmax, t, weight, &trp);
+    if (ev) *emit = c3_mul(m->sigma_a, trp);
+    return ev;
+  }
   rgb w = c3(1, 1, 1), st0 = medium_sigma_t(m);
   float mu = majorant(m), t0, t1;
   *weight = w;
@@ -37,6 +43,7 @@ int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float u
     if (x >= t1) { *weight = w; return 0; }
     float dens = density_grid_at(m->grid, v3_add(o, v3_scale(d, x)));
     rgb ss = c3_scale(m->sigma_s, dens), st = c3_scale(st0, dens);
+    *emit = c3_add(*emit, c3_mul(w, c3_scale(m->sigma_a, dens / mu)));
     rgb sn = c3(fmaxf(mu - st.r, 0), fmaxf(mu - st.g, 0), fmaxf(mu - st.b, 0));
     float ps = c3_avg(c3_mul(ss, w)), pn = c3_avg(c3_mul(sn, w));
     if (!(ps + pn > 0)) { *weight = c3(0, 0, 0); *t = x; return 1; } /* absorbed for certain */

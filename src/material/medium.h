@@ -44,8 +44,9 @@ static inline rgb medium_tr(const medium *m, float d) {
  * exponential by ud. Returns 1 with *t < tmax and the weight sigma_s Tr(t) / pdf(t) for
  * a scattering event, or 0 with the weight Tr(tmax) / P(no event) for reaching the
  * surface; pdf and P average the three channels' densities (the balance heuristic), so
- * the weights are unbiased for every channel. A weight of 0 ends the path. */
-static inline int medium_sample_distance(const medium *m, float uc, float ud, float tmax, float *t, rgb *weight) {
+ * the weights are unbiased for every channel. A weight of 0 ends the path. *tr_pdf is
+ * Tr / pdf (of the event or of passing), what the event's emission is weighted by. */
+static inline int medium_sample_distance(const medium *m, float uc, float ud, float tmax, float *t, rgb *weight, rgb *tr_pdf) {
   rgb st = medium_sigma_t(m);
   int ch = (int)(uc * 3);
   float s = ch <= 0 ? st.r : ch == 1 ? st.g : st.b;
@@ -54,20 +55,24 @@ static inline int medium_sample_distance(const medium *m, float uc, float ud, fl
     rgb tr = medium_tr(m, d);
     float pdf = (st.r * tr.r + st.g * tr.g + st.b * tr.b) / 3;
     *t = d;
-    *weight = pdf > 0 ? c3_scale(c3_mul(m->sigma_s, tr), 1 / pdf) : c3(0, 0, 0);
+    *tr_pdf = pdf > 0 ? c3_scale(tr, 1 / pdf) : c3(0, 0, 0);
+    *weight = c3_mul(m->sigma_s, *tr_pdf);
     return 1;
   }
   rgb tr = medium_tr(m, tmax);
   float p = (tr.r + tr.g + tr.b) / 3;
-  *weight = p > 0 ? c3_scale(tr, 1 / p) : c3(0, 0, 0);
+  *weight = *tr_pdf = p > 0 ? c3_scale(tr, 1 / p) : c3(0, 0, 0);
   return 0;
 }
 
 /* Where a ray from o along unit d in medium m first scatters before the surface at
  * tmax (INFINITY: none), as medium_sample_distance: homogeneous media from (uc, ud),
  * grid media by spectral tracking inside the grid's box with random numbers hashed
- * from key (their count varies). */
-int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight);
+ * from key (their count varies). *emit: the weight of the medium's emission Le collected
+ * on the way (the estimate of the integral of Tr sigma_a over the segment walked): at
+ * a homogeneous medium's event sigma_a Tr / pdf, in a grid sigma_a / majorant times the
+ * tracking weight at every tentative collision. */
+int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight, rgb *emit);
 /* Transmittance from o along unit d over length len (INFINITY: for ever): exact in a
  * homogeneous medium, by ratio tracking (random numbers from key) in a grid. */
 rgb medium_transmittance(const medium *m, vec3 o, vec3 d, float len, uint64_t key);

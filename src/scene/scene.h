@@ -54,9 +54,10 @@ typedef struct material {
 typedef struct nk_curve { int n; float nm[NK_MAX], eta[NK_MAX], k[NK_MAX]; } nk_curve;
 
 /* A participating medium (JSON "media"): absorption and scattering coefficients per
- * unit length (RGB, scale applied) and the Henyey-Greenstein g; homogeneous, or (grid
- * not NULL) both coefficients times the grid's density at each point. */
-typedef struct medium { rgb sigma_a, sigma_s; float g; struct density_grid *grid; char name[64]; } medium;
+ * unit length (RGB, scale applied), the Henyey-Greenstein g and the emitted radiance Le
+ * (the source term is sigma_a Le, as pbrt's); homogeneous, or (grid not NULL) both
+ * coefficients times the grid's density at each point. */
+typedef struct medium { rgb sigma_a, sigma_s; float g; struct density_grid *grid; rgb Le; char name[64]; } medium;
 #define MEDIUM_NONE (-1)  /* vacuum */
 #define MEDIUM_KEEP (-2)  /* tri_media: the triangle is no medium boundary */
 /* The media of one JSON shape's triangles [first, end): inside (against the winding
