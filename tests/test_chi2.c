@@ -935,26 +935,27 @@ static int hg_phase(void) {
  * surface at tmax against sigma_t exp(-sigma_t t), and the surface's share against
  * exp(-sigma_t tmax); in a chromatic one, per channel, the weights' means against
  * transmittance to the surface and 1 - that (the probability of an event before it):
- * picking the channel by MIS must be unbiased for every channel. */
+ * picking the channel uniformly or by a throughput, with MIS, must be unbiased for every
+ * channel. */
 static int free_flight(void) {
   enum { CELLS = 64 };
   const float tmax = 1.5f;
   medium grey = {c3(0.4f, 0.4f, 0.4f), c3(0.8f, 0.8f, 0.8f), 0, NULL, {0, 0, 0}, "grey"};
+  mcoef greyc = medium_coef(&grey, NULL);
   double obs[CELLS + 1] = {0}, ex[CELLS + 1];
   long n = nsamples();
   double st = 1.2;
   for (long i = 0; i < n; i++) {
     sampler s = sampler_make(17, (uint64_t)i, 0);
     float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
-    rgb w;
-    rgb trp;
-    if (medium_sample_distance(&grey, uc, ud, tmax, &t, &w, &trp)) {
+    spec4 w, trp;
+    if (medium_sample_distance(&greyc, NULL, uc, ud, tmax, &t, &w, &trp)) {
       int c = (int)(t / tmax * CELLS);
       obs[c < CELLS ? c : CELLS - 1] += 1;
-      CHECK(fabsf(w.r - 0.8f / 1.2f) < 1e-5f, "grey event weight %g, want albedo %g", (double)w.r, 0.8 / 1.2);
+      CHECK(fabsf(w.v[0] - 0.8f / 1.2f) < 1e-5f, "grey event weight %g, want albedo %g", (double)w.v[0], 0.8 / 1.2);
     } else {
       obs[CELLS] += 1;
-      CHECK(fabsf(w.r - 1) < 1e-5f, "grey surface weight %g, want 1", (double)w.r);
+      CHECK(fabsf(w.v[0] - 1) < 1e-5f, "grey surface weight %g, want 1", (double)w.v[0]);
     }
   }
   for (int c = 0; c < CELLS; c++) ex[c] = n * (exp(-st * tmax * c / CELLS) - exp(-st * tmax * (c + 1) / CELLS));
@@ -962,30 +963,35 @@ static int free_flight(void) {
   int rc = chi2_check("free-flight distances, grey medium", obs, ex, CELLS + 1);
 
   medium col = {c3(0.1f, 0.5f, 0.0f), c3(0.4f, 1.5f, 3.0f), 0, NULL, {0, 0, 0}, "col"};
-  rgb sig_t = medium_sigma_t(&col);
-  double pass[3] = {0}, event[3] = {0}, pass2[3] = {0}, event2[3] = {0};
-  for (long i = 0; i < n; i++) {
-    sampler s = sampler_make(18, (uint64_t)i, 0);
-    float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
-    rgb w;
-    rgb trp;
-    int ev = medium_sample_distance(&col, uc, ud, tmax, &t, &w, &trp);
-    float wv[3] = {w.r, w.g, w.b}, sa[3] = {col.sigma_s.r, col.sigma_s.g, col.sigma_s.b}, stv[3] = {sig_t.r, sig_t.g, sig_t.b};
-    for (int c = 0; c < 3; c++) {
-      /* an event's weight sigma_s Tr / pdf, times sigma_t / sigma_s, estimates P(event) */
-      double x = ev ? wv[c] * stv[c] / sa[c] : wv[c];
-      double *acc = ev ? event : pass, *acc2 = ev ? event2 : pass2;
-      acc[c] += x;
-      acc2[c] += x * x;
+  mcoef colc = medium_coef(&col, NULL);
+  rgb sig_t = c3_add(col.sigma_a, col.sigma_s);
+  /* the channel chosen uniformly, and in proportion to a throughput sel */
+  static const spec4 sels[2] = {{{1, 1, 1, 0}}, {{0.2f, 1, 3, 0}}};
+  for (int v = 0; v < 2; v++) {
+    double pass[3] = {0}, event[3] = {0}, pass2[3] = {0}, event2[3] = {0};
+    for (long i = 0; i < n; i++) {
+      sampler s = sampler_make(18 + v, (uint64_t)i, 0);
+      float uc = sampler_1d(&s), ud = sampler_1d(&s), t;
+      spec4 w, trp;
+      int ev = medium_sample_distance(&colc, v ? &sels[v] : NULL, uc, ud, tmax, &t, &w, &trp);
+      float wv[3] = {w.v[0], w.v[1], w.v[2]}, sa[3] = {col.sigma_s.r, col.sigma_s.g, col.sigma_s.b}, stv[3] = {sig_t.r, sig_t.g, sig_t.b};
+      for (int c = 0; c < 3; c++) {
+        /* an event's weight sigma_s Tr / pdf, times sigma_t / sigma_s, estimates P(event) */
+        double x = ev ? wv[c] * stv[c] / sa[c] : wv[c];
+        double *acc = ev ? event : pass, *acc2 = ev ? event2 : pass2;
+        acc[c] += x;
+        acc2[c] += x * x;
+      }
     }
-  }
-  for (int c = 0; c < 3; c++) {
-    double stc = c == 0 ? sig_t.r : c == 1 ? sig_t.g : sig_t.b, tr = exp(-stc * tmax);
-    double mp = pass[c] / n, me = event[c] / n;
-    double sp = sqrt((pass2[c] / n - mp * mp) / n), se = sqrt((event2[c] / n - me * me) / n);
-    fprintf(stderr, "free flight, channel %d: surface %.5f (want %.5f, sd %.5f), events %.5f (want %.5f, sd %.5f)\n", c, mp, tr, sp, me, 1 - tr, se);
-    CHECK(fabs(mp - tr) < 5 * sp + 1e-6, "channel %d: surface weight mean %g, transmittance %g", c, mp, tr);
-    CHECK(fabs(me - (1 - tr)) < 5 * se + 1e-6, "channel %d: event weight mean %g, want %g", c, me, 1 - tr);
+    for (int c = 0; c < 3; c++) {
+      double stc = c == 0 ? sig_t.r : c == 1 ? sig_t.g : sig_t.b, tr = exp(-stc * tmax);
+      double mp = pass[c] / n, me = event[c] / n;
+      double sp = sqrt((pass2[c] / n - mp * mp) / n), se = sqrt((event2[c] / n - me * me) / n);
+      fprintf(stderr, "free flight (%s), channel %d: surface %.5f (want %.5f, sd %.5f), events %.5f (want %.5f, sd %.5f)\n",
+              v ? "by throughput" : "uniform", c, mp, tr, sp, me, 1 - tr, se);
+      CHECK(fabs(mp - tr) < 5 * sp + 1e-6, "channel %d: surface weight mean %g, transmittance %g", c, mp, tr);
+      CHECK(fabs(me - (1 - tr)) < 5 * se + 1e-6, "channel %d: event weight mean %g, want %g", c, me, 1 - tr);
+    }
   }
   return rc;
 }

@@ -4,6 +4,7 @@
 #ifndef VALO_PATH_COMMON_H
 #define VALO_PATH_COMMON_H
 #include "integrator/direct.h"
+#include "core/spectrum.h"
 
 /* The common start of a vertex of the recursive integrators (whitted, distribution):
  * traces r, puts the emission it finds in *L (if count_emission), and, when it hit a
@@ -63,5 +64,15 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
 /* path_radiance through participating media and null surfaces (path_media.c): what
  * `path` renders when the scene has any (scene.has_media). */
 rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission);
+/* The same walk on a path's channels: RGB (wl NULL; lanes 0-2 of the result) or, for
+ * --spectral, the four wavelengths wl (which a dispersive dielectric may cut to one). */
+spec4 path_media_walk(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission, wavelengths *wl);
+/* --spectral's BSDF at a surface (path_spectral.c): a dispersive dielectric takes its
+ * index at the hero wavelength (the others dropped from wl); a conductor given per
+ * wavelength gets F = 1 in b and is returned (NULL: none), its Fresnel term then being
+ * nk_fresnel's, per wavelength, for the pair of directions (world space, both away from
+ * the surface). */
+const nk_curve *spectral_bsdf(const scene *s, const isect *it, bsdf *b, wavelengths *wl);
+spec4 nk_fresnel(const nk_curve *nk, vec3 wo, vec3 wi, const wavelengths *wl);
 
 #endif

@@ -1,7 +1,8 @@
 /* path_media.c — owns the path integrator's walk through participating media and null
- * surfaces (pbrt-v3's VolPathIntegrator, Mitsuba 3's volpath, for homogeneous media):
- * free-flight sampling with MIS over the RGB channels (material/medium.h) between
- * surfaces; at a scattering point next-event estimation with the Henyey-Greenstein phase
+ * surfaces (pbrt-v3's VolPathIntegrator, Mitsuba 3's volpath), in RGB or on --spectral's
+ * four wavelengths (the path's channels, material/medium.h: the walk is written once on
+ * spec4 lanes, RGB in lanes 0-2): free-flight sampling with MIS over the channels
+ * between surfaces; at a scattering point next-event estimation with the Henyey-Greenstein phase
  * function, MIS-weighted against phase sampling, and phase sampling to continue. Rays
  * pass null surfaces without a vertex (no depth, no MIS state), changing medium where a
  * shape bounds one; shadow rays do the same and carry the transmittance of every medium
@@ -20,9 +21,10 @@
  * med: the product of each crossed medium's Beer-Lambert term, 0 when a surface that is
  * not null blocks it. far: the light lies at infinity (environment, directional), so a
  * medium the segment ends in goes on for ever. */
-static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int far, uint64_t key, thread_stats *ts) {
+static spec4 segment_transmittance(const render_ctx *c, ray r, int32_t med, int far, uint64_t key, const wavelengths *wl,
+                                   thread_stats *ts) {
   const scene *s = c->s;
-  rgb tr = c3(1, 1, 1);
+  spec4 tr = chan_one(wl);
   vec3 target = v3_add(r.o, r.d);
   for (int k = 0; k < NULL_CROSSINGS_MAX; k++) {
     hit h;
@@ -30,11 +32,12 @@ static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int fa
     if (med >= 0) {
       float dl = v3_len(r.d);
       float len = found ? h.t * dl : far ? INFINITY : r.tmax * dl;
-      tr = c3_mul(tr, medium_transmittance(&s->media[med], r.o, v3_scale(r.d, 1 / dl), len, rng_mix64(key + (uint64_t)k)));
-      if (c3_black(tr)) return tr;
+      mcoef mc = medium_coef(&s->media[med], wl);
+      tr = spec_mul(tr, medium_transmittance(&s->media[med], &mc, r.o, v3_scale(r.d, 1 / dl), len, rng_mix64(key + (uint64_t)k)));
+      if (spec_black(tr)) return tr;
     }
     if (!found) return tr;
-    if (s->mats[s->tri_mat[h.tri]].type != MAT_NULL) return c3(0, 0, 0);
+    if (s->mats[s->tri_mat[h.tri]].type != MAT_NULL) return spec_const(0);
     isect it;
     isect_from_hit(s, &r, &h, &it);
     med = scene_medium_after(s, h.tri, it.ng, r.d, med);
@@ -42,21 +45,22 @@ static rgb segment_transmittance(const render_ctx *c, ray r, int32_t med, int fa
     r.d = v3_sub(target, r.o);
     r.tmax = 1 - 1e-4f;
   }
-  return c3(0, 0, 0);
+  return spec_const(0);
 }
 
 /* Next-event estimation at a scattering point p of medium med (HG g) for viewer
  * direction wo, MIS-weighted (power heuristic) against phase sampling. */
-static rgb medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sampler *smp, uint64_t key, thread_stats *ts) {
+static spec4 medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sampler *smp, uint64_t key, const wavelengths *wl,
+                           thread_stats *ts) {
   float pmf;
   light_li ls;
-  if (direct_light_sample(c, p, smp, &pmf, &ls) == UINT32_MAX) return c3(0, 0, 0);
+  if (direct_light_sample(c, p, smp, &pmf, &ls) == UINT32_MAX) return spec_const(0);
   float f = phase_hg(v3_dot(wo, ls.wi), c->s->media[med].g), light_pdf = pmf * ls.pdf;
-  if (!(f > 0) || !(light_pdf > 0)) return c3(0, 0, 0);
-  rgb tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), key, ts);
-  if (c3_black(tr)) return c3(0, 0, 0);
+  if (!(f > 0) || !(light_pdf > 0)) return spec_const(0);
+  spec4 tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), key, wl, ts);
+  if (spec_black(tr)) return spec_const(0);
   float w = ls.delta ? 1.0f : power_heuristic(light_pdf, f);
-  return c3_scale(c3_mul(ls.L, tr), f * w / light_pdf);
+  return spec_scale(spec_mul(chan_from_rgb(ls.L, wl), tr), f * w / light_pdf);
 }
 
 /* The key of a tracking walk's random numbers: hashed from the camera sample's key
@@ -64,9 +68,15 @@ static rgb medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, samp
  * count up from 0, shadow rays down from ~0 by depth). */
 static uint64_t walk_key(const sampler *smp, uint32_t n) { return rng_mix64(smp->key ^ (0x6d65646961ULL + (uint64_t)n * 0xd1b54a32d192ed03ULL)); }
 
-rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
+static int finite4(spec4 v) {
+  for (int k = 0; k < N_LAMBDA; k++)
+    if (!isfinite(v.v[k])) return 0;
+  return 1;
+}
+
+spec4 path_media_walk(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission, wavelengths *wl) {
   const scene *s = c->s;
-  rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
+  spec4 L = spec_const(0), beta = chan_one(wl);
   path_state st = path_state_start(r.o);
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
   int32_t med = s->cam_medium;
@@ -81,15 +91,20 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
     for (;;) {
       found = ctx_intersect(c, &r, &h, ts);
       if (med >= 0) {
+        const medium *m = &s->media[med];
+        mcoef mc = medium_coef(m, wl);
         float dlen = v3_len(r.d), t;
-        rgb w, emit;
+        spec4 w, emit;
         sampler_set_dim(smp, SDIM_MEDIUM + 2 * (flight++ % SDIM_MEDIUM_MAX));
         float uc = sampler_1d(smp), ud = sampler_1d(smp);
         vec3 dir = v3_scale(r.d, 1 / dlen);
-        scattered = medium_sample(&s->media[med], r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w, &emit);
-        if (!c3_black(s->media[med].Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_mul(c3_mul(beta, emit), s->media[med].Le));
-        beta = c3_mul(beta, w);
-        if (c3_black(beta)) return L;
+        scattered = medium_sample(m, &mc, &beta, r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w, &emit);
+        if (!c3_black(m->Le) && (depth > 0 || count_first_emission)) {
+          spec4 le = {{mc.le[0], mc.le[1], mc.le[2], mc.le[3]}};
+          L = spec_add(L, spec_mul(spec_mul(beta, emit), le));
+        }
+        beta = spec_mul(beta, w);
+        if (spec_black(beta)) return L;
         if (scattered) { mp = v3_add(r.o, v3_scale(dir, t)); break; }
       }
       if (!found) break;
@@ -105,7 +120,7 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
       vec3 wo = v3_neg(v3_norm(r.d)), wi;
       float g = s->media[med].g, u1, u2;
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-      L = c3_add(L, c3_mul(beta, medium_direct(c, mp, wo, med, smp, walk_key(smp, ~(uint32_t)depth), ts)));
+      L = spec_add(L, spec_mul(beta, medium_direct(c, mp, wo, med, smp, walk_key(smp, ~(uint32_t)depth), wl, ts)));
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_BSDF_DIR));
       sampler_2d(smp, &u1, &u2);
       float pdf = phase_hg_sample(wo, g, u1, u2, &wi); /* weight phase / pdf = 1 */
@@ -119,25 +134,39 @@ rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *
       rgb Le;
       float w;
       path_vertex_emission(c, &r, &st, found ? &h : NULL, found ? &it : NULL, &Le, &w);
-      if (!c3_black(Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
+      if (!c3_black(Le) && (depth > 0 || count_first_emission)) L = spec_add(L, spec_scale(spec_mul(beta, chan_from_rgb(Le, wl)), w));
       if (!found || depth >= max_depth) break;
       vec3 wo = v3_neg(r.d), ng = it.ng; /* the winding normal: shading_frame may turn it->ng */
       bsdf b = bsdf_at(s, &it);
+      const nk_curve *nk = wl ? spectral_bsdf(s, &it, &b, wl) : NULL;
       frame fr = shading_frame(&it, &b, wo);
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
       direct_sample d;
       if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, &it, &b, &fr, wo, smp, ts, 1, &d)) {
         ray sr = segment_ray(offset_origin_isect(&it, v3_sub(d.p_light, it.p)), it.p, d.p_light, d.n_light);
-        rgb tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, walk_key(smp, ~(uint32_t)depth), ts);
-        L = c3_add(L, c3_mul(beta, c3_scale(c3_mul(c3_mul(d.f_cos, d.Li), tr), d.scale)));
+        spec4 tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, walk_key(smp, ~(uint32_t)depth), wl, ts);
+        /* f and Li upsampled apart and multiplied per wavelength (in RGB per channel) */
+        spec4 f = chan_from_rgb(d.f_cos, wl);
+        if (nk) f = spec_mul(f, nk_fresnel(nk, wo, d.wi, wl));
+        L = spec_add(L, spec_mul(beta, spec_scale(spec_mul(spec_mul(f, chan_from_rgb(d.Li, wl)), tr), d.scale)));
       }
       rgb weight;
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
       if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
       med = scene_medium_after(s, it.tri, ng, r.d, med);
-      beta = c3_mul(beta, weight);
+      beta = spec_mul(beta, chan_from_rgb(weight, wl));
+      if (nk) beta = spec_mul(beta, nk_fresnel(nk, wo, r.d, wl));
     }
-    if (!path_survive(&st, &beta, depth, smp)) break;
+    if (spec_black(beta) || !finite4(beta)) break;
+    sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
+    float survive = path_roulette(&st, spec_max(beta), depth, smp);
+    if (survive == 0) break;
+    beta = spec_scale(beta, survive);
   }
   return L;
+}
+
+rgb path_radiance_media(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
+  spec4 L = path_media_walk(c, r, smp, ts, count_first_emission, NULL);
+  return c3(L.v[0], L.v[1], L.v[2]);
 }

@@ -14,10 +14,9 @@
 #include "core/spectrum.h"
 #include "material/fresnel.h"
 
-/* The Fresnel reflectance of a tabulated conductor at each wavelength, for the pair of
- * directions (world space, both away from the surface): at the half vector, which is
- * the microfacet normal of a rough conductor and the normal of a smooth one. */
-static spec4 nk_fresnel(const nk_curve *nk, vec3 wo, vec3 wi, const wavelengths *wl) {
+/* At the half vector, which is the microfacet normal of a rough conductor and the normal
+ * of a smooth one. */
+spec4 nk_fresnel(const nk_curve *nk, vec3 wo, vec3 wi, const wavelengths *wl) {
   vec3 h = v3_add(wo, wi);
   float len = v3_len(h), c = len > 1e-7f ? fabsf(v3_dot(wo, h)) / len : 0;
   spec4 F;
@@ -37,10 +36,24 @@ static spec4 direct_spectral(const render_ctx *c, const isect *it, const bsdf *b
   return spec_scale(spec_mul(f, spec_from_rgb(d.Li, wl)), d.scale);
 }
 
+const nk_curve *spectral_bsdf(const scene *s, const isect *it, bsdf *b, wavelengths *wl) {
+  if (it->m->dispersion && bsdf_transmits(b)) {
+    b->eta = dispersion_ior((dispersion)it->m->dispersion, wl->lambda[0]);
+    wavelengths_terminate_secondary(wl);
+  }
+  const nk_curve *nk = it->m->nk ? &s->nk[it->m->nk - 1] : NULL;
+  if (nk) b->fresnel_white = 1;
+  return nk;
+}
+
 static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
   const scene *s = c->s;
   sampler_set_dim(smp, SDIM_WAVELENGTH);
   wavelengths wl = wavelengths_sample(sampler_1d(smp));
+  if (s->has_media) {
+    spec4 Lm = path_media_walk(c, r, smp, ts, 1, &wl);
+    return spec_to_rgb(Lm, &wl);
+  }
   spec4 L = spec_const(0), beta = spec_const(1);
   path_state st = path_state_start(r.o);
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
@@ -53,12 +66,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
     if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
     bsdf b = bsdf_at(s, &it);
-    if (it.m->dispersion && bsdf_transmits(&b)) {
-      b.eta = dispersion_ior((dispersion)it.m->dispersion, wl.lambda[0]);
-      wavelengths_terminate_secondary(&wl);
-    }
-    const nk_curve *nk = it.m->nk ? &s->nk[it.m->nk - 1] : NULL;
-    if (nk) b.fresnel_white = 1;
+    const nk_curve *nk = spectral_bsdf(s, &it, &b, &wl);
     frame fr = shading_frame(&it, &b, wo);
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
     if (bsdf_has_smooth(&b)) L = spec_add(L, spec_mul(beta, direct_spectral(c, &it, &b, &fr, wo, smp, ts, &wl, nk)));

@@ -1,4 +1,5 @@
-/* medium.c — see medium.h: the grid media's tracking. */
+/* medium.c — see medium.h: a medium's coefficients on a path's channels, and the grid
+ * media's tracking. */
 #include "material/medium.h"
 #include "core/rng.h"
 #include "scene/volume.h"
@@ -6,6 +7,14 @@
 /* Tracking steps before a walk is taken to be lost (weight 0): a majorant of this many
  * collisions per ray is far beyond any medium a path tracer renders. */
 #define TRACK_STEPS_MAX 100000
+
+mcoef medium_coef(const medium *m, const wavelengths *wl) {
+  mcoef c;
+  spec4 a = chan_from_rgb(m->sigma_a, wl), s = chan_from_rgb(m->sigma_s, wl), le = chan_from_rgb(m->Le, wl);
+  c.n = wl ? N_LAMBDA : 3;
+  for (int k = 0; k < N_LAMBDA; k++) { c.a[k] = a.v[k]; c.s[k] = s.v[k]; c.le[k] = le.v[k]; }
+  return c;
+}
 
 /* The part [*t0, *t1] of [0, len] inside the grid's box, on the ray o + t d; 0 if none. */
 static int box_span(const density_grid *g, vec3 o, vec3 d, float len, float *t0, float *t1) {
@@ -23,56 +32,70 @@ static int box_span(const density_grid *g, vec3 o, vec3 d, float len, float *t0,
 }
 
 static inline float hashed_u(uint64_t key, uint32_t k) { return rng_to_float((uint32_t)(rng_mix64(key + (uint64_t)k * 0x9e3779b97f4a7c15ULL) >> 32)); }
-static float majorant(const medium *m) { return m->grid->dmax * c3_max(medium_sigma_t(m)); }
+/* max density x the largest sigma_t over the channels */
+static float majorant(const medium *m, const mcoef *c) {
+  float mx = 0;
+  for (int k = 0; k < c->n; k++) mx = fmaxf(mx, c->a[k] + c->s[k]);
+  return m->grid->dmax * mx;
+}
 
-int medium_sample(const medium *m, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t, rgb *weight, rgb *emit) {
-  *emit = c3(0, 0, 0);
+int medium_sample(const medium *m, const mcoef *c, const spec4 *sel, vec3 o, vec3 d, float tmax, float uc, float ud, uint64_t key, float *t,
+                  spec4 *weight, spec4 *emit) {
+  *emit = spec_const(0);
   if (!m->grid) {
-    rgb trp;
-    int ev = medium_sample_distance(m, uc, ud, tmax, t, weight, &trp);
-    if (ev) *emit = c3_mul(m->sigma_a, trp);
+    spec4 trp;
+    int ev = medium_sample_distance(c, sel, uc, ud, tmax, t, weight, &trp);
+    if (ev)
+      for (int k = 0; k < c->n; k++) emit->v[k] = c->a[k] * trp.v[k];
     return ev;
   }
-  rgb w = c3(1, 1, 1), st0 = medium_sigma_t(m);
-  float mu = majorant(m), t0, t1;
+  spec4 w = spec_const(0);
+  for (int k = 0; k < c->n; k++) w.v[k] = 1;
+  float mu = majorant(m, c), t0, t1;
   *weight = w;
   if (!(mu > 0) || !box_span(m->grid, o, d, tmax, &t0, &t1)) return 0;
   float x = t0;
-  for (uint32_t k = 0; k < TRACK_STEPS_MAX; k++) {
-    x -= logf(1 - hashed_u(key, 2 * k)) / mu;
+  for (uint32_t step = 0; step < TRACK_STEPS_MAX; step++) {
+    x -= logf(1 - hashed_u(key, 2 * step)) / mu;
     if (x >= t1) { *weight = w; return 0; }
     float dens = density_grid_at(m->grid, v3_add(o, v3_scale(d, x)));
-    rgb ss = c3_scale(m->sigma_s, dens), st = c3_scale(st0, dens);
-    *emit = c3_add(*emit, c3_mul(w, c3_scale(m->sigma_a, dens / mu)));
-    rgb sn = c3(fmaxf(mu - st.r, 0), fmaxf(mu - st.g, 0), fmaxf(mu - st.b, 0));
-    float ps = c3_avg(c3_mul(ss, w)), pn = c3_avg(c3_mul(sn, w));
-    if (!(ps + pn > 0)) { *weight = c3(0, 0, 0); *t = x; return 1; } /* absorbed for certain */
+    float ps = 0, pn = 0;
+    spec4 ss, sn;
+    for (int k = 0; k < N_LAMBDA; k++) {
+      ss.v[k] = c->s[k] * dens;
+      sn.v[k] = fmaxf(mu - (c->a[k] + c->s[k]) * dens, 0);
+      emit->v[k] += w.v[k] * c->a[k] * dens / mu;
+      float b = sel && isfinite(sel->v[k]) ? fmaxf(sel->v[k], 0) : 1;
+      ps += ss.v[k] * w.v[k] * b;
+      pn += sn.v[k] * w.v[k] * b;
+    }
+    if (!(ps + pn > 0)) { *weight = spec_const(0); *t = x; return 1; } /* absorbed for certain */
     ps /= ps + pn;
-    if (hashed_u(key, 2 * k + 1) < ps) {
-      *weight = c3_mul(w, c3_scale(ss, 1 / (mu * ps)));
+    if (hashed_u(key, 2 * step + 1) < ps) {
+      *weight = spec_mul(w, spec_scale(ss, 1 / (mu * ps)));
       *t = x;
       return 1;
     }
-    w = c3_mul(w, c3_scale(sn, 1 / (mu * (1 - ps))));
+    w = spec_mul(w, spec_scale(sn, 1 / (mu * (1 - ps))));
   }
-  *weight = c3(0, 0, 0);
+  *weight = spec_const(0);
   *t = x;
   return 1;
 }
 
-rgb medium_transmittance(const medium *m, vec3 o, vec3 d, float len, uint64_t key) {
-  if (!m->grid) return medium_tr(m, len);
-  rgb tr = c3(1, 1, 1), st0 = medium_sigma_t(m);
-  float mu = majorant(m), t0, t1;
+spec4 medium_transmittance(const medium *m, const mcoef *c, vec3 o, vec3 d, float len, uint64_t key) {
+  if (!m->grid) return medium_tr(c, len);
+  spec4 tr = spec_const(0);
+  for (int k = 0; k < c->n; k++) tr.v[k] = 1;
+  float mu = majorant(m, c), t0, t1;
   if (!(mu > 0) || !box_span(m->grid, o, d, len, &t0, &t1)) return tr;
   float x = t0;
-  for (uint32_t k = 0; k < TRACK_STEPS_MAX; k++) {
-    x -= logf(1 - hashed_u(key, k)) / mu;
+  for (uint32_t step = 0; step < TRACK_STEPS_MAX; step++) {
+    x -= logf(1 - hashed_u(key, step)) / mu;
     if (x >= t1) return tr;
     float dens = density_grid_at(m->grid, v3_add(o, v3_scale(d, x)));
-    rgb st = c3_scale(st0, dens);
-    tr = c3_mul(tr, c3(fmaxf(1 - st.r / mu, 0), fmaxf(1 - st.g / mu, 0), fmaxf(1 - st.b / mu, 0)));
-    if (c3_black(tr)) return tr;
+    for (int k = 0; k < c->n; k++) tr.v[k] *= fmaxf(1 - (c->a[k] + c->s[k]) * dens / mu, 0);
+    if (spec_black(tr)) return tr;
   }
-  return c3(0, 0, 0);
+  return spec_const(0);
 }

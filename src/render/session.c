@@ -33,9 +33,9 @@ int session_report_progress(valo_progress_fn progress, void *user, double frac, 
 valo_status session_create(const scene *s, const valo_options *opts, const integrator_ops *integ, const double *params, float ao_dist,
                            session **out, valo_error *err) {
   *out = NULL;
-  if (s->has_media && strcmp(integ->name, "path"))
-    return err_set(err, VALO_ERR_UNSUPPORTED, "%s: participating media and null surfaces are rendered by the path integrator only%s, not %s",
-                   s->path, strcmp(integ->name, "path-spectral") ? "" : " in RGB mode", integ->name);
+  if (s->has_media && strcmp(integ->name, "path") && strcmp(integ->name, "path-spectral"))
+    return err_set(err, VALO_ERR_UNSUPPORTED, "%s: participating media and null surfaces are rendered by the path integrator only, not %s",
+                   s->path, integ->name);
   /* A crop window is the film: opt.width and height are its size from here on, and the
    * camera sees the whole frame. */
   valo_options o = *opts;
