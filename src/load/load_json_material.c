@@ -156,9 +156,10 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     m->kd = c3(0, 0, 0); m->ks = c3(1, 1, 1);
     TRY(json_get_rgb(c, o, "reflectance", where, &m->ks));
     TRY(json_get_rgb(c, o, "diffuse", where, &m->kd));
-  } else if (!strcmp(type, "dielectric")) {
-    TRY(json_check_keys(c, o, where, k_dielectric));
-    m->type = MAT_DIELECTRIC;
+  } else if (!strcmp(type, "dielectric") || !strcmp(type, "thindielectric")) {
+    int thin = type[0] == 't'; /* a pane: no dispersion, no roughness */
+    TRY(json_check_keys(c, o, where, thin ? k_thin : k_dielectric));
+    m->type = thin ? MAT_THIN_DIELECTRIC : MAT_DIELECTRIC;
     double ior = 1.5;
     TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
     m->ior = (float)ior;
@@ -170,12 +171,6 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
-  } else if (!strcmp(type, "thindielectric")) {
-    TRY(json_check_keys(c, o, where, k_thin));
-    m->type = MAT_THIN_DIELECTRIC;
-    double ior = 1.5;
-    TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
-    m->ior = (float)ior;
   } else if (!strcmp(type, "conductor")) {
     TRY(json_check_keys(c, o, where, k_conductor));
     m->type = MAT_CONDUCTOR;
