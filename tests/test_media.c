@@ -310,7 +310,8 @@ static int null_surface_invisible(void) {
 }
 
 /* AOVs describe the first surface that is not null: a plane seen through a smoke-filled
- * null sphere has the plane's albedo, normal and depth (3) at the centre. */
+ * null sphere has the plane's albedo, normal and depth (3) at the centre, and its ao is
+ * 1 though the sphere hangs 0.7 above it within the ao rays' length (3). */
 static int aovs_through_null(void) {
   CHECK(scratch_file("media_plane.obj", "v -5 -5 0\nv -5 5 0\nv 5 5 0\nv 5 -5 0\nf 1 2 3 4\n"), "write");
   const char *path = scratch_file("media_aov.json",
@@ -323,13 +324,18 @@ static int aovs_through_null(void) {
       "  \"lights\": [{\"type\": \"point\", \"position\": [0,2,2], \"intensity\": 1}] }\n");
   valo_options o;
   valo_options_init(&o);
-  o.aovs = 1;
+  o.aovs = 1 | VALO_AOVS_AO;
+  snprintf(o.params, sizeof o.params, "ao.distance=3");
   valo_scene *sc;
   valo_render *r = render_file(path, &o, &sc);
   CHECK(r, "render failed");
-  const char *names[3] = {"albedo", "normal", "depth"};
-  image im[3];
-  for (int k = 0; k < 3; k++) CHECK(read_aov(r, names[k], &im[k]) == 0, "cannot write or read the %s AOV", names[k]);
+  const char *names[4] = {"albedo", "normal", "depth", "ao"};
+  image im[4];
+  for (int k = 0; k < 4; k++) CHECK(read_aov(r, names[k], &im[k]) == 0, "cannot write or read the %s AOV", names[k]);
+  const float *ao = &im[3].rgb[3 * (4 * 9 + 4)];
+  fprintf(stderr, "centre ao %g\n", ao[0]);
+  CHECK(ao[0] == 1, "ao %g under the null sphere, want 1", ao[0]);
+  image_free(&im[3]);
   const float *a = &im[0].rgb[3 * (4 * 9 + 4)], *n = &im[1].rgb[3 * (4 * 9 + 4)], *d = &im[2].rgb[3 * (4 * 9 + 4)];
   fprintf(stderr, "centre: albedo %g %g %g, normal %g %g %g, depth %g\n", a[0], a[1], a[2], n[0], n[1], n[2], d[0]);
   CHECK(fabsf(a[0] - 0.2f) < 1e-5f && fabsf(a[1] - 0.4f) < 1e-5f && fabsf(a[2] - 0.6f) < 1e-5f, "albedo (%g %g %g)", a[0], a[1], a[2]);

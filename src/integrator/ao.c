@@ -45,8 +45,16 @@ int ao_sample(const render_ctx *c, const isect *it, vec3 n, float dist, sampler 
   if (v3_dot(d, it->ng) * v3_dot(n, it->ng) <= 0) return 0;
   ray r = spawn_ray(it, d);
   r.tmax = dist;
-  ts->rays++;
-  if (accel_occluded(c->acc, &r)) return 0;
+  if (c->s->has_media) {
+    /* null surfaces (media's boundaries) occlude nothing */
+    hit h;
+    isect solid;
+    float before;
+    if (ctx_intersect_solid(c, r, &h, &solid, &before, ts)) return 0;
+  } else {
+    ts->rays++;
+    if (accel_occluded(c->acc, &r)) return 0;
+  }
   *dir = d;
   return 1;
 }

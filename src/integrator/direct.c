@@ -16,6 +16,19 @@ ray segment_ray(vec3 o, vec3 from, vec3 p_to, vec3 n_to) {
   return r;
 }
 
+int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *before, thread_stats *ts) {
+  *before = 0;
+  for (int crossed = 0; crossed < 256; crossed++) { /* more: an offset that failed */
+    if (!ctx_intersect(c, &r, h, ts)) return 0;
+    isect_from_hit(c->s, &r, h, it);
+    if (it->m->type != MAT_NULL) return 1;
+    *before += h->t * v3_len(r.d);
+    r.o = offset_origin_isect(it, r.d);
+    r.tmax -= h->t;
+  }
+  return 0;
+}
+
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
   ray r = segment_ray(offset_origin_isect(it, v3_sub(p_to, it->p)), it->p, p_to, n_to);
   ts->rays++;

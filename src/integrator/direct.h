@@ -12,6 +12,11 @@ static inline int ctx_intersect(const render_ctx *c, const ray *r, hit *h, threa
  * towards `from` too when n_to is non-zero (a point on a surface): direction p_to - o,
  * tmax just short of 1. */
 ray segment_ray(vec3 o, vec3 from, vec3 p_to, vec3 n_to);
+/* The first hit along r on a surface that is not null: null surfaces (the boundaries of
+ * media) are passed, r going on from just past each. Returns 1 with *h (its t measured
+ * from the last origin) and *it, and in *before the distance from r's origin to that
+ * last origin; 0 when nothing solid lies within r.tmax. */
+int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *before, thread_stats *ts);
 /* Is the segment from it (leaving towards p_to) blocked? (segment_ray from it's offset
  * origin) */
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);

@@ -21,16 +21,8 @@ int aov_kind_of(const char *output, size_t *plen) {
 void aov_record(const session *ss, ray ry, float *acc, sampler *smp, thread_stats *ts) {
   hit h;
   isect it;
-  float before = 0; /* the distance to the last null surface passed (they have no AOVs) */
-  for (int crossed = 0;; crossed++) {
-    if (!ctx_intersect(&ss->ctx, &ry, &h, ts)) return;
-    isect_from_hit(ss->s, &ry, &h, &it);
-    if (it.m->type != MAT_NULL) break;
-    if (crossed == 256) return;
-    before += h.t * v3_len(ry.d);
-    ry.o = offset_origin_isect(&it, ry.d);
-    ry.tmax = INFINITY;
-  }
+  float before; /* the distance to the last null surface passed (they have no AOVs) */
+  if (!ctx_intersect_solid(&ss->ctx, ry, &h, &it, &before, ts)) return;
   bsdf b = bsdf_at(ss->s, &it);
   material tm = *it.m;
   tm.kd = b.kd;
