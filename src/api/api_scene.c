@@ -33,7 +33,7 @@ VALO_API valo_status valo_scene_load(const char *path, valo_scene **out, valo_er
 
 VALO_API int valo_scene_has_light(const valo_scene *vs) {
   for (uint32_t i = 0; i < vs->s->nmedia; i++)
-    if (!c3_black(vs->s->media[i].Le) && !c3_black(vs->s->media[i].sigma_a)) return 1; /* a glowing medium */
+    if (medium_glows(&vs->s->media[i])) return 1;
   return vs->s->nlights > 0;
 }
 

@@ -99,7 +99,7 @@ spec4 path_media_walk(const render_ctx *c, ray r, sampler *smp, thread_stats *ts
         float uc = sampler_1d(smp), ud = sampler_1d(smp);
         vec3 dir = v3_scale(r.d, 1 / dlen);
         scattered = medium_sample(m, &mc, &beta, r.o, dir, found ? h.t * dlen : INFINITY, uc, ud, walk_key(smp, flight), &t, &w, &emit);
-        if (!c3_black(m->Le) && (depth > 0 || count_first_emission)) {
+        if (medium_glows(m) && (depth > 0 || count_first_emission)) {
           spec4 le = {{mc.le[0], mc.le[1], mc.le[2], mc.le[3]}};
           L = spec_add(L, spec_mul(spec_mul(beta, emit), le));
         }

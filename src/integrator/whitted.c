@@ -39,8 +39,7 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
     break;
   }
   case BSDF_THIN_DIELECTRIC: {
-    float R = fresnel_dielectric(fabsf(wo_l.z), b.eta);
-    if (R < 1) R += (1 - R) * (1 - R) * R / (1 - R * R);
+    float R = fresnel_thin_dielectric(wo_l.z, b.eta);
     k_refl = c3(R, R, R);
     k_refr = c3(1 - R, 1 - R, 1 - R);
     refr_l = v3_neg(wo_l);

@@ -15,7 +15,7 @@ static int scene_has_any_light(const scene *s) {
   for (uint32_t t = 0; t < s->ntris; t++)
     if (!c3_black(s->mats[s->tri_mat[t]].emission)) return 1;
   for (uint32_t i = 0; i < s->nmedia; i++)
-    if (!c3_black(s->media[i].Le) && !c3_black(s->media[i].sigma_a)) return 1; /* a glowing medium */
+    if (medium_glows(&s->media[i])) return 1;
   return 0;
 }
 

@@ -228,10 +228,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     return 1;
   }
   case BSDF_THIN_DIELECTRIC: {
-    /* Both faces of a pane, light bouncing between them summed (pbrt-v4's
-     * ThinDielectricBxDF): R' = R + T^2 R / (1 - R^2), the rest passes straight on. */
-    float R = fresnel_dielectric(fabsf(wo.z), b->eta);
-    if (R < 1) R += (1 - R) * (1 - R) * R / (1 - R * R);
+    float R = fresnel_thin_dielectric(wo.z, b->eta);
     s->pdf = 0;
     s->delta = 1;
     s->wi = ulobe < R ? v3(-wo.x, -wo.y, wo.z) : v3_neg(wo);

@@ -21,6 +21,13 @@ static inline float fresnel_dielectric(float cos_i, float eta) {
   float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
   return 0.5f * (r_par * r_par + r_perp * r_perp);
 }
+/* A thin pane of index eta (its two faces and the light bouncing between them, pbrt-v4's
+ * ThinDielectricBxDF): R' = R + T^2 R / (1 - R^2) of one face's R, T = 1 - R, at |cos_i|;
+ * the rest passes straight through. */
+static inline float fresnel_thin_dielectric(float cos_i, float eta) {
+  float R = fresnel_dielectric(fabsf(cos_i), eta);
+  return R < 1 ? R + (1 - R) * (1 - R) * R / (1 - R * R) : R;
+}
 
 static inline float fresnel_conductor1(float cos_i, float eta, float k) {
   cos_i = clampf(cos_i, 0, 1);

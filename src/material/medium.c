@@ -49,8 +49,7 @@ int medium_sample(const medium *m, const mcoef *c, const spec4 *sel, vec3 o, vec
       for (int k = 0; k < c->n; k++) emit->v[k] = c->a[k] * trp.v[k];
     return ev;
   }
-  spec4 w = spec_const(0);
-  for (int k = 0; k < c->n; k++) w.v[k] = 1;
+  spec4 w = lanes_one(c->n);
   float mu = majorant(m, c), t0, t1;
   *weight = w;
   if (!(mu > 0) || !box_span(m->grid, o, d, tmax, &t0, &t1)) return 0;
@@ -85,8 +84,7 @@ int medium_sample(const medium *m, const mcoef *c, const spec4 *sel, vec3 o, vec
 
 spec4 medium_transmittance(const medium *m, const mcoef *c, vec3 o, vec3 d, float len, uint64_t key) {
   if (!m->grid) return medium_tr(c, len);
-  spec4 tr = spec_const(0);
-  for (int k = 0; k < c->n; k++) tr.v[k] = 1;
+  spec4 tr = lanes_one(c->n);
   float mu = majorant(m, c), t0, t1;
   if (!(mu > 0) || !box_span(m->grid, o, d, len, &t0, &t1)) return tr;
   float x = t0;

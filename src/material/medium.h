@@ -47,8 +47,14 @@ static inline spec4 chan_from_rgb(rgb c, const wavelengths *wl) {
   spec4 v = {{c.r, c.g, c.b, 0}};
   return v;
 }
+/* 1 on the first n lanes, 0 beyond. */
+static inline spec4 lanes_one(int n) {
+  spec4 v = spec_const(0);
+  for (int k = 0; k < n; k++) v.v[k] = 1;
+  return v;
+}
 /* 1 on every channel of the path (lane 3 is 0 in RGB). */
-static inline spec4 chan_one(const wavelengths *wl) { return wl ? spec_const(1) : chan_from_rgb(c3(1, 1, 1), NULL); }
+static inline spec4 chan_one(const wavelengths *wl) { return lanes_one(wl ? N_LAMBDA : 3); }
 /* Transmittance over distance d (d may be infinite: channels with sigma_t 0 keep 1). */
 static inline spec4 medium_tr(const mcoef *c, float d) {
   spec4 tr = spec_const(0);

@@ -236,7 +236,6 @@ static valo_status commit_media(scene *s, valo_error *err) {
     }
   return VALO_OK;
 }
-#define TRY_ST(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
 valo_status scene_commit(scene *s, valo_error *err) {
   if (s->ntris == 0 && s->nlights == 0 && !s->has_env)
@@ -268,7 +267,8 @@ valo_status scene_commit(scene *s, valo_error *err) {
     s->tri_light[t] = (int32_t)s->nlights;
     if (scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   }
-  TRY_ST(commit_media(s, err));
+  valo_status mst = commit_media(s, err);
+  if (mst) return mst;
   int any_normal_map = 0;
   for (uint32_t m = 0; m < s->nmats; m++) any_normal_map |= s->mats[m].tex_normal >= 0;
   if (any_normal_map) {

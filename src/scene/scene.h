@@ -58,6 +58,8 @@ typedef struct nk_curve { int n; float nm[NK_MAX], eta[NK_MAX], k[NK_MAX]; } nk_
  * (the source term is sigma_a Le, as pbrt's); homogeneous, or (grid not NULL) both
  * coefficients times the grid's density at each point. */
 typedef struct medium { rgb sigma_a, sigma_s; float g; struct density_grid *grid; rgb Le; char name[64]; } medium;
+/* 1 when the medium emits light (its source term sigma_a Le is not black). */
+static inline int medium_glows(const medium *m) { return !c3_black(m->Le) && !c3_black(m->sigma_a); }
 #define MEDIUM_NONE (-1)  /* vacuum */
 #define MEDIUM_KEEP (-2)  /* tri_media: the triangle is no medium boundary */
 /* The media of one JSON shape's triangles [first, end): inside (against the winding

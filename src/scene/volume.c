@@ -8,6 +8,7 @@
 #include <string.h>
 
 static int read_i32(FILE *f, int32_t *v) { return fread(v, 4, 1, f) == 1; }
+static int clamp_index(int i, int n) { return i < 0 ? 0 : i > n - 1 ? n - 1 : i; }
 
 valo_status density_grid_load(const char *path, density_grid **out, valo_error *err) {
   *out = NULL;
@@ -42,12 +43,15 @@ valo_status density_grid_load(const char *path, density_grid **out, valo_error *
   }
   for (int k = 0; k < 6; k++)
     if (!isfinite(box[k])) { st = err_set(err, VALO_ERR_PARSE, "%s: the grid's box is not finite", path); goto done; }
-  uint64_t count = (uint64_t)n[0] * n[1] * n[2], vsize = enc == 1 ? 4 : 1;
+  uint64_t count = (uint64_t)n[0] * n[1] * n[2];
   if ((st = mem_check(count * 4, path, "density grid", err))) goto done;
+  /* float32 values are read straight into the grid, uint8 ones through a byte buffer */
   g = calloc(1, sizeof *g);
-  raw = malloc(count * vsize);
-  if (!g || !raw || !(g->d = malloc(count * sizeof(float)))) { st = err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); goto done; }
-  if (fread(raw, vsize, count, f) != count) {
+  if (!g || !(g->d = malloc(count * sizeof(float))) || (enc == 3 && !(raw = malloc(count)))) {
+    st = err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path);
+    goto done;
+  }
+  if (fread(enc == 1 ? (void *)g->d : (void *)raw, enc == 1 ? 4 : 1, count, f) != count) {
     st = err_set(err, VALO_ERR_PARSE, "%s: the file ends before its %d x %d x %d values", path, (int)n[0], (int)n[1], (int)n[2]);
     goto done;
   }
@@ -56,9 +60,7 @@ valo_status density_grid_load(const char *path, density_grid **out, valo_error *
   g->box.hi = v3(box[3], box[4], box[5]);
   g->dmax = 0;
   for (uint64_t i = 0; i < count; i++) {
-    float v;
-    if (enc == 1) memcpy(&v, raw + 4 * i, 4);
-    else v = raw[i] / 255.0f;
+    float v = enc == 1 ? g->d[i] : raw[i] / 255.0f;
     if (!isfinite(v) || v < 0) {
       st = err_set(err, VALO_ERR_PARSE, "%s: value %llu is %g (densities are finite and not negative)", path, (unsigned long long)i, (double)v);
       goto done;
@@ -89,12 +91,8 @@ float density_grid_at(const density_grid *g, vec3 p) {
   for (int k = 0; k < 3; k++) {
     float x = u[k] * n[k] - 0.5f, fl = floorf(x);
     w[k] = x - fl;
-    i0[k] = (int)fl;
-    i1[k] = i0[k] + 1;
-    if (i0[k] < 0) i0[k] = 0;
-    if (i1[k] > n[k] - 1) i1[k] = n[k] - 1;
-    if (i0[k] > n[k] - 1) i0[k] = n[k] - 1;
-    if (i1[k] < 0) i1[k] = 0;
+    i0[k] = clamp_index((int)fl, n[k]);
+    i1[k] = clamp_index((int)fl + 1, n[k]);
   }
 #define D(x, y, z) g->d[((size_t)(z) * g->ny + (y)) * g->nx + (x)]
   float c00 = D(i0[0], i0[1], i0[2]) * (1 - w[0]) + D(i1[0], i0[1], i0[2]) * w[0];
