@@ -6,6 +6,8 @@
 #include "valo/valo.h"
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* 64 bytes each: rays traced, losses by cause (valo_loss) and surface samples drawn (the
  * base of the per-vertex loss fractions). */
@@ -15,6 +17,14 @@ typedef struct thread_stats {
   uint64_t surface_samples;
   char pad[64 - (2 + VALO_LOSS_COUNT) * sizeof(uint64_t)]; /* arrays of these: no false sharing */
 } thread_stats;
+/* n zeroed thread_stats on 64-byte boundaries (free with free()): the padding above keeps
+ * the threads' counters apart only if the array starts on a cache line, which calloc does
+ * not promise. NULL when out of memory. */
+static inline thread_stats *thread_stats_alloc(int n) {
+  thread_stats *ts = aligned_alloc(64, (size_t)(n > 0 ? n : 1) * sizeof *ts);
+  if (ts) memset(ts, 0, (size_t)(n > 0 ? n : 1) * sizeof *ts);
+  return ts;
+}
 static inline void thread_stats_add(thread_stats *into, const thread_stats *from) {
   into->rays += from->rays;
   into->surface_samples += from->surface_samples;

@@ -228,7 +228,7 @@ static valo_status run_finish(session *ss, thread_stats *ts, double t0, valo_sta
 
 valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo_error *err) {
   int threads = ss->opt.threads;
-  thread_stats *ts = calloc((size_t)threads, sizeof *ts);
+  thread_stats *ts = thread_stats_alloc(threads);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   double t0 = now_seconds();
   if (dist_size() > 1 && dist_rank() > 0) return run_finish(ss, ts, t0, dist_worker(ss, ts, err));
@@ -314,7 +314,7 @@ valo_status session_step(session *ss, int spp, int restart, valo_error *err) {
   if (ss->opt.frames > 0 || ss->opt.adaptive || dist_size() > 1)
     return err_set(err, VALO_ERR_INVALID, "steps are for one process rendering a still without adaptive sampling");
   if (spp < 1 || (int64_t)ss->spp_done * !restart + spp > INT32_MAX) return err_set(err, VALO_ERR_INVALID, "step of %d samples per pixel: out of range", spp);
-  thread_stats *ts = calloc((size_t)ss->opt.threads, sizeof *ts);
+  thread_stats *ts = thread_stats_alloc(ss->opt.threads);
   if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   double t0 = now_seconds();
   atomic_store(&ss->cancel, 0);
