@@ -139,20 +139,22 @@ static int bsdf_sf(void *c, sampler *s, vec3 *d);
 static int test_bsdf_wo(const char *name, material m, vec3 wo);
 static int test_bsdf(const char *name, material m, float theta_o_deg);
 
-/* GGX rough conductor (6 tests) and rough dielectric seen from outside and inside
- * (4 tests). */
+/* Rough conductor (6 tests per distribution, GGX and Beckmann) and rough dielectric
+ * seen from outside and inside (4 tests per distribution). */
 static int rough_conductor(void) {
   material m = material_default();
   m.type = MAT_CONDUCTOR;
   conductor_preset("Au", &m.eta, &m.k);
   float rough[3] = {0.3f, 0.6f, 0.9f}, th[2] = {20, 70};
   int rc = 0;
+  for (int beck = 0; beck < 2; beck++)
   for (int i = 0; i < 3; i++)
     for (int j = 0; j < 2; j++) {
       m.roughness = rough[i];
+      m.beckmann = beck;
       float t = th[j] * (float)M_PI / 180;
       char name[96];
-      snprintf(name, sizeof name, "GGX conductor roughness %.1f, theta_o %.0f", rough[i], th[j]);
+      snprintf(name, sizeof name, "%s conductor roughness %.1f, theta_o %.0f", beck ? "Beckmann" : "GGX", rough[i], th[j]);
       rc |= test_bsdf_wo(name, m, v3(sinf(t) * 0.6f, sinf(t) * 0.8f, cosf(t)));
     }
   return rc;
@@ -163,11 +165,14 @@ static int rough_dielectric(void) {
   m.ior = 1.5f;
   struct { float r, th; int inside; } cfg[4] = {{0.4f, 30, 0}, {0.4f, 30, 1}, {0.8f, 70, 0}, {0.8f, 50, 1}};
   int rc = 0;
+  for (int beck = 0; beck < 2; beck++)
   for (int i = 0; i < 4; i++) {
     m.roughness = cfg[i].r;
+    m.beckmann = beck;
     float t = cfg[i].th * (float)M_PI / 180;
     char name[96];
-    snprintf(name, sizeof name, "GGX dielectric roughness %.1f, theta_o %.0f, %s", cfg[i].r, cfg[i].th, cfg[i].inside ? "inside" : "outside");
+    snprintf(name, sizeof name, "%s dielectric roughness %.1f, theta_o %.0f, %s", beck ? "Beckmann" : "GGX", cfg[i].r, cfg[i].th,
+             cfg[i].inside ? "inside" : "outside");
     rc |= test_bsdf_wo(name, m, v3(sinf(t), 0, cfg[i].inside ? -cosf(t) : cosf(t)));
   }
   return rc;
@@ -226,15 +231,17 @@ static int pbr_metallic_roughness(void) {
  * multiple scattering between microfacets is not modelled). */
 static int microfacet_furnace(void) {
   float rough[4] = {0.2f, 0.5f, 0.8f, 1.0f}, th[3] = {0, 45, 80};
-  for (int kind = 0; kind < 2; kind++) {
+  for (int kind = 0; kind < 4; kind++) {
+    static const char *const label[4] = {"GGX mirror", "GGX glass ", "Beckmann mirror", "Beckmann glass "};
     material m = material_default();
-    m.type = kind ? MAT_DIELECTRIC : MAT_CONDUCTOR;
+    m.type = (kind & 1) ? MAT_DIELECTRIC : MAT_CONDUCTOR;
+    m.beckmann = kind >> 1;
     m.eta = c3(1e-3f, 1e-3f, 1e-3f); m.k = c3(1e3f, 1e3f, 1e3f); m.ior = 1.5f;
     for (int i = 0; i < 4; i++) {
       for (int j = 0; j < 3; j++) {
         m.roughness = rough[i];
         double albedo = directional_albedo(&m, th[j], 17);
-        fprintf(stderr, "%s roughness %.1f theta_o %2.0f: albedo %.4f (single-scattering loss %.1f%%)\n", kind ? "GGX glass " : "GGX mirror",
+        fprintf(stderr, "%s roughness %.1f theta_o %2.0f: albedo %.4f (single-scattering loss %.1f%%)\n", label[kind],
                 rough[i], th[j], albedo, 100 * (1 - albedo));
         CHECK(albedo <= 1.0 + 5e-3, "albedo %.4f > 1", albedo);
         /* At normal incidence only 1/(1 + alpha^2) of the cosine-weighted normals reflect

@@ -27,7 +27,7 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
   switch (b.type) {
   case BSDF_DIFFUSE: case BSDF_PHONG: case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: break; /* direct light only */
   case BSDF_MIRROR: k_refl = b.ks; break;
-  case BSDF_CONDUCTOR: k_refl = fresnel_conductor(fabsf(wo_l.z), b.cond_eta, b.cond_k); break;
+  case BSDF_CONDUCTOR: k_refl = c3_mul(b.cond_tint, fresnel_conductor(fabsf(wo_l.z), b.cond_eta, b.cond_k)); break;
   case BSDF_DIELECTRIC: {
     float F = fresnel_dielectric(wo_l.z, b.eta);
     k_refl = c3(F, F, F);

@@ -116,9 +116,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_thin[] = {"type", "ior", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "roughness", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
@@ -188,6 +188,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     }
     TRY(json_get_rgb(c, o, "eta", where, &m->eta));
     TRY(json_get_rgb(c, o, "k", where, &m->k));
+    TRY(json_get_rgb(c, o, "reflectance", where, &m->tint));
   } else {
     return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, null)");
   }
@@ -199,6 +200,10 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   double rough = m->roughness;
   TRY(json_get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;
+  const char *dist = NULL;
+  TRY(json_get_str(c, o, "distribution", where, &dist));
+  if (dist && strcmp(dist, "ggx") && strcmp(dist, "beckmann")) return json_bad(c, where, "distribution must be \"ggx\" or \"beckmann\"");
+  m->beckmann = dist && !strcmp(dist, "beckmann");
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
   return VALO_OK;

@@ -23,7 +23,8 @@ bsdf bsdf_from_material(const material *m) {
   bsdf b;
   memset(&b, 0, sizeof b);
   b.kd = m->kd; b.ks = m->ks; b.exponent = m->exponent; b.eta = m->ior;
-  b.cond_eta = m->eta; b.cond_k = m->k;
+  b.cond_eta = m->eta; b.cond_k = m->k; b.cond_tint = m->tint;
+  b.beckmann = m->beckmann && m->type != MAT_PBR;
   b.p_first = 1;
   switch (m->type) {
   case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
@@ -108,7 +109,7 @@ static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
   float etap;
   if (!rd_half(b, wo, wi, &wm, &etap)) return c3(0, 0, 0);
   float F = fresnel_dielectric(v3_dot(wo, wm), b->eta);
-  float D = ggx_D(b->alpha, wm), G = ggx_G(b->alpha, wo, wi);
+  float D = mf_D(b->beckmann, b->alpha, wm), G = mf_G(b->beckmann, b->alpha, wo, wi);
   float v;
   if (etap == 1) v = D * G * F / fabsf(4 * wi.z * wo.z);
   else {
@@ -123,16 +124,16 @@ static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (!rd_half(b, wo, wi, &wm, &etap)) return 0;
   float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;
   float pdf;
-  if (etap == 1) pdf = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm))) * R / (R + T);
+  if (etap == 1) pdf = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm))) * R / (R + T);
   else {
     float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap);
-    pdf = ggx_D_visible(b->alpha, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
+    pdf = mf_pdf_m(b->beckmann, b->alpha, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
   }
   return pdf;
 }
 
 static rgb conductor_F(const bsdf *b, float cos_i) {
-  return b->fresnel_white ? c3(1, 1, 1) : fresnel_conductor(cos_i, b->cond_eta, b->cond_k);
+  return c3_mul(b->cond_tint, b->fresnel_white ? c3(1, 1, 1) : fresnel_conductor(cos_i, b->cond_eta, b->cond_k));
 }
 
 static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
@@ -155,7 +156,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_PBR: return pbr_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
-    float dg = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
+    float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->alpha, wo, wi) / (4 * wo.z * wi.z);
     rgb F = conductor_F(b, fabsf(v3_dot(wo, wm)));
     return c3_scale(F, dg);
   }
@@ -175,7 +176,7 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_PBR: return pbr_pdf(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
-    float p = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
+    float p = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
     return p;
   }
   }
@@ -264,7 +265,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   }
   case BSDF_ROUGH_CONDUCTOR: {
     if (wo.z <= 0) return 0;
-    vec3 wm = ggx_sample_visible(b->alpha, wo, u1, u2);
+    vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
     s->wi = v3_reflect(wo, wm);
     if (s->wi.z <= 0) return 0;
     s->pdf = bsdf_pdf(b, wo, s->wi);
@@ -273,7 +274,9 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   }
   case BSDF_ROUGH_DIELECTRIC: {
     if (wo.z == 0) return 0;
-    vec3 wm = ggx_sample_visible(b->alpha, wo, u1, u2);
+    vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
+    /* Beckmann samples normals wo cannot see: lost (GGX samples only visible ones). */
+    if (b->beckmann && v3_dot(wo, wm) * wo.z <= 0) return 0;
     float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;
     if (ulobe < R / (R + T)) {
       s->wi = v3_reflect(wo, wm);
@@ -301,7 +304,7 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_DIFFUSE: return m->kd;
   case MAT_PHONG: case MAT_MIRROR: return c3_add(m->kd, m->ks);
   case MAT_DIELECTRIC: case MAT_THIN_DIELECTRIC: return c3(1, 1, 1);
-  case MAT_CONDUCTOR: return fresnel_conductor(fabsf(cos_o), m->eta, m->k);
+  case MAT_CONDUCTOR: return c3_mul(m->tint, fresnel_conductor(fabsf(cos_o), m->eta, m->k));
   case MAT_PBR: return m->kd;
   case MAT_NULL: break;
   }

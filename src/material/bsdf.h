@@ -18,11 +18,12 @@ typedef struct bsdf {
   rgb kd, ks;
   float exponent;
   float eta;          /* dielectric: interior index / exterior index */
-  rgb cond_eta, cond_k;
+  rgb cond_eta, cond_k, cond_tint;
   int fresnel_white;  /* conductors: F = 1, the caller applies F per wavelength (--spectral) */
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types) */
   float metallic;     /* BSDF_PBR */
+  int beckmann;       /* rough conductor and dielectric: the Beckmann distribution, not GGX */
   int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */
 } bsdf;
 

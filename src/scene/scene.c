@@ -72,6 +72,7 @@ material material_default(void) {
   m.ior = 1.5f;
   m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
   m.bump_scale = 1;
+  m.tint = c3(1, 1, 1);
   m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = -1;
   m.alpha_cutoff = 0.5f;
   snprintf(m.name, sizeof m.name, "default");

@@ -26,8 +26,10 @@ typedef struct material {
   float exponent;
   float ior;
   rgb eta, k;
+  rgb tint;          /* conductor: multiplies its Fresnel reflectance (Mitsuba's specular_reflectance), 1 by default */
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
   float metallic;    /* MAT_PBR: 0 dielectric .. 1 metal */
+  int beckmann;      /* conductor/dielectric roughness: Beckmann's distribution (JSON "distribution"), else GGX */
   int metal_flat;    /* MAT_PBR: metal reflectance kd at every angle, no Schlick term (MTL PBR extension) */
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
