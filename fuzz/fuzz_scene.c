@@ -1,7 +1,7 @@
 /* fuzz_scene.c — owns the scene-file fuzz harness: the input is written as a scene file
  * and loaded through the public API (valo_scene_load), which checks it, reads it and
  * commits the scene. FUZZ_NAME (set by the build) picks the file name, and so the path
- * the loader takes: scene.json (the JSON loader), mesh.obj (valo's OBJ/MTL pre-reader,
+ * the loader takes: scene.json (the JSON loader), scene.xml (the Mitsuba reader), mesh.obj (valo's OBJ/MTL pre-reader,
  * then Assimp), mesh.ply (valo's PLY check, then Assimp), mesh.gltf or mesh.glb (valo's
  * glTF check, then Assimp). With FUZZ_MTL the input is mesh.mtl, the material library of
  * a fixed OBJ that names it (valo's MTL reading, then Assimp's MTL reader, which a fuzzed

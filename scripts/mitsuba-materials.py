@@ -348,6 +348,68 @@ def scene_dict(mi, name, mat, spp):
                       "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [LE, LE, LE]}}}}, WIDTH, HEIGHT
 
 
+# Mitsuba's XML of a scene dict (write_xml): the element of each plugin type.
+XML_TAGS = {"bsdf": "diffuse dielectric roughdielectric thindielectric conductor roughconductor principled null twosided plastic roughplastic",
+            "shape": "obj ply sphere rectangle cube disk", "emitter": "area point spot directional envmap constant",
+            "sensor": "perspective orthographic thinlens", "film": "hdrfilm", "rfilter": "box tent gaussian",
+            "sampler": "independent", "integrator": "path volpath", "medium": "homogeneous heterogeneous", "phase": "hg isotropic",
+            "volume": "gridvolume", "texture": "bitmap"}
+
+
+def write_xml(mi, d, path):
+    """Writes scene dict d as a Mitsuba 3 XML file (file names relative to it): the file
+    valo's .xml reader is tested on, with the same meaning as the dict Mitsuba rendered
+    (--check-xml renders it in Mitsuba and compares)."""
+    import numpy as np
+    tag = {t: k for k, ts in XML_TAGS.items() for t in ts.split()}
+    out = ['<scene version="3.0.0">']
+
+    def num(x):
+        return repr(float(x)) if isinstance(x, float) else str(x)
+
+    def emit(name, v, ind, top=False):
+        pad = "\t" * ind
+        attr = (' id="%s"' if top else ' name="%s"') % name if name else ""
+        if isinstance(v, mi.ScalarTransform4f):
+            m = np.array(v.matrix).reshape(4, 4)
+            out.append('%s<transform%s><matrix value="%s"/></transform>' % (pad, attr, " ".join("%.9g" % x for x in m.flatten())))
+        elif isinstance(v, dict) and v["type"] in ("rgb", "uniform", "irregular"):
+            if v["type"] == "rgb":
+                out.append('%s<rgb%s value="%s"/>' % (pad, attr, ", ".join(num(x) for x in v["value"])))
+            elif v["type"] == "uniform":
+                out.append('%s<spectrum%s value="%s"/>' % (pad, attr, num(v["value"])))
+            else:
+                pairs = zip(v["wavelengths"].split(", "), v["values"].split(", "))
+                out.append('%s<spectrum%s value="%s"/>' % (pad, attr, ", ".join("%s:%s" % p for p in pairs)))
+        elif isinstance(v, dict):
+            out.append('%s<%s type="%s"%s>' % (pad, tag[v["type"]], v["type"], attr))
+            for k, x in v.items():
+                if k != "type":
+                    emit(k, x, ind + 1)
+            out.append("%s</%s>" % (pad, tag[v["type"]]))
+        elif isinstance(v, bool):
+            out.append('%s<boolean%s value="%s"/>' % (pad, attr, "true" if v else "false"))
+        elif isinstance(v, int):
+            out.append('%s<integer%s value="%d"/>' % (pad, attr, v))
+        elif isinstance(v, float):
+            out.append('%s<float%s value="%s"/>' % (pad, attr, num(v)))
+        elif isinstance(v, str):
+            s = os.path.relpath(v, os.path.dirname(path)) if name == "filename" else v
+            out.append('%s<string%s value="%s"/>' % (pad, attr, s))
+        elif isinstance(v, (list, tuple)) and len(v) == 3:
+            out.append('%s<%s%s x="%s" y="%s" z="%s"/>' % (pad, "vector" if name == "direction" else "point", attr, *map(num, v)))
+        else:
+            raise ValueError("no XML for %s = %r" % (name, v))
+
+    for k, v in d.items():
+        if k != "type":
+            emit(k, v, 1, top=True)
+    out.append("</scene>")
+    with open(path, "w") as f:
+        f.write("<!-- written by scripts/mitsuba-materials.py from the scene Mitsuba rendered into the EXR beside it -->\n")
+        f.write("\n".join(out) + "\n")
+
+
 def spectral_white(mi):
     """Mitsuba's linear sRGB of the equal-energy spectrum of radiance 1: a constant
     environment seen directly, 16 x 16 pixels at 4096 spp (wavelength noise < 0.05 %)."""
@@ -358,8 +420,12 @@ def spectral_white(mi):
     return np.array(mi.render(s, seed=1)).reshape(-1, 3).mean(axis=0)
 
 
-def render(mi, name, mat, spp, seed):
+def render(mi, name, mat, spp, seed, xml_only=False):
     scene, w, h = scene_dict(mi, name, mat, spp)
+    if "spectral" not in mi.variant() and SUFFIX == "" and name != "gold-spectral":
+        write_xml(mi, scene, os.path.join(OUT, name + ".xml"))
+    if xml_only:
+        return
     white = None
     if "spectral" in mi.variant():
         # valo's spectral white is the equal-energy spectrum, balanced per channel on the film
@@ -394,6 +460,9 @@ def main():
     ap.add_argument("--seed", type=int, default=11)
     ap.add_argument("--shared", default=os.path.join(ROOT, "..", "shared"))
     ap.add_argument("--max-depth", type=int, default=-1, help="valo's max_depth D (bounces); Mitsuba's max_depth is D + 1")
+    ap.add_argument("--xml-only", action="store_true", help="write the scenes (JSON and Mitsuba XML) without rendering")
+    ap.add_argument("--check-xml", type=int, default=0, metavar="SPP",
+                    help="render each written XML file in Mitsuba at SPP and compare its mean with the committed EXR")
     a = ap.parse_args()
     global SHARED, INTEGRATOR, SUFFIX
     SHARED = a.shared
@@ -416,7 +485,16 @@ def main():
     for name, mat in (list(SCENES.items()) + list(ENV_SCENES.items()) + list(LIGHT_SCENES.items()) + list(TEXTURE_SCENES.items()) +
                       list(CAMERA_SCENES.items()) + list(MEDIUM_SCENES.items()) + list(GRID_SCENES.items())):
         if not a.only or a.only == name:
-            render(mi, name, mat, a.spp, a.seed)
+            render(mi, name, mat, a.spp, a.seed, xml_only=a.xml_only or a.check_xml > 0)
+            xml = os.path.join(OUT, name + ".xml")
+            if a.check_xml > 0 and os.path.exists(xml):
+                import numpy as np
+                img = np.array(mi.render(mi.load_file(xml), spp=a.check_xml, seed=a.seed + 1000))
+                ref = np.array(mi.Bitmap(os.path.join(OUT, name + "-mitsuba.exr")))[..., :3]
+                mx, mr = img.reshape(-1, 3).mean(0), ref.reshape(-1, 3).mean(0)
+                print("%s: Mitsuba from the XML at %d spp against the EXR: mean %s (%s)" %
+                      (name, a.check_xml, " ".join("%+.2f%%" % (100 * (x / r - 1)) for x, r in zip(mx, mr)),
+                       " ".join("%.4f" % x for x in mx)), flush=True)
 
 
 if __name__ == "__main__":

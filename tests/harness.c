@@ -145,13 +145,15 @@ int test_main(int argc, char **argv, const test_case *cases) {
   return failed ? 1 : 0;
 }
 
-valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene) {
+valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene) { return render_file_with(path, NULL, opt, scene); }
+
+valo_render *render_file_with(const char *path, const valo_load_options *lo, const valo_options *opt, valo_scene **scene) {
   valo_error err;
   valo_scene *sc = NULL;
   valo_render *r = NULL;
   *scene = NULL;
   if (!path) { fprintf(stderr, "no scene file\n"); return NULL; }
-  if (valo_scene_load(path, &sc, &err)) { fprintf(stderr, "load: %s\n", err.message); return NULL; }
+  if (valo_scene_load_with(path, lo, &sc, &err)) { fprintf(stderr, "load: %s\n", err.message); return NULL; }
   if (valo_render_create(sc, opt, &r, &err)) { fprintf(stderr, "create: %s\n", err.message); valo_scene_destroy(sc); return NULL; }
   if (valo_render_run(r, NULL, NULL, &err) || check_losses(r)) {
     if (err.status) fprintf(stderr, "run: %s\n", err.message);

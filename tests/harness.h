@@ -45,6 +45,8 @@ float *render_json_text(const char *json, const valo_options *opt, int *w, int *
  * returns the finished render and its scene in *scene (destroy both), or NULL with the
  * message printed. */
 valo_render *render_file(const char *path, const valo_options *opt, valo_scene **scene);
+/* The same with load options (NULL: defaults). */
+valo_render *render_file_with(const char *path, const valo_load_options *lo, const valo_options *opt, valo_scene **scene);
 /* 1 (with a message) when render r lost samples: any NaN, infinite or negative sample
  * or non-finite BSDF sample, or more shading-normal refusals than the case allows
  * (1 % of surface samples, what interpolated normals on coarse spheres refuse, unless

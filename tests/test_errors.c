@@ -128,6 +128,58 @@ static int wrong_type(void) {
 
 /* Participating media: each mistake names its key; a medium an integrator cannot
  * render is refused by name (exit 1). */
+/* Mitsuba scene files (.xml): what valo cannot read is an error naming the file, the line
+ * and the element; never a crash. */
+static int bad_mitsuba(void) {
+#define SENSOR "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/></sensor>\n"
+  static const struct { const char *name, *xml, *said1, *said2; } cases[] = {
+      {"mx1.xml", "<scene version=\"3.0.0\">\n<shape type=\"obj\">\n</scene>\n", "mx1.xml:3:3", "end tag does not match <shape> of line 2"},
+      {"mx2.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"serialized\"><string name=\"filename\" value=\"a.serialized\"/></shape>\n</scene>",
+       "mx2.xml:3: <shape type=\"serialized\">", "convert them to PLY or OBJ"},
+      {"mx3.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"hair\"/></shape>\n</scene>", "mx3.xml:3: <bsdf type=\"hair\">",
+       "valo has no such BSDF"},
+      {"mx4.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"$kind\"/>\n</scene>", "mx4.xml:3", "$kind has no <default"},
+      {"mx5.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.1, 700:0.9\"/></bsdf></shape>\n</scene>",
+       "mx5.xml:3: <spectrum name=\"reflectance\">", "give wavelength-dependent colours as <rgb>"},
+      {"mx6.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>\n"
+       "<transform name=\"to_world\"><rotate x=\"1\" angle=\"90\"/></transform></emitter>\n</scene>", "mx6.xml:3: <emitter type=\"envmap\">", "only about +y"},
+      {"mx7.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>"
+       "<float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n</scene>", "mx7.xml:3", "isotropic"},
+      {"mx8.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"1\"/>"
+       "<float name=\"ext_ior\" value=\"1.33\"/></bsdf></shape>\n</scene>", "mx8.xml:3", "int_ior >= ext_ior"},
+      {"mx9.xml", "<scene version=\"3.0.0\">\n<shape type=\"sphere\"/>\n</scene>", "mx9.xml:1: <scene>", "has no <sensor>"},
+      {"mx10.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform></shape>\n</scene>",
+       "mx10.xml:3: <shape type=\"sphere\">", "no ellipsoids"},
+      {"mx11.xml", "<scene version=\"3.0.0\">\n<include filename=\"other.xml\"/>\n</scene>", "mx11.xml:2: <include>", "merge the included file"},
+      {"mx12.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/></shape>\n</scene>", "none.obj",
+       "(the <shape> at line 3)"},
+      {"mx13.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><float name=\"radius\" value=\"-1\"/></shape>\n</scene>", "mx13.xml",
+       "(the <shape> at line 3)"},
+      {"mx14.xml", "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"x\"/></sensor>\n</scene>",
+       "mx14.xml:2: <float name=\"fov\">", "is not a number"},
+      {"mx15.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"cube\"><transform name=\"to_world\"><matrix value=\"1 0 0\"/></transform></shape>\n</scene>",
+       "mx15.xml:3: <matrix>", "16 numbers"},
+      {"mx16.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><ref name=\"interior\" id=\"fog\"/></shape>\n</scene>",
+       "mx16.xml:3: <ref name=\"interior\" id=\"fog\">", "refers to an id that no element has"},
+      {"mx19.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\">\n<ref id=\"nothing\"/></shape>\n</scene>",
+       "mx19.xml:4: <ref id=\"nothing\">", "refers to an id that no element has"},
+      {"mx17.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"area\"/>\n</scene>", "mx17.xml:3: <emitter type=\"area\">", "belongs inside the <shape>"},
+      {"mx18.xml", "<notascene/>", "mx18.xml:1: <notascene>", "root element of a Mitsuba scene is <scene>"},
+  };
+#undef SENSOR
+  for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+    const char *p = write_file(cases[k].name, cases[k].xml);
+    EXPECT_FAIL(1, "render", p);
+    SAID(cases[k].said1); SAID(cases[k].said2); NO_SANITIZER();
+  }
+  /* --define is for Mitsuba scenes: on a JSON scene it is an error */
+  EXPECT_FAIL(1, "render", write_file("plain.json", "{}"), "-D", "a=1");
+  SAID("--define sets a Mitsuba scene's <default> values");
+  EXPECT_FAIL(2, "render", write_file("plain2.json", "{}"), "-D", "novalue");
+  SAID("NAME=VALUE");
+  return 0;
+}
+
 static int bad_media(void) {
   /* grids of 2 x 2 x 2: one cut short, one right (for med15, whose fault is its box),
    * one with a negative density */
@@ -765,7 +817,7 @@ int main(int argc, char **argv) {
                                     {"malformed_json", malformed_json},
                                     {"unknown_key", unknown_key},
                                     {"wrong_type", wrong_type},
-                                    {"bad_media", bad_media}, {"unsupported_format", unsupported_format},
+                                    {"bad_mitsuba", bad_mitsuba}, {"bad_media", bad_media}, {"unsupported_format", unsupported_format},
                                     {"index_out_of_range", index_out_of_range},
                                     {"nan_vertices", nan_vertices},
                                     {"bad_ply", bad_ply},

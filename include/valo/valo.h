@@ -123,6 +123,8 @@ typedef struct valo_load_options {
   double env_rotation;    /* its rotation about the up axis in degrees (default 0) */
   char up[4];             /* mesh files framed automatically: the model's up axis, "y"
                              (default) or "z" (scanned and CAD models) */
+  char defines[1024];     /* a Mitsuba scene's <default> values: "NAME=VALUE NAME=VALUE",
+                             replacing the file's (Mitsuba's -D); "" = none (default) */
   void (*on_warning)(void *user, const char *message); /* where this scene's warnings go,
                              while loading and in every render of it (a valo_log_fn);
                              NULL (default): the process-wide handler */

@@ -12,8 +12,10 @@ void usage_render(FILE *f);
 void usage_render(FILE *f) {
   fprintf(f,
           "Usage: valo render SCENE [options]\n\n"
-          "SCENE is a .json scene file (docs/scene-format.md) or a mesh file read by Assimp\n"
-          "(OBJ/MTL, glTF 2.0, PLY, ...; its camera is used, or the view is framed automatically).\n"
+          "SCENE is a .json scene file (docs/scene-format.md), a Mitsuba scene (.xml: Mitsuba 3\n"
+          "or 0.6; what it holds that valo cannot render is an error or a warning naming the\n"
+          "line), or a mesh file read by Assimp (OBJ/MTL, glTF 2.0, PLY, ...; its camera is\n"
+          "used, or the view is framed automatically).\n"
           "Options override the scene file:\n"
           "  -o, --output FILE      output image; .exr/.pfm linear float, .hdr Radiance RGBE,\n"
           "                         .png/.jpg 8-bit sRGB;\n"
@@ -123,6 +125,7 @@ int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err) 
       }
       continue;
     }
+    if (!strcmp(a, "-D")) a = "--define"; /* Mitsuba's spelling */
     if (a[0] == '-' && a[1]) {
       /* a declared option (valo_option_at): a flag alone, or a flag and its value */
       const valo_option_info *info = NULL;

@@ -95,6 +95,8 @@ const option_decl option_table[] = {
      .lo = -36000, .hi = 36000, .def = 0, .range_text = "degrees"},
     {INFO("--up", "y|z", NULL, "up axis of a mesh file framed automatically (default y;\nz for scans and CAD models)"), L(up),
      .type = OPT_NAME, .names = "y|z", .def_text = "y", .range_text = "y or z"},
+    {INFO("--define", "NAME=VALUE", NULL, "a Mitsuba scene (.xml): set its <default> NAME, which\n$NAME stands for (repeatable; -D, as Mitsuba's)"),
+     L(defines), .type = OPT_PARAMS, .range_text = "NAME=VALUE"},
     {INFO("--exposure", "STOPS", NULL, "PNG exposure (default 0)"), O(exposure), .type = OPT_FLOAT, .lo = -100, .hi = 100, .def = 0,
      .range_text = "stops, -100..100"},
     {INFO("--tonemap", "NAME", NULL, "PNG tone curve: clamp (default), log, reinhard, aces"), O(tonemap), .type = OPT_NAME,

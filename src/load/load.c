@@ -28,9 +28,13 @@ valo_status scene_load(const char *path, const valo_load_options *lo, scene **ou
   if (strcmp(lo->up, "y") && strcmp(lo->up, "z") && lo->up[0]) return err_set(err, VALO_ERR_INVALID, "up axis \"%s\" (y or z)", lo->up);
   scene *s = scene_new(path);
   if (!s) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  int json = str_ends_with(path, ".json");
+  int xml = str_ends_with(path, ".xml"), json = xml || str_ends_with(path, ".json");
+  if (lo->defines[0] && !xml) {
+    scene_free(s);
+    return err_set(err, VALO_ERR_INVALID, "--define sets a Mitsuba scene's <default> values; %s is not a Mitsuba scene (.xml)", path);
+  }
   s->up_z = !strcmp(lo->up, "z");
-  valo_status st = json ? load_json(s, path, file, err) : load_mesh(s, path, NULL, UINT32_MAX, 1, file, err);
+  valo_status st = xml ? load_mitsuba(s, path, lo->defines, file, err) : json ? load_json(s, path, file, err) : load_mesh(s, path, NULL, UINT32_MAX, LOAD_MESH_CAMERA, file, err);
   if (st == VALO_OK && lo->env_file[0]) {
     /* --env replaces whatever environment the scene had. */
     envmap_destroy(s->env_map);

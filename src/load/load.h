@@ -16,9 +16,14 @@ valo_status scene_load(const char *path, const valo_load_options *lo, scene **ou
 
 /* The two loaders, appending to s; file (may be NULL) receives the settings they find. */
 valo_status load_json(scene *s, const char *path, valo_options *file, valo_error *err);
+/* A Mitsuba scene (.xml, Mitsuba 3 or 0.6), translated into the JSON scene format;
+ * defines ("NAME=VALUE ...", may be NULL) replace its <default> values. */
+valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *file, valo_error *err);
 /* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
  * override_mat: material index for every triangle, or UINT32_MAX to keep the file's;
- * take_camera: use the file's camera (its aspect sets the file's film size). */
-valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int take_camera, valo_options *file,
+ * mesh_flags: LOAD_MESH_CAMERA, use the file's camera (its aspect sets the file's film
+ * size); LOAD_MESH_FLAT, shade with the triangles' own normals, not the file's. */
+enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2 };
+valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int mesh_flags, valo_options *file,
                       valo_error *err);
 #endif

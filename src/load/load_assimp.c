@@ -259,6 +259,7 @@ typedef struct load_ctx {
   uint64_t added, degenerate;
   valo_error *err;
   int gltf;          /* a .gltf/.glb file: its cameras and materials need glTF meanings */
+  int flat;          /* LOAD_MESH_FLAT: the file's vertex normals are not used */
   valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
 } load_ctx;
 
@@ -325,7 +326,7 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
     float a2 = v3_len2(ng);
     if (!(a2 > 0) || !isfinite(a2)) { c->degenerate++; continue; }
     uint8_t fl = 0;
-    if (mesh->mNormals && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
+    if (mesh->mNormals && !c->flat && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
       fl |= TRI_HAS_NORMALS;
     if (mesh->mTextureCoords[0]) fl |= TRI_HAS_UVS;
     s->tri_mat[ti] = mat;
@@ -451,7 +452,7 @@ static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
   return VALO_OK;
 }
 
-valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int take_camera, valo_options *file,
+valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
                       valo_error *err) {
   /* Loading and building peak at a multiple of the file's size (MESH_MEMORY_FACTOR; 7-11
    * measured on the bunny, the dragon and Sponza: README.md); a file that would not fit
@@ -506,7 +507,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
                    ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, file};
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, file};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
@@ -544,7 +545,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   }
   if (c.degenerate)
     log_warning("%s: skipped %llu degenerate (zero-area) triangles", path, (unsigned long long)c.degenerate);
-  if (take_camera && ai->mNumCameras > 0) take_file_camera(&c, &x);
+  if ((mesh_flags & LOAD_MESH_CAMERA) && ai->mNumCameras > 0) take_file_camera(&c, &x);
   st = take_file_lights(&c, &x);
 done:
   aiReleaseImport(ai);

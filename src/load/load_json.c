@@ -183,9 +183,34 @@ static valo_status parse_render(jctx *c, const cJSON *o) {
   return json_settings(c, o, "render");
 }
 
-static valo_status parse_transform(jctx *c, const cJSON *o, const char *where, float xf[12]) {
-  static const char *const keys[] = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate", NULL};
+/* "matrix": 16 numbers, row-major, the last row 0 0 0 1 (or 12: the first three rows). */
+static valo_status parse_matrix(jctx *c, const cJSON *a, const char *where, float xf[12]) {
+  char w[96];
+  snprintf(w, sizeof w, "%s.matrix", where);
+  int n = cJSON_IsArray(a) ? cJSON_GetArraySize(a) : 0;
+  if (n != 16 && n != 12) return json_bad(c, w, "must be an array of 16 numbers (a 4x4 matrix, row by row) or 12 (its first three rows)");
+  double m[16] = {0};
+  int i = 0;
+  for (const cJSON *e = a->child; e; e = e->next, i++) {
+    if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) return json_bad(c, w, "must hold finite numbers");
+    m[i] = e->valuedouble;
+  }
+  if (n == 16 && (m[12] != 0 || m[13] != 0 || m[14] != 0 || m[15] != 1))
+    return json_bad(c, w, "the last row must be 0 0 0 1 (no projective transforms)");
+  for (i = 0; i < 12; i++) xf[i] = (float)m[i];
+  double det = m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) + m[2] * (m[4] * m[9] - m[5] * m[8]);
+  if (!(fabs(det) > 0)) return json_bad(c, w, "is singular (it flattens the shape)");
+  return VALO_OK;
+}
+
+valo_status json_parse_transform(jctx *c, const cJSON *o, const char *where, float xf[12]) {
+  static const char *const keys[] = {"scale", "rotate_x", "rotate_y", "rotate_z", "translate", "matrix", NULL};
   TRY(json_check_keys(c, o, where, keys));
+  const cJSON *mx = cJSON_GetObjectItemCaseSensitive(o, "matrix");
+  if (mx) {
+    if (cJSON_GetArraySize(o) != 1) return json_bad(c, where, "\"matrix\" is the whole transform: give it alone");
+    return parse_matrix(c, mx, where, xf);
+  }
   vec3 sc = v3(1, 1, 1), tr = v3(0, 0, 0);
   TRY(json_get_vec(c, o, "scale", where, 1, &sc));
   TRY(json_get_vec(c, o, "translate", where, 0, &tr));
@@ -225,7 +250,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
-                                     "proximity", "interior", "exterior", NULL};
+                                     "proximity", "interior", "exterior", "face_normals", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
   int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
@@ -260,6 +285,17 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   return VALO_OK;
 }
 
+/* A shape's "transform" (identity when absent). */
+static valo_status shape_transform(jctx *c, const cJSON *o, const char *where, float xf[12]) {
+  static const float id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  memcpy(xf, id, sizeof id);
+  const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
+  if (!t) return VALO_OK;
+  char w2[80];
+  snprintf(w2, sizeof w2, "%s.transform", where);
+  return json_parse_transform(c, t, w2, xf);
+}
+
 static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend) {
   const char *type = "mesh", *file = NULL, *mname = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
@@ -274,18 +310,29 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       return json_bad(c, where, msg);
     }
   }
-  if (!strcmp(type, "mesh")) {
-    if (!file) return json_bad(c, where, "a mesh shape needs \"file\"");
-    float xf[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-    const cJSON *t = cJSON_GetObjectItemCaseSensitive(o, "transform");
-    if (t) {
-      char w2[80];
-      snprintf(w2, sizeof w2, "%s.transform", where);
-      TRY(parse_transform(c, t, w2, xf));
+  /* Keys another kind of shape takes are errors, not silently ignored. */
+  int mesh = !strcmp(type, "mesh"), sphere = !strcmp(type, "sphere");
+  static const char *const sphere_only[] = {"center", "radius", "subdivisions", "smooth", NULL};
+  for (int j = 0; (mesh || sphere) && sphere_only[j]; j++)
+    if (mesh && cJSON_GetObjectItemCaseSensitive(o, sphere_only[j])) {
+      char msg[160];
+      snprintf(msg, sizeof msg, "\"%s\" is a sphere's; a mesh is placed by \"transform\"", sphere_only[j]);
+      return json_bad(c, where, msg);
     }
+  if (mesh && cJSON_GetObjectItemCaseSensitive(o, "flip_normals")) return json_bad(c, where, "\"flip_normals\" is not read for a mesh (its file's winding sets its front side)");
+  if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "face_normals")) return json_bad(c, where, "\"face_normals\" is a mesh's");
+  if (sphere && (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "file")))
+    return json_bad(c, where, "a sphere is placed by \"center\" and \"radius\" (no \"transform\" or \"file\")");
+  if (mesh) {
+    if (!file) return json_bad(c, where, "a mesh shape needs \"file\"");
+    float xf[12];
+    TRY(shape_transform(c, o, where, xf));
     char full[2048];
     json_resolve_path(c, file, full, sizeof full);
-    return load_mesh(c->s, full, xf, mat, c->cam_from_file && !c->s->has_camera, c->file, c->err);
+    int flat = 0;
+    TRY(json_get_bool(c, o, "face_normals", where, &flat));
+    int flags = (c->cam_from_file && !c->s->has_camera ? LOAD_MESH_CAMERA : 0) | (flat ? LOAD_MESH_FLAT : 0);
+    return load_mesh(c->s, full, xf, mat, flags, c->file, c->err);
   }
   if (!strcmp(type, "sphere")) {
     vec3 center = v3(0, 0, 0);
@@ -305,7 +352,28 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       log_warning("%s: %s: a sphere has no texture coordinates, so the maps of material '%s' are ignored", c->s->path, where, c->s->mats[mat].name);
     return scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err);
   }
-  return json_bad(c, where, "unknown shape type (mesh, sphere)");
+  static const char *const prims[] = {"rectangle", "cube", "disk"};
+  for (int k = 0; k < 3; k++) {
+    if (strcmp(type, prims[k])) continue;
+    float xf[12];
+    TRY(shape_transform(c, o, where, xf));
+    int flip = 0;
+    TRY(json_get_bool(c, o, "flip_normals", where, &flip));
+    static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "file"};
+    for (int j = 0; j < 5; j++)
+      if (cJSON_GetObjectItemCaseSensitive(o, own[j])) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "a %s takes no \"%s\": it is the unit shape placed by \"transform\"", type, own[j]);
+        return json_bad(c, where, msg);
+      }
+    if (mat == UINT32_MAX) {
+      material d = material_default();
+      mat = scene_add_material(c->s, &d);
+      if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    }
+    return scene_add_primitive(c->s, (primitive_kind)k, xf, flip, mat, c->err);
+  }
+  return json_bad(c, where, "unknown shape type (mesh, sphere, rectangle, cube, disk)");
 }
 
 static valo_status parse_light(jctx *c, const cJSON *o, int index) {
@@ -358,31 +426,9 @@ static valo_status parse_light(jctx *c, const cJSON *o, int index) {
 
 
 valo_status load_json(scene *s, const char *path, valo_options *settings, valo_error *err) {
-  valo_options unused;
-  valo_options_init(&unused);
-  jctx c = {.s = s, .path = path, .err = err, .file = settings ? settings : &unused};
-  const char *slash = strrchr(path, '/');
-  if (slash) snprintf(c.dir, sizeof c.dir, "%.*s", (int)(slash - path), path);
-  FILE *f = fopen(path, "rb");
-  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-  char *text = NULL;
-  size_t len = 0, cap = 0;
-  for (;;) {
-    if (len + 4096 + 1 > cap) {
-      cap = cap ? cap * 2 : 65536;
-      if (cap > (64u << 20)) { fclose(f); free(text); return err_set(err, VALO_ERR_INVALID, "%s: scene file larger than 64 MiB", path); }
-      char *t = realloc(text, cap);
-      if (!t) { fclose(f); free(text); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-      text = t;
-    }
-    size_t n = fread(text + len, 1, 4096, f);
-    len += n;
-    if (n < 4096) break;
-  }
-  int rerr = ferror(f);
-  fclose(f);
-  if (rerr) { free(text); return err_set(err, VALO_ERR_IO, "%s: read error", path); }
-  text[len] = 0;
+  char *text;
+  size_t len;
+  TRY(scene_text_read(path, &text, &len, err));
   if (strlen(text) != len) { free(text); return err_set(err, VALO_ERR_PARSE, "%s: contains a NUL byte: not a JSON text file", path); }
   const char *end = NULL;
   cJSON *root = cJSON_ParseWithOpts(text, &end, 1);
@@ -395,6 +441,17 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
     return err_set(err, VALO_ERR_PARSE, "%s:%d:%d: JSON syntax error", path, line, col);
   }
   free(text);
+  valo_status st = load_json_tree(s, path, root, settings, NULL, err);
+  cJSON_Delete(root);
+  return st;
+}
+
+valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_options *settings, int at[2], valo_error *err) {
+  valo_options unused;
+  valo_options_init(&unused);
+  jctx c = {.s = s, .path = path, .err = err, .file = settings ? settings : &unused};
+  const char *slash = strrchr(path, '/');
+  if (slash) snprintf(c.dir, sizeof c.dir, "%.*s", (int)(slash - path), path);
   valo_status st = VALO_OK;
   static const char *const keys[] = {"camera", "film", "render", "shapes", "materials", "media", "lights", "environment", NULL};
 #undef TRY
@@ -426,7 +483,11 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
   if (shapes) {
     if (!cJSON_IsArray(shapes)) { st = json_bad(&c, "shapes", "must be an array"); goto done; }
     int i = 0;
-    for (const cJSON *sh = shapes->child; sh; sh = sh->next, i++) TRY(parse_shape(&c, sh, i, mfirst, mend));
+    for (const cJSON *sh = shapes->child; sh; sh = sh->next, i++) {
+      if (at) at[0] = i;
+      TRY(parse_shape(&c, sh, i, mfirst, mend));
+    }
+    if (at) at[0] = -1;
   }
   if (c.cam_from_file) {
     if (!s->has_camera) { st = json_bad(&c, "camera.from_file", "no shape file has a camera"); goto done; }
@@ -446,7 +507,11 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
   if (lights) {
     if (!cJSON_IsArray(lights)) { st = json_bad(&c, "lights", "must be an array"); goto done; }
     int i = 0;
-    for (const cJSON *l = lights->child; l; l = l->next, i++) TRY(parse_light(&c, l, i));
+    for (const cJSON *l = lights->child; l; l = l->next, i++) {
+      if (at) at[1] = i;
+      TRY(parse_light(&c, l, i));
+    }
+    if (at) at[1] = -1;
   }
   const cJSON *env = cJSON_GetObjectItemCaseSensitive(root, "environment");
   if (env) {
@@ -496,7 +561,6 @@ valo_status load_json(scene *s, const char *path, valo_options *settings, valo_e
     s->has_env = 1;
   }
 done:
-  cJSON_Delete(root);
   return st;
 }
 

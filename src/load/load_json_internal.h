@@ -33,6 +33,15 @@ valo_status json_parse_media(jctx *c, const cJSON *o);
  * is when the key is absent. */
 valo_status json_get_medium(jctx *c, const cJSON *o, const char *key, const char *where, int32_t *med);
 
+/* A scene file's whole text (at most 64 MiB), NUL-ended (free it): *len bytes. */
+valo_status scene_text_read(const char *path, char **text, size_t *len, valo_error *err);
+/* A shape's "transform" object into xf (3x4 row-major). */
+valo_status json_parse_transform(jctx *c, const cJSON *o, const char *where, float xf[12]);
+/* The JSON scene format's reader over a parsed tree (load_json reads the text first);
+ * path names the file in messages and resolves relative file names. On an error, at
+ * (may be NULL; -1 each first) gets the index of the shape and of the light being read. */
+valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_options *settings, int at[2], valo_error *err);
+
 #define TRY(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
 #endif

@@ -129,3 +129,30 @@ void json_line_col(const char *text, const char *at, int *line, int *col) {
     if (*p == '\n') { (*line)++; *col = 1; } else (*col)++;
   }
 }
+
+valo_status scene_text_read(const char *path, char **out, size_t *out_len, valo_error *err) {
+  *out = NULL;
+  FILE *f = fopen(path, "rb");
+  if (!f) return err_set(err, VALO_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+  char *text = NULL;
+  size_t len = 0, cap = 0;
+  for (;;) {
+    if (len + 4096 + 1 > cap) {
+      cap = cap ? cap * 2 : 65536;
+      if (cap > (64u << 20)) { fclose(f); free(text); return err_set(err, VALO_ERR_INVALID, "%s: scene file larger than 64 MiB", path); }
+      char *t = realloc(text, cap);
+      if (!t) { fclose(f); free(text); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+      text = t;
+    }
+    size_t n = fread(text + len, 1, 4096, f);
+    len += n;
+    if (n < 4096) break;
+  }
+  int rerr = ferror(f);
+  fclose(f);
+  if (rerr) { free(text); return err_set(err, VALO_ERR_IO, "%s: read error", path); }
+  text[len] = 0;
+  *out = text;
+  *out_len = len;
+  return VALO_OK;
+}

@@ -1,5 +1,5 @@
 /* scene.c — owns scene construction: growable arrays, commit (bounds, area lights,
- * automatic camera framing), tessellated spheres and conductor presets. */
+ * automatic camera framing) and conductor presets. */
 #include "scene/scene.h"
 #include "core/error.h"
 #include "scene/envmap.h"
@@ -305,54 +305,6 @@ valo_status scene_commit(scene *s, valo_error *err) {
     s->cam_auto = 1;
     s->has_camera = 1;
   }
-  return VALO_OK;
-}
-
-/* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
- * are not shared between faces (flat arrays stay simple); normals are exact. */
-valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, int smooth, uint32_t mat, valo_error *err) {
-  if (subdiv < 0 || subdiv > 7) return err_set(err, VALO_ERR_INVALID, "%s: sphere subdivisions must be 0..7", s->path);
-  if (!(r > 0) || !isfinite(r)) return err_set(err, VALO_ERR_INVALID, "%s: sphere radius must be positive", s->path);
-  const float t = (1.0f + sqrtf(5.0f)) / 2.0f;
-  vec3 iv[12] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-  uint32_t nf = 20u << (2 * subdiv);
-  vec3 *tris = malloc((size_t)nf * 3 * sizeof(vec3)), *tmp = malloc((size_t)nf * 3 * sizeof(vec3));
-  if (!tris || !tmp || scene_reserve(s, nf * 3, nf)) { free(tris); free(tmp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  for (int i = 0; i < 20; i++)
-    for (int k = 0; k < 3; k++) tris[3 * i + k] = v3_norm(iv[f[i][k]]);
-  uint32_t n = 20;
-  for (int d = 0; d < subdiv; d++) {
-    for (uint32_t i = 0; i < n; i++) {
-      vec3 a = tris[3 * i], b = tris[3 * i + 1], cc = tris[3 * i + 2];
-      vec3 ab = v3_norm(v3_add(a, b)), bc = v3_norm(v3_add(b, cc)), ca = v3_norm(v3_add(cc, a));
-      vec3 *o = &tmp[12 * i];
-      o[0] = a; o[1] = ab; o[2] = ca; o[3] = ab; o[4] = b; o[5] = bc;
-      o[6] = ca; o[7] = bc; o[8] = cc; o[9] = ab; o[10] = bc; o[11] = ca;
-    }
-    vec3 *sw = tris; tris = tmp; tmp = sw;
-    n *= 4;
-  }
-  for (uint32_t i = 0; i < n; i++) {
-    uint32_t base = s->nverts;
-    for (int k = 0; k < 3; k++) {
-      int kk = flip ? 2 - k : k;
-      vec3 u = tris[3 * i + kk];
-      s->pos[base + k] = v3_add(c, v3_scale(u, r));
-      s->nrm[base + k] = flip ? v3_neg(u) : u;
-      s->uv[2 * (base + k)] = 0.5f + atan2f(u.z, u.x) / (2 * PI_F);
-      s->uv[2 * (base + k) + 1] = acosf(clampf(u.y, -1, 1)) / PI_F;
-    }
-    s->nverts += 3;
-    uint32_t ti = s->ntris++;
-    s->idx[3 * ti] = base; s->idx[3 * ti + 1] = base + 1; s->idx[3 * ti + 2] = base + 2;
-    s->tri_mat[ti] = mat;
-    s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS);
-  }
-  free(tris); free(tmp);
   return VALO_OK;
 }
 

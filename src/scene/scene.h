@@ -210,6 +210,12 @@ camera scene_camera_at(const scene *s, const camera *still, float f);
  * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,
                              int smooth, uint32_t mat, valo_error *err);
+/* Mitsuba's unit shapes, flat-shaded: the rectangle [-1, 1]^2 at z = 0 facing +z, the
+ * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments);
+ * placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps the front side);
+ * flip: facing the other way. */
+typedef enum { PRIM_RECTANGLE, PRIM_CUBE, PRIM_DISK } primitive_kind;
+valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, uint32_t mat, valo_error *err);
 /* Conductor presets: 0 on success. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
 #endif

@@ -1,0 +1,45 @@
+# mitsuba-shared-xml.py — Mitsuba 3's renders of the Mitsuba scene files in ../shared/scenes
+# that valo reads directly (valo render scene.xml), for tests/test_mitsuba.c: each is
+# rendered from its own XML file with the <default> values below (Mitsuba's -D), the
+# integrator replaced by path (the files name a path-guiding plugin neither renderer has),
+# and written to tests/data/mitsuba-xml/NAME-mitsuba.exr (half float). Optional tooling:
+# the EXRs are committed; valo builds, renders and tests without Python.
+#
+#   pip install mitsuba numpy
+#   DRJIT_LIBLLVM_PATH=~/.rustup/toolchains/stable-x86_64-unknown-linux-gnu/lib/libLLVM.so.22.1-rust-1.95.0-stable \
+#   python3 scripts/mitsuba-shared-xml.py [--spp 8192] [--only veach-mis]
+import argparse, os
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OUT = os.path.join(ROOT, "tests", "data", "mitsuba-xml")
+# name: (scene file under ../shared/scenes, its defaults); tests/test_mitsuba.c passes the
+# same values with --define.
+SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "path", "resx": "320", "resy": "180"})}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--spp", type=int, default=8192)
+    ap.add_argument("--only", default="")
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--shared", default=os.path.join(ROOT, "..", "shared"))
+    a = ap.parse_args()
+    import mitsuba as mi
+    mi.set_variant(a.variant)
+    os.makedirs(OUT, exist_ok=True)
+    for name, (path, defs) in SCENES.items():
+        if a.only and a.only != name:
+            continue
+        scene = mi.load_file(os.path.join(a.shared, "scenes", path), **defs)
+        img = None
+        passes = max(1, a.spp // 4096)
+        for k in range(passes):
+            part = mi.render(scene, seed=11 + k, spp=min(a.spp, 4096))
+            img = part if img is None else img + part
+        out = os.path.join(OUT, name + "-mitsuba.exr")
+        mi.Bitmap(img / passes).convert(component_format=mi.Struct.Type.Float16).write(out)
+        print("wrote %s (%d spp, mitsuba %s)" % (out, passes * min(a.spp, 4096), mi.__version__), flush=True)
+
+
+if __name__ == "__main__":
+    main()

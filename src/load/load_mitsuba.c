@@ -1,0 +1,483 @@
+/* load_mitsuba.c — owns reading Mitsuba scene files (.xml, Mitsuba 3 and 0.6): the
+ * document's structure (defaults and $substitution, ids and refs, 0.6's camelCase
+ * names), and the sensor, film, sampler,
+ * integrator and shapes; load_mitsuba_props.c reads properties and transforms,
+ * load_mitsuba_plugins.c translates BSDFs, media and emitters.
+ * The result is a valo JSON scene tree read by load_json_tree (docs/scene-format.md,
+ * "Mitsuba scenes", lists what is read and how). */
+#include "load/load.h"
+#include "load/load_json_internal.h"
+#include "load/mitsuba_internal.h"
+#include "core/error.h"
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- sensor, film, sampler, integrator ---- */
+
+static valo_status put_num(mctx *c, cJSON *o, const char *key, double v) {
+  if (!cJSON_AddNumberToObject(o, key, v)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  return VALO_OK;
+}
+static cJSON *put_obj(cJSON *o, const char *key) {
+  cJSON *x = cJSON_GetObjectItemCaseSensitive(o, key);
+  return x ? x : cJSON_AddObjectToObject(o, key);
+}
+static cJSON *vec_json(double x, double y, double z) { return cJSON_CreateDoubleArray((double[]){x, y, z}, 3); }
+
+static valo_status read_film(mctx *c, xml_node *film, int *w, int *h) {
+  *w = 768; *h = 576; /* Mitsuba's defaults */
+  cJSON *f = put_obj(c->out, "film");
+  if (!f) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  const char *rf = "gaussian";
+  double radius = 2;
+  if (film) {
+    const char *type = xml_attr_get(film, "type");
+    if (type && strcmp(type, "hdrfilm") && strcmp(type, "specfilm") && strcmp(type, "ldrfilm"))
+      mi_warn(c, film, "read as an hdrfilm");
+    TRY(mi_int(c, film, "width", w));
+    TRY(mi_int(c, film, "height", h));
+    if (*w < 1 || *h < 1 || *w > 16384 || *h > 16384) return mi_bad(c, film, "width and height must be 1 to 16384");
+    static const char *const crop[4][2] = {{"crop_offset_x", "crop_x"}, {"crop_offset_y", "crop_y"}, {"crop_width", "crop_width"}, {"crop_height", "crop_height"}};
+    for (int i = 0; i < 4; i++) {
+      int v = -1;
+      TRY(mi_int(c, film, crop[i][0], &v));
+      if (v >= 0) TRY(put_num(c, f, crop[i][1], v));
+    }
+    /* What valo writes is chosen on its command line: the film's file settings are not read. */
+    static const char *const quiet[] = {"file_format", "pixel_format", "component_format", "banner", "high_quality_edges", "sample_border", NULL};
+    for (int i = 0; quiet[i]; i++) (void)mi_prop(c, film, quiet[i]);
+    xml_node *r = mi_child(c, film, "rfilter", 0);
+    if (r) {
+      const char *t = xml_attr_get(r, "type");
+      if (t && (!strcmp(t, "box") || !strcmp(t, "tent") || !strcmp(t, "gaussian"))) {
+        rf = t;
+        radius = !strcmp(t, "box") ? 0.5 : !strcmp(t, "tent") ? 1 : 2;
+        if (!strcmp(t, "gaussian")) {
+          double sd = 0.5;
+          TRY(mi_float(c, r, "stddev", &sd));
+          radius = 4 * sd; /* valo's Gaussian has standard deviation radius / 4 */
+        } else {
+          TRY(mi_float(c, r, "radius", &radius));
+        }
+        if (!(radius >= 0.1 && radius <= 16)) return mi_bad(c, r, "valo's filter radius is 0.1 to 16 pixels");
+        mi_warn_unused(c, r);
+      } else {
+        mi_warn(c, r, "valo has no such filter (box, tent, gaussian): it uses Mitsuba's default, a Gaussian of standard deviation 0.5");
+      }
+    }
+    mi_warn_unused(c, film);
+  }
+  TRY(put_num(c, f, "width", *w));
+  TRY(put_num(c, f, "height", *h));
+  if (!cJSON_AddStringToObject(f, "filter", rf)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  return put_num(c, f, "filter_radius", radius);
+}
+
+static valo_status read_sensor(mctx *c, xml_node *s) {
+  const char *type = xml_attr_get(s, "type");
+  int persp = type && (!strcmp(type, "perspective") || !strcmp(type, "thinlens"));
+  int ortho = type && (!strcmp(type, "orthographic") || !strcmp(type, "telecentric"));
+  if (!persp && !ortho) return mi_bad(c, s, "valo reads perspective, thinlens and orthographic sensors");
+  int w, h;
+  TRY(read_film(c, mi_child(c, s, "film", 0), &w, &h));
+  xml_node *smp = mi_child(c, s, "sampler", 0);
+  cJSON *render = put_obj(c->out, "render");
+  if (!render) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  if (smp) {
+    int spp = -1, seed = -1;
+    TRY(mi_int(c, smp, "sample_count", &spp));
+    TRY(mi_int(c, smp, "seed", &seed));
+    if (spp > 0) TRY(put_num(c, render, "spp", spp));
+    if (seed >= 0) TRY(put_num(c, render, "seed", seed));
+    const char *st = xml_attr_get(smp, "type");
+    if (st && !strcmp(st, "independent") && !cJSON_AddStringToObject(render, "sampler", "independent"))
+      return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    mi_warn_unused(c, smp);
+  }
+  double m[16];
+  TRY(mi_transform(c, s, "to_world", m, NULL));
+  cJSON *cam = put_obj(c->out, "camera");
+  if (!cam) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  /* Mitsuba's camera looks down its +z with +y up; its +x is the image's left. */
+  double pos[3] = {m[3], m[7], m[11]}, fwd[3] = {m[2], m[6], m[10]}, up[3] = {m[1], m[5], m[9]}, lft[3] = {m[0], m[4], m[8]};
+  double fl = sqrt(fwd[0] * fwd[0] + fwd[1] * fwd[1] + fwd[2] * fwd[2]), ul = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+  if (!(fl > 0) || !(ul > 0)) return mi_bad(c, s, "to_world flattens the camera");
+  double det = lft[0] * (up[1] * fwd[2] - up[2] * fwd[1]) - lft[1] * (up[0] * fwd[2] - up[2] * fwd[0]) + lft[2] * (up[0] * fwd[1] - up[1] * fwd[0]);
+  if (det < 0) mi_warn(c, s, "to_world mirrors the camera; valo's image is not mirrored");
+  cJSON_AddItemToObject(cam, "position", vec_json(pos[0], pos[1], pos[2]));
+  cJSON_AddItemToObject(cam, "look_at", vec_json(pos[0] + fwd[0] / fl, pos[1] + fwd[1] / fl, pos[2] + fwd[2] / fl));
+  cJSON_AddItemToObject(cam, "up", vec_json(up[0] / ul, up[1] / ul, up[2] / ul));
+  double aspect = (double)w / h;
+  if (ortho) {
+    /* Mitsuba's orthographic camera sees x in [-1, 1] and y in [-1/aspect, 1/aspect] of its space. */
+    if (!cJSON_AddStringToObject(cam, "type", "orthographic")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    TRY(put_num(c, cam, "height", 2 * ul / aspect));
+  } else {
+    double fov = -1;
+    TRY(mi_float(c, s, "fov", &fov));
+    if (fov < 0) {
+      if (mi_prop(c, s, "focal_length")) return mi_bad(c, s, "give the field of view as <float name=\"fov\">; valo does not read focal_length");
+      return mi_bad(c, s, "needs <float name=\"fov\">");
+    }
+    if (!(fov > 0 && fov < 180)) return mi_bad(c, s, "fov must be in (0, 180) degrees");
+    const char *axis = "x";
+    TRY(mi_string(c, s, "fov_axis", &axis));
+    double t = tan(fov * M_PI / 360), scale; /* tan(vertical / 2) = t * scale */
+    if (!strcmp(axis, "x")) scale = 1 / aspect;
+    else if (!strcmp(axis, "y")) scale = 1;
+    else if (!strcmp(axis, "diagonal")) scale = 1 / sqrt(aspect * aspect + 1);
+    else if (!strcmp(axis, "smaller")) scale = aspect < 1 ? 1 / aspect : 1;
+    else if (!strcmp(axis, "larger")) scale = aspect > 1 ? 1 / aspect : 1;
+    else return mi_bad(c, s, "fov_axis must be x, y, diagonal, smaller or larger");
+    TRY(put_num(c, cam, "fov", 360 / M_PI * atan(t * scale)));
+  }
+  double ar = 0, fd = -1;
+  TRY(mi_float(c, s, "aperture_radius", &ar));
+  TRY(mi_float(c, s, "focus_distance", &fd));
+  if (ar > 0) TRY(put_num(c, cam, "aperture_radius", ar));
+  if (fd > 0) TRY(put_num(c, cam, "focus_distance", fd));
+  (void)mi_prop(c, s, "near_clip");
+  (void)mi_prop(c, s, "far_clip");
+  xml_node *med = mi_child(c, s, "medium", 0);
+  if (med) {
+    char name[96];
+    TRY(mi_medium(c, med, name, sizeof name));
+    if (!cJSON_AddStringToObject(cam, "medium", name)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  }
+  mi_warn_unused(c, s);
+  return VALO_OK;
+}
+
+static valo_status read_integrator(mctx *c, xml_node *n) {
+  const char *type = xml_attr_get(n, "type");
+  cJSON *render = put_obj(c->out, "render");
+  if (!render) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  int depth = -1, direct = type && !strcmp(type, "direct");
+  if (type && (!strcmp(type, "path") || !strcmp(type, "volpath") || !strcmp(type, "volpathmis") || !strcmp(type, "prb") || direct)) {
+    TRY(mi_int(c, n, "max_depth", &depth));
+    (void)mi_prop(c, n, "rr_depth");
+    if (direct) { depth = 2; (void)mi_prop(c, n, "emitter_samples"); (void)mi_prop(c, n, "bsdf_samples"); }
+  } else {
+    mi_warn(c, n, "not an integrator valo has: rendered by path (valo render --integrator chooses another)");
+    (void)mi_int(c, n, "max_depth", &depth);
+    for (xml_node *k = n->child; k; k = k->next) k->used = 1;
+  }
+  /* Mitsuba counts the camera ray as a depth (max_depth 2 = direct light); valo counts bounces. */
+  if (depth == 0) mi_warn(c, n, "max_depth 0 renders nothing in Mitsuba; valo renders the emitters seen directly");
+  if (!cJSON_AddStringToObject(render, "integrator", "path")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  if (depth >= 0) TRY(put_num(c, render, "max_depth", depth > 0 ? depth - 1 : 0));
+  mi_warn_unused(c, n);
+  return VALO_OK;
+}
+
+/* ---- shapes ---- */
+
+static valo_status matrix_json(mctx *c, const double m[16], cJSON *shape) {
+  cJSON *t = cJSON_AddObjectToObject(shape, "transform");
+  cJSON *a = t ? cJSON_CreateDoubleArray(m, 16) : NULL;
+  if (!a) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  cJSON_AddItemToObject(t, "matrix", a);
+  return VALO_OK;
+}
+
+static valo_status read_shape(mctx *c, xml_node *n) {
+  const char *type = xml_attr_get(n, "type");
+  if (!type) return mi_bad(c, n, "needs a type");
+  cJSON *sh = cJSON_CreateObject();
+  if (!sh) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  cJSON_AddItemToArray(c->shapes, sh);
+  int *l = realloc(c->shape_line, (size_t)(c->nshape_line + 1) * sizeof *l);
+  if (!l) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->shape_line = l;
+  l[c->nshape_line++] = n->line;
+  double m[16];
+  int has_xf;
+  TRY(mi_transform(c, n, "to_world", m, &has_xf));
+  int flip = 0;
+  TRY(mi_bool(c, n, "flip_normals", &flip));
+  if (!strcmp(type, "obj") || !strcmp(type, "ply")) {
+    const char *file = NULL;
+    TRY(mi_string(c, n, "filename", &file));
+    if (!file) return mi_bad(c, n, "needs <string name=\"filename\">");
+    if (flip) return mi_bad(c, n, "flip_normals is not read for meshes (the file's winding sets the front side)");
+    int fn = 0;
+    TRY(mi_bool(c, n, "face_normals", &fn));
+    if (fn) cJSON_AddTrueToObject(sh, "face_normals");
+    (void)mi_prop(c, n, "flip_tex_coords"); /* Mitsuba's default flip undoes OBJ's bottom-up v, as valo reads it */
+    cJSON_AddStringToObject(sh, "file", file);
+    if (has_xf) TRY(matrix_json(c, m, sh));
+  } else if (!strcmp(type, "sphere")) {
+    vec3 ctr = v3(0, 0, 0);
+    double r = 1;
+    TRY(mi_point(c, n, "center", &ctr));
+    TRY(mi_float(c, n, "radius", &r));
+    if (has_xf) {
+      /* A sphere moved and scaled evenly stays a sphere; anything else is not read. */
+      double sx = sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]), sy = sqrt(m[1] * m[1] + m[5] * m[5] + m[9] * m[9]),
+             sz = sqrt(m[2] * m[2] + m[6] * m[6] + m[10] * m[10]);
+      double d01 = m[0] * m[1] + m[4] * m[5] + m[8] * m[9], d02 = m[0] * m[2] + m[4] * m[6] + m[8] * m[10], d12 = m[1] * m[2] + m[5] * m[6] + m[9] * m[10];
+      if (fabs(sx - sy) > 1e-5 * sx || fabs(sx - sz) > 1e-5 * sx || fabs(d01) + fabs(d02) + fabs(d12) > 1e-5 * sx * sx)
+        return mi_bad(c, n, "a sphere's to_world must move, turn and scale it evenly (valo has no ellipsoids)");
+      vec3 p = ctr;
+      ctr = v3((float)(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]), (float)(m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7]),
+               (float)(m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]));
+      r *= sx;
+    }
+    cJSON_AddStringToObject(sh, "type", "sphere");
+    cJSON_AddItemToObject(sh, "center", vec_json(ctr.x, ctr.y, ctr.z));
+    TRY(put_num(c, sh, "radius", r));
+    if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
+  } else if (!strcmp(type, "rectangle") || !strcmp(type, "cube") || !strcmp(type, "disk")) {
+    cJSON_AddStringToObject(sh, "type", type);
+    if (has_xf) TRY(matrix_json(c, m, sh));
+    if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
+  } else if (!strcmp(type, "serialized")) {
+    return mi_bad(c, n, "Mitsuba's serialized meshes are not read; convert them to PLY or OBJ (Mitsuba's mesh export, or "
+                        "Blender's Mitsuba add-on)");
+  } else {
+    return mi_bad(c, n, "valo reads obj, ply, sphere, rectangle, cube and disk shapes");
+  }
+  /* Material: the shape's BSDF (or Mitsuba's default), with its area emitter's radiance. */
+  xml_node *b = mi_child(c, n, "bsdf", 0);
+  xml_node *e = mi_child(c, n, "emitter", 0);
+  cJSON *emit = NULL;
+  if (e) {
+    const char *et = xml_attr_get(e, "type");
+    if (!et || strcmp(et, "area")) return mi_bad(c, e, "a shape's emitter must be an area emitter");
+    TRY(mi_color(c, e, "radiance", 0, &emit));
+    if (!emit && !(emit = vec_json(1, 1, 1))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    mi_warn_unused(c, e);
+  }
+  char name[96];
+  valo_status st = mi_material(c, b, emit, n, name, sizeof name);
+  cJSON_Delete(emit);
+  if (st) return st;
+  cJSON_AddStringToObject(sh, "material", name);
+  for (int side = 0; side < 2; side++) {
+    const char *key = side ? "exterior" : "interior";
+    xml_node *med = NULL;
+    for (xml_node *k = n->child; k && !med; k = k->next) {
+      const char *nm = xml_attr_get(k, "name");
+      if (!nm || strcmp(nm, key)) continue;
+      k->used = 1;
+      med = !strcmp(k->name, "ref") ? mi_find_id(c, xml_attr_get(k, "id") ? xml_attr_get(k, "id") : "") : k;
+      if (!med) return mi_bad(c, k, "refers to an id that no element has");
+      if (strcmp(med->name, "medium")) return mi_bad(c, k, "must be a <medium>");
+    }
+    if (!med) continue;
+    TRY(mi_medium(c, med, name, sizeof name));
+    cJSON_AddStringToObject(sh, key, name);
+  }
+  mi_warn_unused(c, n);
+  return VALO_OK;
+}
+
+/* ---- the document ---- */
+
+/* Mitsuba 0.6 names: camelCase becomes snake_case ("toWorld" -> "to_world", "intIOR" -> "int_ior"). */
+static void upgrade_names(xml_node *n) {
+  for (; n; n = n->next) {
+    for (int i = 0; i < n->nattrs; i++) {
+      if (strcmp(n->attrs[i].name, "name")) continue;
+      const char *v = n->attrs[i].value;
+      char *o = malloc(2 * strlen(v) + 1), *q = o;
+      if (!o) continue;
+      for (const char *p = v; *p; p++) {
+        if (isupper((unsigned char)*p) && p > v && (islower((unsigned char)p[-1]) || isdigit((unsigned char)p[-1]))) *q++ = '_';
+        *q++ = (char)tolower((unsigned char)*p);
+      }
+      *q = 0;
+      free(n->attrs[i].value);
+      n->attrs[i].value = o;
+    }
+    if (!strcmp(n->name, "lookAt")) { free(n->name); n->name = strdup("lookat"); }
+    upgrade_names(n->child);
+  }
+}
+
+/* The command line's NAME=VALUE for name (length n), or NULL: *len gets the value's length. */
+static const char *define_of(const char *defines, const char *name, size_t n, size_t *len) {
+  for (const char *p = defines; p && *p;) {
+    while (*p == ' ') p++;
+    const char *eq = strchr(p, '='), *end = strchr(p, ' ');
+    if (!end) end = p + strlen(p);
+    if (eq && eq < end && (size_t)(eq - p) == n && !strncmp(p, name, n)) { *len = (size_t)(end - eq - 1); return eq + 1; }
+    p = end;
+  }
+  return NULL;
+}
+
+typedef struct { const char *name, *value; } mdef;
+
+/* Replaces $name in every attribute with its <default>'s value. */
+static valo_status substitute(mctx *c, xml_node *n, const mdef *d, int nd) {
+  for (; n; n = n->next) {
+    for (int i = 0; i < n->nattrs; i++) {
+      char *v = n->attrs[i].value;
+      if (!strchr(v, '$')) continue;
+      size_t cap = strlen(v) + 1, len = 0;
+      char *o = malloc(cap);
+      if (!o) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+      for (const char *p = v; *p;) {
+        const char *add = p;
+        size_t alen = 1;
+        if (*p == '$') {
+          const char *e = p + 1;
+          while (isalnum((unsigned char)*e) || *e == '_') e++;
+          int k;
+          for (k = 0; k < nd; k++)
+            if (strlen(d[k].name) == (size_t)(e - p - 1) && !strncmp(d[k].name, p + 1, (size_t)(e - p - 1))) break;
+          if (k < nd) {
+            add = d[k].value;
+            alen = strlen(add);
+          } else if (!(add = define_of(c->defines, p + 1, (size_t)(e - p - 1), &alen))) {
+            free(o);
+            int nl = (int)(e - p - 1 > 60 ? 60 : e - p - 1);
+            return mi_bad(c, n, "$%.*s has no <default name=\"%.*s\"> (or --define %.*s=VALUE)", nl, p + 1, nl, p + 1, nl, p + 1);
+          }
+          p = e;
+        } else {
+          p++;
+        }
+        if (len + alen + 1 > cap) {
+          cap = 2 * (len + alen + 1);
+          if (cap > (1u << 20)) { free(o); return mi_bad(c, n, "an attribute grows past 1 MiB by substitution"); }
+          char *t = realloc(o, cap);
+          if (!t) { free(o); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+          o = t;
+        }
+        memcpy(o + len, add, alen);
+        len += alen;
+      }
+      o[len] = 0;
+      free(v);
+      n->attrs[i].value = o;
+    }
+    TRY(substitute(c, n->child, d, nd));
+  }
+  return VALO_OK;
+}
+
+/* Every <ref> names an element that exists. */
+static valo_status check_refs(mctx *c, xml_node *n) {
+  for (; n; n = n->next) {
+    if (!strcmp(n->name, "ref")) {
+      const char *id = xml_attr_get(n, "id");
+      if (!id) return mi_bad(c, n, "needs an id");
+      if (!mi_find_id(c, id)) return mi_bad(c, n, "refers to an id that no element has");
+    }
+    TRY(check_refs(c, n->child));
+  }
+  return VALO_OK;
+}
+
+static valo_status read_document(mctx *c) {
+  xml_node *r = c->root;
+  if (strcmp(r->name, "scene")) return mi_bad(c, r, "the root element of a Mitsuba scene is <scene>");
+  const char *ver = xml_attr_get(r, "version");
+  if (ver && atoi(ver) < 2) upgrade_names(r->child);
+  mdef defs[256];
+  int nd = 0;
+  for (xml_node *k = r->child; k; k = k->next) {
+    if (strcmp(k->name, "default")) continue;
+    const char *nm = xml_attr_get(k, "name"), *v = xml_attr_get(k, "value");
+    if (!nm || !v) return mi_bad(c, k, "needs name and value");
+    if (nd == 256) return mi_bad(c, k, "more than 256 defaults");
+    size_t dl;
+    const char *dv = define_of(c->defines, nm, strlen(nm), &dl);
+    if (dv) {
+      /* the command line's value replaces the file's (kept in the node, freed with it) */
+      char *cp = malloc(dl + 1);
+      if (!cp) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+      memcpy(cp, dv, dl);
+      cp[dl] = 0;
+      for (int i = 0; i < k->nattrs; i++)
+        if (!strcmp(k->attrs[i].name, "value")) { free(k->attrs[i].value); k->attrs[i].value = cp; v = cp; }
+    }
+    defs[nd].name = nm; defs[nd].value = v;
+    nd++;
+    k->used = 1;
+  }
+  /* The values point into <default> nodes, which substitution does not rewrite ($ in a
+   * default's own value is not expanded, as in Mitsuba). */
+  for (xml_node *k = r->child; k; k = k->next)
+    if (strcmp(k->name, "default")) TRY(substitute(c, k, defs, nd));
+  TRY(check_refs(c, r->child));
+  int sensors = 0;
+  for (xml_node *k = r->child; k; k = k->next) {
+    if (!strcmp(k->name, "default")) continue;
+    if (!strcmp(k->name, "sensor")) {
+      if (sensors++) { mi_warn(c, k, "valo renders the first sensor; this one is not read"); continue; }
+      k->used = 1;
+      TRY(read_sensor(c, k));
+    } else if (!strcmp(k->name, "integrator")) {
+      k->used = 1;
+      TRY(read_integrator(c, k));
+    } else if (!strcmp(k->name, "shape")) {
+      k->used = 1;
+      TRY(read_shape(c, k));
+    } else if (!strcmp(k->name, "emitter")) {
+      k->used = 1;
+      TRY(mi_emitter(c, k));
+    } else if (!strcmp(k->name, "bsdf") || !strcmp(k->name, "texture") || !strcmp(k->name, "medium") || !strcmp(k->name, "phase") ||
+               !strcmp(k->name, "volume")) {
+      continue; /* read where a shape or sensor refers to it */
+    } else if (!strcmp(k->name, "include")) {
+      return mi_bad(c, k, "<include> is not read: merge the included file into this one");
+    } else {
+      return mi_bad(c, k, "valo does not read this element here (sensor, integrator, shape, emitter, bsdf, texture, medium, default)");
+    }
+  }
+  if (!sensors) {
+    /* Mitsuba's default sensor is a perspective camera at the origin looking down +z. */
+    return mi_bad(c, r, "has no <sensor>: valo needs the camera given");
+  }
+  return VALO_OK;
+}
+
+/* Adds the XML line of the shape or light the JSON stage was reading to its message. */
+static void add_lines(mctx *c, const int at[2]) {
+  int *lines[2] = {c->shape_line, c->light_line}, nl[2] = {c->nshape_line, c->nlight_line};
+  for (int j = 0; j < 2; j++) {
+    int i = at[j];
+    if (i < 0 || i >= nl[j]) continue;
+    size_t len = strlen(c->err->message);
+    snprintf(c->err->message + len, sizeof c->err->message - len, " (the %s at line %d)", j ? "<emitter>" : "<shape>", lines[j][i]);
+    return;
+  }
+}
+
+valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *settings, valo_error *err) {
+  char *text;
+  size_t len;
+  TRY(scene_text_read(path, &text, &len, err));
+  mctx c = {.path = path, .err = err, .defines = defines};
+  valo_status st = xml_parse(path, text, len, &c.root, err);
+  free(text);
+  if (st) return st;
+  c.out = cJSON_CreateObject();
+  if (c.out) {
+    c.materials = cJSON_AddObjectToObject(c.out, "materials");
+    c.media = cJSON_AddObjectToObject(c.out, "media");
+    c.shapes = cJSON_AddArrayToObject(c.out, "shapes");
+    c.lights = cJSON_AddArrayToObject(c.out, "lights");
+  }
+  if (!c.out || !c.materials || !c.media || !c.shapes || !c.lights) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
+  if (!st) st = read_document(&c);
+  if (!st) {
+    int at[2] = {-1, -1};
+    st = load_json_tree(s, path, c.out, settings, at, err);
+    if (st) add_lines(&c, at);
+  }
+  cJSON_Delete(c.out);
+  xml_free(c.root);
+  free(c.shape_line);
+  free(c.light_line);
+  free(c.bsdf_names);
+  return st;
+}

@@ -1,0 +1,459 @@
+/* load_mitsuba_plugins.c — owns the translation of Mitsuba's BSDFs, media and emitters
+ * into valo's materials, media, lights and environment (docs/scene-format.md, "Mitsuba
+ * scenes", has the table); what has no valo equivalent is an error naming the line, and
+ * an approximation is a warning that says what it gives up. */
+#include "load/mitsuba_internal.h"
+#include "load/load_json_internal.h"
+#include "core/error.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NOMEM err_set(c->err, VALO_ERR_NOMEM, "out of memory")
+
+/* Mitsuba's named indices of refraction (its documentation's table of common materials). */
+static int named_ior(const char *s, double *v) {
+  static const struct { const char *n; double v; } t[] = {
+      {"vacuum", 1.0},       {"helium", 1.00004},   {"hydrogen", 1.00013},       {"air", 1.00028},
+      {"carbon dioxide", 1.00045}, {"water", 1.3330}, {"acetone", 1.36},         {"ethanol", 1.361},
+      {"carbon tetrachloride", 1.461}, {"glycerol", 1.4729}, {"benzene", 1.501}, {"silicone oil", 1.52045},
+      {"bromine", 1.661},    {"water ice", 1.31},   {"fused quartz", 1.458},     {"pyrex", 1.470},
+      {"acrylic glass", 1.49}, {"polypropylene", 1.49}, {"bk7", 1.5046},          {"sodium chloride", 1.544},
+      {"amber", 1.55},       {"pet", 1.5750},       {"diamond", 2.419}};
+  for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+    if (!strcmp(s, t[i].n)) { *v = t[i].v; return 1; }
+  return 0;
+}
+
+/* An index: a number or a name (int_ior, ext_ior). */
+static valo_status ior_prop(mctx *c, xml_node *b, const char *name, double *v) {
+  xml_node *k = mi_prop(c, b, name);
+  if (!k) return VALO_OK;
+  const char *val = xml_attr_get(k, "value");
+  if (!val) return mi_bad(c, k, "needs a value");
+  if (!strcmp(k->name, "string")) {
+    if (!named_ior(val, v)) return mi_bad(c, k, "unknown material name for an index of refraction (give the number)");
+    return VALO_OK;
+  }
+  return mi_float(c, b, name, v);
+}
+
+static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m) {
+  double a = def_alpha, au = -1, av = -1;
+  TRY(mi_float(c, b, "alpha", &a));
+  TRY(mi_float(c, b, "alpha_u", &au));
+  TRY(mi_float(c, b, "alpha_v", &av));
+  if (au >= 0 || av >= 0) {
+    if (au != av) return mi_bad(c, b, "valo's microfacets are isotropic: alpha_u and alpha_v must be equal");
+    a = au;
+  }
+  if (mi_prop(c, b, "alpha") && !strcmp(mi_prop(c, b, "alpha")->name, "texture")) return mi_bad(c, b, "a roughness texture is not read");
+  if (!(a >= 0 && a <= 1)) return mi_bad(c, b, "alpha must be in [0, 1]");
+  const char *dist = "beckmann";
+  TRY(mi_string(c, b, "distribution", &dist));
+  if (strcmp(dist, "ggx") && strcmp(dist, "beckmann")) return mi_bad(c, b, "distribution must be beckmann or ggx");
+  const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
+  if (t && !strcmp(t, "pbr")) {
+    if (strcmp(dist, "ggx")) mi_warn(c, b, "rendered with GGX (valo's pbr material): this %s distribution of the same alpha is not", dist);
+  } else if (!cJSON_AddStringToObject(m, "distribution", dist)) {
+    return NOMEM;
+  }
+  (void)mi_prop(c, b, "sample_visible"); /* the sampling strategy changes the noise, not the image */
+  if (!cJSON_AddNumberToObject(m, "roughness", sqrt(a))) return NOMEM; /* valo's alpha = roughness^2 */
+  return VALO_OK;
+}
+
+static valo_status set_color(mctx *c, xml_node *b, const char *mname, cJSON *m, const char *key, int rgb_only) {
+  cJSON *v;
+  TRY(mi_color(c, b, mname, rgb_only, &v));
+  if (v) cJSON_AddItemToObject(m, key, v);
+  return VALO_OK;
+}
+
+/* The specular tint Mitsuba allows on its smooth and rough dielectrics: valo has none. */
+static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
+  cJSON *v;
+  TRY(mi_color(c, b, name, 1, &v));
+  if (!v) return VALO_OK;
+  int one = 1;
+  for (int i = 0; i < 3; i++) one &= cJSON_GetArrayItem(v, i)->valuedouble == 1;
+  cJSON_Delete(v);
+  if (!one) mi_warn(c, b, "%s is not read: valo's glass reflects and transmits what Fresnel gives", name);
+  return VALO_OK;
+}
+
+static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m);
+static cJSON *vec3_json(double x, double y, double z) { return cJSON_CreateDoubleArray((double[]){x, y, z}, 3); }
+
+static valo_status wrapped(mctx *c, xml_node *b, cJSON *m, const char *what) {
+  xml_node *in = mi_child(c, b, "bsdf", 0);
+  if (!in) return mi_bad(c, b, "needs the %s BSDF inside it", what);
+  return translate_bsdf(c, in, m);
+}
+
+static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
+  const char *type = xml_attr_get(b, "type");
+  if (!type) return mi_bad(c, b, "needs a type");
+  b->used = 1;
+#define TYPE(t) cJSON_AddStringToObject(m, "type", t)
+  if (!strcmp(type, "twosided")) {
+    /* valo's surfaces scatter from both sides already. */
+    if (mi_child(c, b, "bsdf", 1)) mi_warn(c, b, "valo uses the first BSDF on both sides");
+    TRY(wrapped(c, b, m, "front"));
+  } else if (!strcmp(type, "normalmap") || !strcmp(type, "bumpmap")) {
+    int normal = type[0] == 'n';
+    xml_node *tex = NULL;
+    for (xml_node *k = b->child; k && !tex; k = k->next)
+      if (!strcmp(k->name, "texture") || (!strcmp(k->name, "ref") && xml_attr_get(k, "name"))) tex = k;
+    if (!tex) return mi_bad(c, b, "needs its map as a bitmap <texture>");
+    const char *tname = xml_attr_get(tex, "name");
+    cJSON *file;
+    if (tname) TRY(mi_color(c, b, tname, 0, &file));
+    else {
+      /* an unnamed texture child: name it for the reader */
+      return mi_bad(c, tex, "give the map texture a name (name=\"%s\")", normal ? "normalmap" : "bumpmap");
+    }
+    if (!cJSON_IsString(file)) { cJSON_Delete(file); return mi_bad(c, tex, "must be a bitmap texture (a file)"); }
+    double scale = 1;
+    valo_status st = VALO_OK;
+    if (!normal) st = mi_float(c, b, "scale", &scale);
+    if (!st) st = wrapped(c, b, m, normal ? "mapped" : "bumped");
+    if (st) { cJSON_Delete(file); return st; }
+    cJSON_AddItemToObject(m, normal ? "normal_map" : "bump_map", file);
+    if (!normal) cJSON_AddNumberToObject(m, "bump_scale", scale);
+  } else if (!strcmp(type, "diffuse")) {
+    TYPE("diffuse");
+    cJSON *v;
+    TRY(mi_color(c, b, "reflectance", 0, &v));
+    cJSON_AddItemToObject(m, "reflectance", v ? v : cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
+  } else if (!strcmp(type, "dielectric") || !strcmp(type, "roughdielectric") || !strcmp(type, "thindielectric")) {
+    double in = 1.5046, out = 1.00028; /* bk7 in air, Mitsuba's defaults */
+    TRY(ior_prop(c, b, "int_ior", &in));
+    TRY(ior_prop(c, b, "ext_ior", &out));
+    if (!(in > 0 && out > 0)) return mi_bad(c, b, "indices of refraction must be positive");
+    if (in < out) return mi_bad(c, b, "valo's glass is denser than outside (int_ior >= ext_ior): flip the shape's normals and swap them");
+    TYPE(type[0] == 't' ? "thindielectric" : "dielectric");
+    cJSON_AddNumberToObject(m, "ior", in / out);
+    if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
+    TRY(no_tint(c, b, "specular_reflectance"));
+    TRY(no_tint(c, b, "specular_transmittance"));
+  } else if (!strcmp(type, "conductor") || !strcmp(type, "roughconductor")) {
+    const char *mat = "none";
+    TRY(mi_string(c, b, "material", &mat));
+    cJSON *eta = NULL, *k = NULL;
+    TRY(mi_color(c, b, "eta", 1, &eta));
+    valo_status st = mi_color(c, b, "k", 1, &k);
+    if (st) { cJSON_Delete(eta); return st; }
+    if (eta || k) {
+      if (!eta || !k) { cJSON_Delete(eta); cJSON_Delete(k); return mi_bad(c, b, "give both eta and k"); }
+      TYPE("conductor");
+      cJSON_AddItemToObject(m, "eta", eta);
+      cJSON_AddItemToObject(m, "k", k);
+    } else if (!strcmp(mat, "none")) {
+      /* Mitsuba's "none": F = 1. Smooth, valo's mirror; rough, its pbr metal of base
+       * colour 1 (Schlick's F is then 1) with the same GGX, tinted by base_color. */
+      if (type[0] == 'r') {
+        TYPE("pbr");
+        cJSON_AddNumberToObject(m, "metallic", 1);
+        TRY(set_color(c, b, "specular_reflectance", m, "base_color", 1));
+        if (!cJSON_GetObjectItemCaseSensitive(m, "base_color")) cJSON_AddItemToObject(m, "base_color", vec3_json(1, 1, 1));
+        TRY(roughness_of(c, b, 0.1, m));
+        mi_warn_unused(c, b);
+        return VALO_OK;
+      }
+      TYPE("mirror");
+    } else if (!strcmp(mat, "Au") || !strcmp(mat, "Ag") || !strcmp(mat, "Cu") || !strcmp(mat, "Al")) {
+      TYPE("conductor");
+      cJSON_AddStringToObject(m, "preset", mat);
+    } else {
+      return mi_bad(c, b, "valo's conductor presets are Au, Ag, Cu and Al: give eta and k for \"%s\"", mat);
+    }
+    (void)mi_prop(c, b, "ext_eta");
+    TRY(set_color(c, b, "specular_reflectance", m, "reflectance", 1));
+    if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
+  } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
+    mi_warn(c, b, "valo has no plastic: approximated by its pbr (glTF) material with the same diffuse colour, a clear coat of "
+                  "index 1.5 and GGX roughness");
+    TYPE("pbr");
+    cJSON *v;
+    TRY(mi_color(c, b, "diffuse_reflectance", 0, &v));
+    cJSON_AddItemToObject(m, "base_color", v ? v : cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
+    cJSON_AddNumberToObject(m, "metallic", 0);
+    if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
+    else cJSON_AddNumberToObject(m, "roughness", 0);
+    for (const char *const *q = (const char *const[]){"int_ior", "ext_ior", "nonlinear", "specular_reflectance", NULL}; *q; q++)
+      (void)mi_prop(c, b, *q);
+  } else if (!strcmp(type, "principled")) {
+    mi_warn(c, b, "read as valo's pbr (glTF metallic-roughness) material: base_color, metallic and roughness only");
+    TYPE("pbr");
+    TRY(set_color(c, b, "base_color", m, "base_color", 0));
+    double met = 0, r = 0.5;
+    TRY(mi_float(c, b, "metallic", &met));
+    TRY(mi_float(c, b, "roughness", &r));
+    cJSON_AddNumberToObject(m, "metallic", met);
+    cJSON_AddNumberToObject(m, "roughness", r);
+  } else if (!strcmp(type, "phong")) {
+    TYPE("phong");
+    TRY(set_color(c, b, "diffuse_reflectance", m, "diffuse", 0));
+    TRY(set_color(c, b, "specular_reflectance", m, "specular", 0));
+    double e = 30;
+    TRY(mi_float(c, b, "exponent", &e));
+    cJSON_AddNumberToObject(m, "exponent", e);
+  } else if (!strcmp(type, "null")) {
+    TYPE("null");
+  } else {
+    return mi_bad(c, b, "valo has no such BSDF (diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, "
+                        "plastic, roughplastic, principled, phong, twosided, normalmap, bumpmap, null)");
+  }
+#undef TYPE
+  mi_warn_unused(c, b);
+  return VALO_OK;
+}
+
+static valo_status add_material(mctx *c, cJSON *m, const char *name) {
+  if (cJSON_GetObjectItemCaseSensitive(c->materials, name)) { cJSON_Delete(m); return VALO_OK; }
+  cJSON_AddItemToObject(c->materials, name, m);
+  return VALO_OK;
+}
+
+valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, char *name, size_t n) {
+  const char *id = b ? xml_attr_get(b, "id") : NULL;
+  if (b && id && !emit) {
+    for (int i = 0; i < c->nbsdf_names; i++)
+      if (!strcmp(c->bsdf_names[i].id, id)) { snprintf(name, n, "%s", c->bsdf_names[i].name); return VALO_OK; }
+  }
+  cJSON *m = cJSON_CreateObject();
+  if (!m) return NOMEM;
+  valo_status st = VALO_OK;
+  char base[64];
+  if (b) {
+    st = translate_bsdf(c, b, m);
+    if (id) snprintf(base, sizeof base, "%.60s", id);
+    else snprintf(base, sizeof base, "bsdf@line%d", b->line);
+  } else {
+    /* Mitsuba's default BSDF: diffuse, reflectance 0.5 */
+    cJSON_AddStringToObject(m, "type", "diffuse");
+    cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
+    snprintf(base, sizeof base, "mitsuba-default");
+  }
+  if (st) { cJSON_Delete(m); return st; }
+  if (emit) {
+    const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
+    if (t && !strcmp(t, "null")) {
+      /* valo's null surface carries nothing; an emitter on Mitsuba's null BSDF is a black
+       * diffuse light */
+      cJSON_DeleteItemFromObject(m, "type");
+      cJSON_AddStringToObject(m, "type", "diffuse");
+      cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){0, 0, 0}, 3));
+    }
+    cJSON_AddItemToObject(m, "emission", cJSON_Duplicate(emit, 1));
+    snprintf(name, n, "%s+area@line%d", base, at->line);
+  } else {
+    snprintf(name, n, "%s", base);
+  }
+  TRY(add_material(c, m, name));
+  if (b && id && !emit) {
+    void *q = realloc(c->bsdf_names, (size_t)(c->nbsdf_names + 1) * sizeof *c->bsdf_names);
+    if (!q) return NOMEM;
+    c->bsdf_names = q;
+    c->bsdf_names[c->nbsdf_names].id = id;
+    snprintf(c->bsdf_names[c->nbsdf_names].name, sizeof c->bsdf_names[0].name, "%s", name);
+    c->nbsdf_names++;
+  }
+  return VALO_OK;
+}
+
+/* ---- media ---- */
+
+static valo_status phase_g(mctx *c, xml_node *med, double *g) {
+  xml_node *p = mi_child(c, med, "phase", 0);
+  *g = 0;
+  if (!p) return VALO_OK;
+  const char *t = xml_attr_get(p, "type");
+  if (t && !strcmp(t, "hg")) TRY(mi_float(c, p, "g", g));
+  else if (!t || strcmp(t, "isotropic")) return mi_bad(c, p, "valo's phase functions are isotropic and hg");
+  if (!(*g > -1 && *g < 1)) return mi_bad(c, p, "g must be in (-1, 1)");
+  mi_warn_unused(c, p);
+  return VALO_OK;
+}
+
+/* A constant medium property: a colour, or a constvolume holding one. */
+static valo_status const_color(mctx *c, xml_node *med, const char *name, double def, double v[3]) {
+  xml_node *k = mi_prop(c, med, name);
+  v[0] = v[1] = v[2] = def;
+  if (!k) return VALO_OK;
+  xml_node *src = med;
+  const char *key = name;
+  if (!strcmp(k->name, "volume")) {
+    const char *t = xml_attr_get(k, "type");
+    if (!t || strcmp(t, "constvolume")) return mi_bad(c, k, "valo reads %s as a constant here", name);
+    src = k;
+    key = "value";
+  }
+  cJSON *col;
+  TRY(mi_color(c, src, key, 1, &col));
+  if (col) {
+    for (int i = 0; i < 3; i++) v[i] = cJSON_GetArrayItem(col, i)->valuedouble;
+    cJSON_Delete(col);
+  }
+  if (src != med) mi_warn_unused(c, src);
+  return VALO_OK;
+}
+
+valo_status mi_medium(mctx *c, xml_node *med, char *name, size_t n) {
+  const char *id = xml_attr_get(med, "id");
+  if (id) snprintf(name, n, "%.90s", id);
+  else snprintf(name, n, "medium@line%d", med->line);
+  if (cJSON_GetObjectItemCaseSensitive(c->media, name)) return VALO_OK;
+  med->used = 1;
+  const char *type = xml_attr_get(med, "type");
+  int het = type && !strcmp(type, "heterogeneous");
+  if (!het && (!type || strcmp(type, "homogeneous"))) return mi_bad(c, med, "valo reads homogeneous and heterogeneous media");
+  cJSON *o = cJSON_CreateObject();
+  if (!o) return NOMEM;
+  cJSON_AddItemToObject(c->media, name, o);
+  double g, scale = 1, albedo[3], st[3], sa[3], ss[3];
+  TRY(phase_g(c, med, &g));
+  TRY(mi_float(c, med, "scale", &scale));
+  xml_node *grid = NULL;
+  if (het) {
+    xml_node *k = mi_prop(c, med, "sigma_t");
+    if (!k) k = mi_prop(c, med, "density"); /* Mitsuba 0.6 */
+    if (k && !strcmp(k->name, "volume")) {
+      const char *t = xml_attr_get(k, "type");
+      if (!t || strcmp(t, "gridvolume")) return mi_bad(c, k, "valo reads a density grid from a gridvolume (.vol file)");
+      grid = k;
+    } else {
+      return mi_bad(c, med, "a heterogeneous medium needs sigma_t as a gridvolume");
+    }
+  }
+  TRY(const_color(c, med, "albedo", 0.75, albedo));
+  if (!grid) TRY(const_color(c, med, "sigma_t", 1, st));
+  else st[0] = st[1] = st[2] = 1;
+  if (mi_prop(c, med, "sigma_a") || mi_prop(c, med, "sigma_s")) {
+    /* Mitsuba 0.6: sigma_a and sigma_s */
+    TRY(const_color(c, med, "sigma_a", 0, sa));
+    TRY(const_color(c, med, "sigma_s", 0, ss));
+  } else {
+    for (int i = 0; i < 3; i++) { ss[i] = albedo[i] * st[i]; sa[i] = st[i] - ss[i]; }
+  }
+  for (int i = 0; i < 3; i++)
+    if (!(sa[i] >= 0 && ss[i] >= 0)) return mi_bad(c, med, "the coefficients must be positive (albedo in [0, 1])");
+  cJSON_AddStringToObject(o, "type", grid ? "grid" : "homogeneous");
+  cJSON_AddItemToObject(o, "sigma_a", cJSON_CreateDoubleArray(sa, 3));
+  cJSON_AddItemToObject(o, "sigma_s", cJSON_CreateDoubleArray(ss, 3));
+  cJSON_AddNumberToObject(o, "scale", scale);
+  cJSON_AddNumberToObject(o, "g", g);
+  if (grid) {
+    const char *file = NULL;
+    TRY(mi_string(c, grid, "filename", &file));
+    if (!file) return mi_bad(c, grid, "needs <string name=\"filename\">");
+    cJSON_AddStringToObject(o, "file", file);
+    double m[16];
+    int given;
+    TRY(mi_transform(c, grid, "to_world", m, &given));
+    if (m[1] != 0 || m[2] != 0 || m[4] != 0 || m[6] != 0 || m[8] != 0 || m[9] != 0)
+      return mi_bad(c, grid, "valo's grids are axis-aligned boxes: to_world may only scale and translate");
+    /* The unit cube placed by to_world, as Mitsuba 3's gridvolume. */
+    double lo[3], hi[3];
+    for (int i = 0; i < 3; i++) {
+      double a = m[4 * i + 3], b2 = m[4 * i + i] + m[4 * i + 3];
+      lo[i] = fmin(a, b2);
+      hi[i] = fmax(a, b2);
+    }
+    cJSON_AddItemToObject(o, "bounds_min", cJSON_CreateDoubleArray(lo, 3));
+    cJSON_AddItemToObject(o, "bounds_max", cJSON_CreateDoubleArray(hi, 3));
+    mi_warn_unused(c, grid);
+  }
+  mi_warn_unused(c, med);
+  return VALO_OK;
+}
+
+/* ---- emitters ---- */
+
+valo_status mi_emitter(mctx *c, xml_node *e) {
+  const char *type = xml_attr_get(e, "type");
+  if (!type) return mi_bad(c, e, "needs a type");
+  double m[16];
+  int has_xf;
+  TRY(mi_transform(c, e, "to_world", m, &has_xf));
+  if (!strcmp(type, "constant") || !strcmp(type, "envmap")) {
+    if (cJSON_GetObjectItemCaseSensitive(c->out, "environment")) return mi_bad(c, e, "valo has one environment: a second is not read");
+    cJSON *env = cJSON_AddObjectToObject(c->out, "environment");
+    if (!env) return NOMEM;
+    if (type[0] == 'c') {
+      cJSON_AddStringToObject(env, "type", "constant");
+      cJSON *v;
+      TRY(mi_color(c, e, "radiance", 1, &v));
+      cJSON_AddItemToObject(env, "radiance", v ? v : vec3_json(1, 1, 1));
+    } else {
+      const char *file = NULL;
+      double scale = 1;
+      TRY(mi_string(c, e, "filename", &file));
+      TRY(mi_float(c, e, "scale", &scale));
+      if (!file) return mi_bad(c, e, "needs <string name=\"filename\">");
+      /* Mitsuba's map has u = 0 at -z, valo's centre looks down -z: a turn of theta about
+       * +y there is theta - 180 degrees here. Other turns are not read. */
+      double ang = 180;
+      if (has_xf) {
+        double sy = m[5], off = fabs(m[1]) + fabs(m[4]) + fabs(m[6]) + fabs(m[9]) + fabs(m[3]) + fabs(m[7]) + fabs(m[11]);
+        if (fabs(sy - 1) > 1e-4 || off > 1e-4 || fabs(m[0] - m[10]) > 1e-4 || fabs(m[2] + m[8]) > 1e-4 ||
+            fabs(m[0] * m[0] + m[2] * m[2] - 1) > 1e-4)
+          return mi_bad(c, e, "valo turns environment maps only about +y (a y-up world): this to_world does more");
+        ang = atan2(m[2], m[0]) * 180 / M_PI;
+      }
+      cJSON_AddStringToObject(env, "type", "map");
+      cJSON_AddStringToObject(env, "file", file);
+      cJSON_AddNumberToObject(env, "scale", scale);
+      cJSON_AddNumberToObject(env, "rotation", ang - 180);
+    }
+    mi_warn_unused(c, e);
+    return VALO_OK;
+  }
+  cJSON *l = cJSON_CreateObject();
+  if (!l) return NOMEM;
+  cJSON_AddItemToArray(c->lights, l);
+  int *ln = realloc(c->light_line, (size_t)(c->nlight_line + 1) * sizeof *ln);
+  if (!ln) return NOMEM;
+  c->light_line = ln;
+  ln[c->nlight_line++] = e->line;
+  double org[3] = {m[3], m[7], m[11]}, dir[3] = {m[2], m[6], m[10]};
+  cJSON *v;
+  if (!strcmp(type, "point")) {
+    vec3 p = v3((float)org[0], (float)org[1], (float)org[2]);
+    TRY(mi_point(c, e, "position", &p));
+    cJSON_AddStringToObject(l, "type", "point");
+    cJSON_AddItemToObject(l, "position", vec3_json(p.x, p.y, p.z));
+    TRY(mi_color(c, e, "intensity", 1, &v));
+    cJSON_AddItemToObject(l, "intensity", v ? v : vec3_json(1, 1, 1));
+  } else if (!strcmp(type, "spot")) {
+    double cutoff = 20, beam = -1;
+    TRY(mi_float(c, e, "cutoff_angle", &cutoff));
+    TRY(mi_float(c, e, "beam_width", &beam));
+    if (beam < 0) beam = cutoff * 3 / 4;
+    if (mi_prop(c, e, "texture")) return mi_bad(c, e, "a spot light's texture is not read");
+    double dl = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    if (!(dl > 0)) return mi_bad(c, e, "to_world flattens the light");
+    cJSON_AddStringToObject(l, "type", "spot");
+    cJSON_AddItemToObject(l, "position", vec3_json(org[0], org[1], org[2]));
+    cJSON_AddItemToObject(l, "look_at", vec3_json(org[0] + dir[0] / dl, org[1] + dir[1] / dl, org[2] + dir[2] / dl));
+    TRY(mi_color(c, e, "intensity", 1, &v));
+    cJSON_AddItemToObject(l, "intensity", v ? v : vec3_json(1, 1, 1));
+    cJSON_AddNumberToObject(l, "cone_angle", cutoff);
+    cJSON_AddNumberToObject(l, "cone_delta_angle", beam < cutoff ? cutoff - beam : 0);
+  } else if (!strcmp(type, "directional")) {
+    vec3 d = v3((float)dir[0], (float)dir[1], (float)dir[2]);
+    TRY(mi_point(c, e, "direction", &d));
+    cJSON_AddStringToObject(l, "type", "directional");
+    cJSON_AddItemToObject(l, "direction", vec3_json(d.x, d.y, d.z));
+    TRY(mi_color(c, e, "irradiance", 1, &v));
+    cJSON_AddItemToObject(l, "irradiance", v ? v : vec3_json(1, 1, 1));
+  } else if (!strcmp(type, "area")) {
+    return mi_bad(c, e, "an area emitter belongs inside the <shape> that emits");
+  } else {
+    return mi_bad(c, e, "valo reads point, spot, directional, constant, envmap and (in shapes) area emitters");
+  }
+  mi_warn_unused(c, e);
+  return VALO_OK;
+}

@@ -1,0 +1,59 @@
+/* mitsuba_internal.h — owns what the Mitsuba XML reader's files share: the translation
+ * context and the typed property readers, each error naming the file and the line. The
+ * reader translates a Mitsuba scene into valo's JSON scene format (a cJSON tree) and
+ * hands it to the JSON loader, so both formats mean the same thing by construction. */
+#ifndef VALO_MITSUBA_INTERNAL_H
+#define VALO_MITSUBA_INTERNAL_H
+#include "load/xml.h"
+#include "core/vec.h"
+#include <cjson/cJSON.h>
+
+typedef struct mctx {
+  const char *path;
+  const char *defines; /* the command line's NAME=VALUE ... (replacing <default> values) */
+  valo_error *err;
+  xml_node *root;
+  cJSON *out, *materials, *shapes, *lights, *media;
+  int *shape_line, nshape_line; /* the XML line of each valo shape (error messages) */
+  int *light_line, nlight_line;
+  struct { const char *id; char name[96]; } *bsdf_names; /* materials made from bsdfs with an id */
+  int nbsdf_names;
+} mctx;
+
+/* "file:line: <tag name="..">: what" */
+valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* The node with id (any tag), or NULL. */
+xml_node *mi_find_id(mctx *c, const char *id);
+/* The property child named `name` of plugin p (marked used), following a <ref name=..>
+ * to its target; NULL when absent. */
+xml_node *mi_prop(mctx *c, xml_node *p, const char *name);
+/* Typed properties: absent leaves *out as it is; present of the wrong kind is an error. */
+valo_status mi_float(mctx *c, xml_node *p, const char *name, double *out);
+valo_status mi_int(mctx *c, xml_node *p, const char *name, int *out);
+valo_status mi_bool(mctx *c, xml_node *p, const char *name, int *out);
+valo_status mi_string(mctx *c, xml_node *p, const char *name, const char **out);
+valo_status mi_point(mctx *c, xml_node *p, const char *name, vec3 *out);
+/* A 4x4 transform (row-major) from a <transform name=..> child; identity when absent. */
+valo_status mi_transform(mctx *c, xml_node *p, const char *name, double m[16], int *given);
+/* A colour property as valo JSON: [r, g, b], or a bitmap texture's file name; *out
+ * stays NULL when absent. `rgb_only`: a texture is an error. */
+valo_status mi_color(mctx *c, xml_node *p, const char *name, int rgb_only, cJSON **out);
+/* Parses up to n numbers separated by commas and/or spaces; returns how many. */
+int mi_numbers(const char *s, double *v, int n);
+/* The child plugins of p with this tag (bsdf, emitter, ...), following <ref> children
+ * whose target has the tag; nth from 0; marks it used. */
+xml_node *mi_child(mctx *c, xml_node *p, const char *tag, int nth);
+/* Warns about p's children that nothing read (properties valo does not use). */
+void mi_warn_unused(mctx *c, xml_node *p);
+
+/* BSDFs, media and emitters (load_mitsuba_plugins.c). */
+/* The name of the valo material for bsdf node b (made on first use); with an area
+ * emitter's radiance `emit` (NULL: none) a material of its own. b NULL: Mitsuba's default
+ * (diffuse 0.5). */
+valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, char *name, size_t n);
+/* Adds the medium node m (once) to "media"; its name in *name. */
+valo_status mi_medium(mctx *c, xml_node *m, char *name, size_t n);
+/* A top-level emitter: a light or the environment. */
+valo_status mi_emitter(mctx *c, xml_node *e);
+#endif

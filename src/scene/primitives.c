@@ -1,0 +1,143 @@
+/* primitives.c — owns the shapes a scene file describes by kind rather than by mesh:
+ * the tessellated sphere and Mitsuba's unit rectangle, cube and disk, placed by a
+ * 3x4 transform. */
+#include "scene/scene.h"
+#include "core/error.h"
+#include <math.h>
+#include <stdlib.h>
+
+/* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
+ * are not shared between faces (flat arrays stay simple); normals are exact. */
+valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, int smooth, uint32_t mat, valo_error *err) {
+  if (subdiv < 0 || subdiv > 7) return err_set(err, VALO_ERR_INVALID, "%s: sphere subdivisions must be 0..7", s->path);
+  if (!(r > 0) || !isfinite(r)) return err_set(err, VALO_ERR_INVALID, "%s: sphere radius must be positive", s->path);
+  const float t = (1.0f + sqrtf(5.0f)) / 2.0f;
+  vec3 iv[12] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                               {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
+                               {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  uint32_t nf = 20u << (2 * subdiv);
+  vec3 *tris = malloc((size_t)nf * 3 * sizeof(vec3)), *tmp = malloc((size_t)nf * 3 * sizeof(vec3));
+  if (!tris || !tmp || scene_reserve(s, nf * 3, nf)) { free(tris); free(tmp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (int i = 0; i < 20; i++)
+    for (int k = 0; k < 3; k++) tris[3 * i + k] = v3_norm(iv[f[i][k]]);
+  uint32_t n = 20;
+  for (int d = 0; d < subdiv; d++) {
+    for (uint32_t i = 0; i < n; i++) {
+      vec3 a = tris[3 * i], b = tris[3 * i + 1], cc = tris[3 * i + 2];
+      vec3 ab = v3_norm(v3_add(a, b)), bc = v3_norm(v3_add(b, cc)), ca = v3_norm(v3_add(cc, a));
+      vec3 *o = &tmp[12 * i];
+      o[0] = a; o[1] = ab; o[2] = ca; o[3] = ab; o[4] = b; o[5] = bc;
+      o[6] = ca; o[7] = bc; o[8] = cc; o[9] = ab; o[10] = bc; o[11] = ca;
+    }
+    vec3 *sw = tris; tris = tmp; tmp = sw;
+    n *= 4;
+  }
+  for (uint32_t i = 0; i < n; i++) {
+    uint32_t base = s->nverts;
+    for (int k = 0; k < 3; k++) {
+      int kk = flip ? 2 - k : k;
+      vec3 u = tris[3 * i + kk];
+      s->pos[base + k] = v3_add(c, v3_scale(u, r));
+      s->nrm[base + k] = flip ? v3_neg(u) : u;
+      s->uv[2 * (base + k)] = 0.5f + atan2f(u.z, u.x) / (2 * PI_F);
+      s->uv[2 * (base + k) + 1] = acosf(clampf(u.y, -1, 1)) / PI_F;
+    }
+    s->nverts += 3;
+    uint32_t ti = s->ntris++;
+    s->idx[3 * ti] = base; s->idx[3 * ti + 1] = base + 1; s->idx[3 * ti + 2] = base + 2;
+    s->tri_mat[ti] = mat;
+    s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS);
+  }
+  free(tris); free(tmp);
+  return VALO_OK;
+}
+
+
+static vec3 xf_point(const float *xf, vec3 p) {
+  return v3(xf[0] * p.x + xf[1] * p.y + xf[2] * p.z + xf[3], xf[4] * p.x + xf[5] * p.y + xf[6] * p.z + xf[7],
+            xf[8] * p.x + xf[9] * p.y + xf[10] * p.z + xf[11]);
+}
+
+/* Appends flat triangles (no shading normals) over nv vertices with their UVs. */
+static valo_status add_flat(scene *s, const vec3 *p, const float *uv, uint32_t nv, const uint32_t *idx, uint32_t nt, const float *xf,
+                            int flip, uint32_t mat, valo_error *err) {
+  float det = xf[0] * (xf[5] * xf[10] - xf[6] * xf[9]) - xf[1] * (xf[4] * xf[10] - xf[6] * xf[8]) + xf[2] * (xf[4] * xf[9] - xf[5] * xf[8]);
+  if (!(fabsf(det) > 0) || !isfinite(det)) return err_set(err, VALO_ERR_INVALID, "%s: a shape's transform is singular (it flattens the shape)", s->path);
+  if (det < 0) flip = !flip; /* a mirroring transform keeps the front side, as for meshes */
+  if (scene_reserve(s, nv, nt)) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  uint32_t base = s->nverts;
+  for (uint32_t v = 0; v < nv; v++) {
+    s->pos[base + v] = xf_point(xf, p[v]);
+    if (!v3_finite(s->pos[base + v])) return err_set(err, VALO_ERR_INVALID, "%s: a shape's vertex is not finite after its transform", s->path);
+    s->nrm[base + v] = v3(0, 0, 0);
+    s->uv[2 * (base + v)] = uv[2 * v];
+    s->uv[2 * (base + v) + 1] = uv[2 * v + 1];
+  }
+  s->nverts += nv;
+  for (uint32_t t = 0; t < nt; t++) {
+    uint32_t ti = s->ntris++;
+    s->idx[3 * ti] = base + idx[3 * t];
+    s->idx[3 * ti + 1] = base + idx[3 * t + (flip ? 2 : 1)];
+    s->idx[3 * ti + 2] = base + idx[3 * t + (flip ? 1 : 2)];
+    s->tri_mat[ti] = mat;
+    s->tri_flags[ti] = TRI_HAS_UVS;
+  }
+  return VALO_OK;
+}
+
+#define DISK_SEGMENTS 256
+
+valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, uint32_t mat, valo_error *err) {
+  static const float id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  if (!xf) xf = id;
+  if (kind == PRIM_RECTANGLE) {
+    const vec3 p[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    return add_flat(s, p, uv, 4, idx, 2, xf, flip, mat, err);
+  }
+  if (kind == PRIM_CUBE) {
+    /* Six faces of four vertices, each wound counter-clockwise seen from outside. */
+    vec3 p[24];
+    float uv[48];
+    uint32_t idx[36];
+    for (int f = 0; f < 6; f++) {
+      int axis = f >> 1;
+      float sgn = (f & 1) ? -1.0f : 1.0f;
+      for (int k = 0; k < 4; k++) {
+        float a = (k == 1 || k == 2) ? 1.0f : -1.0f, b = (k >= 2) ? 1.0f : -1.0f;
+        float c[3];
+        /* (a, b) on the two other axes in cyclic order, so (u, v, n) is right-handed;
+         * the -n faces swap u to stay counter-clockwise from outside. */
+        c[axis] = sgn;
+        c[(axis + 1) % 3] = a * sgn;
+        c[(axis + 2) % 3] = b;
+        p[4 * f + k] = v3(c[0], c[1], c[2]);
+        uv[8 * f + 2 * k] = 0.5f * (a + 1);
+        uv[8 * f + 2 * k + 1] = 0.5f * (b + 1);
+      }
+      const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+      for (int k = 0; k < 6; k++) idx[6 * f + k] = 4u * (uint32_t)f + q[k];
+    }
+    return add_flat(s, p, uv, 24, idx, 12, xf, flip, mat, err);
+  }
+  /* PRIM_DISK: a fan of DISK_SEGMENTS triangles around the centre (area within 0.01 % of
+   * pi); UVs are the unit square's, (x + 1) / 2 and (y + 1) / 2. */
+  vec3 p[DISK_SEGMENTS + 1];
+  float uv[2 * (DISK_SEGMENTS + 1)];
+  uint32_t idx[3 * DISK_SEGMENTS];
+  p[0] = v3(0, 0, 0);
+  uv[0] = uv[1] = 0.5f;
+  for (int k = 0; k < DISK_SEGMENTS; k++) {
+    double phi = 2 * M_PI * k / DISK_SEGMENTS;
+    p[k + 1] = v3((float)cos(phi), (float)sin(phi), 0);
+    uv[2 * (k + 1)] = 0.5f * (p[k + 1].x + 1);
+    uv[2 * (k + 1) + 1] = 0.5f * (p[k + 1].y + 1);
+    idx[3 * k] = 0;
+    idx[3 * k + 1] = (uint32_t)k + 1;
+    idx[3 * k + 2] = (uint32_t)(k + 1) % DISK_SEGMENTS + 1;
+  }
+  return add_flat(s, p, uv, DISK_SEGMENTS + 1, idx, DISK_SEGMENTS, xf, flip, mat, err);
+}

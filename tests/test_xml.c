@@ -1,0 +1,274 @@
+/* test_xml.c — Mitsuba scene files (.xml): the XML reader (entities, comments, errors with
+ * line and column), the translation into valo's scene (an XML scene renders as the JSON
+ * scene it means), Mitsuba 0.6's camelCase names, <default> values and --define, the
+ * warning for properties valo does not read, and Mitsuba's unit shapes. Against Mitsuba
+ * itself: test_mitsuba from_xml and veach_mis_xml. */
+#include "harness.h"
+#include "load/xml.h"
+#include "valo/valo.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int parser(void) {
+  const char *ok = "<?xml version='1.0'?>\n<!-- a comment -->\n<scene version=\"3.0.0\">\n"
+                   "  <string name=\"a\" value=\"x &amp; &lt;y&gt; &quot;q&quot; &apos;s&apos; &#65;&#x42; &#xe9;\"/>\n"
+                   "  <!-- <shape> inside a comment is not an element -->\n"
+                   "  <shape type='obj'><ref id=\"m\"/>text is ignored</shape>\n</scene>\n";
+  xml_node *root;
+  valo_error err;
+  CHECK(xml_parse("ok.xml", ok, strlen(ok), &root, &err) == VALO_OK, "%s", err.message);
+  CHECK(!strcmp(root->name, "scene") && root->line == 3, "root <%s> at line %d", root->name, root->line);
+  const xml_node *s = root->child;
+  CHECK(s && !strcmp(s->name, "string") && s->line == 4, "first child");
+  CHECK(!strcmp(xml_attr_get(s, "value"), "x & <y> \"q\" 's' AB \xc3\xa9"), "entities decoded: [%s]", xml_attr_get(s, "value"));
+  const xml_node *sh = s->next;
+  CHECK(sh && !strcmp(sh->name, "shape") && sh->line == 6 && !strcmp(xml_attr_get(sh, "type"), "obj"), "second child");
+  CHECK(sh->child && !strcmp(sh->child->name, "ref") && !sh->child->next && sh->next == NULL, "the ref and nothing else");
+  xml_free(root);
+  static const struct { const char *text, *said; } bad[] = {
+      {"<scene>\n  <shape type=\"obj\">\n</scene>", "bad.xml:3:3: XML: end tag does not match <shape> of line 2"},
+      {"<scene>\n  <a b=\"1\" b=\"2\"/>\n</scene>", "bad.xml:2:12: XML: attribute given twice"},
+      {"<scene a=1/>", "bad.xml:1:10: XML: attribute value must be quoted"},
+      {"<scene/>\n<more/>", "bad.xml:2:1: XML: text after the root element"},
+      {"<scene>\n<!-- open", "bad.xml:2:1: XML: comment not closed"},
+      {"<scene a=\"&nbsp;\"/>", "unknown entity"},
+      {"<scene a=\"&#0;\"/>", "unknown entity"},
+      {"<scene a=\"x\">", "element not closed"},
+      {"", "no element in the file"},
+      {"<scene><![CDATA[x]]></scene>", "CDATA"},
+      {"<scene a=\"<\"/>", "'<' inside an attribute value"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+    valo_status st = xml_parse("bad.xml", bad[k].text, strlen(bad[k].text), &root, &err);
+    CHECK(st != VALO_OK && root == NULL, "case %zu parsed", k);
+    CHECK(strstr(err.message, bad[k].said), "case %zu: \"%s\" does not say \"%s\"", k, err.message, bad[k].said);
+  }
+  /* nesting is bounded (no input can exhaust the stack) */
+  char deep[70 * 4 + 16] = "";
+  for (int i = 0; i < 70; i++) strcat(deep, "<a>");
+  CHECK(xml_parse("deep.xml", deep, strlen(deep), &root, &err) != VALO_OK && strstr(err.message, "64 deep"), "%s", err.message);
+  return 0;
+}
+
+/* A Mitsuba 3 scene with one of most things valo reads, and the JSON scene it means. */
+static const char *XML_SCENE =
+    "<scene version=\"3.0.0\">\n"
+    "  <default name=\"spp\" value=\"4\"/>\n"
+    "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"5\"/></integrator>\n"
+    "  <sensor type=\"perspective\">\n"
+    "    <float name=\"fov\" value=\"50\"/>\n"
+    "    <transform name=\"to_world\"><lookat origin=\"0, 2, 6\" target=\"0, 0.5, 0\" up=\"0, 1, 0\"/></transform>\n"
+    "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/></sampler>\n"
+    "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"48\"/><integer name=\"height\" value=\"32\"/><rfilter type=\"tent\"/></film>\n"
+    "  </sensor>\n"
+    "  <bsdf type=\"twosided\" id=\"white\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.7, 0.6, 0.5\"/></bsdf></bsdf>\n"
+    "  <bsdf type=\"roughconductor\" id=\"metal\"><float name=\"alpha\" value=\"0.09\"/><rgb name=\"eta\" value=\"0.2 0.9 1.1\"/>\n"
+    "    <rgb name=\"k\" value=\"3.9, 2.4, 2.1\"/><rgb name=\"specular_reflectance\" value=\"0.8, 0.8, 0.8\"/></bsdf>\n"
+    "  <shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"4\"/><rotate x=\"1\" angle=\"-90\"/></transform>\n"
+    "    <ref id=\"white\"/></shape>\n"
+    "  <shape type=\"cube\"><transform name=\"to_world\"><scale x=\"0.5\" y=\"0.5\" z=\"0.5\"/><rotate y=\"1\" angle=\"30\"/>\n"
+    "    <translate x=\"-1\" y=\"0.5\"/></transform><ref id=\"metal\"/></shape>\n"
+    "  <shape type=\"sphere\"><point name=\"center\" x=\"1\" y=\"0.6\" z=\"0\"/><float name=\"radius\" value=\"0.6\"/>\n"
+    "    <bsdf type=\"dielectric\"><string name=\"int_ior\" value=\"bk7\"/><string name=\"ext_ior\" value=\"air\"/></bsdf></shape>\n"
+    "  <shape type=\"disk\"><transform name=\"to_world\"><scale value=\"0.5\"/><rotate x=\"1\" angle=\"90\"/><translate y=\"3\"/></transform>\n"
+    "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"8, 8, 8\"/></emitter></shape>\n"
+    "  <emitter type=\"point\"><point name=\"position\" x=\"2\" y=\"3\" z=\"2\"/><rgb name=\"intensity\" value=\"5, 5, 5\"/></emitter>\n"
+    "  <emitter type=\"spot\"><transform name=\"to_world\"><lookat origin=\"-2, 3, 2\" target=\"-2, 0, 2\" up=\"0, 0, 1\"/></transform>\n"
+    "    <rgb name=\"intensity\" value=\"10, 10, 10\"/><float name=\"cutoff_angle\" value=\"30\"/></emitter>\n"
+    "  <emitter type=\"directional\"><vector name=\"direction\" x=\"0.3\" y=\"-1\" z=\"-0.2\"/><rgb name=\"irradiance\" value=\"0.5\"/></emitter>\n"
+    "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.1, 0.15, 0.2\"/></emitter>\n"
+    "</scene>\n";
+
+static float *render_path(const char *path, int *w, int *h) {
+  valo_options o;
+  valo_options_init(&o);
+  o.threads = 2;
+  valo_scene *sc;
+  valo_render *r = render_file(path, &o, &sc);
+  if (!r) return NULL;
+  valo_stats st;
+  valo_render_stats(r, &st);
+  *w = st.width; *h = st.height;
+  float *px = malloc((size_t)st.width * st.height * 3 * sizeof(float));
+  if (px) valo_render_pixels(r, px);
+  valo_render_destroy(r);
+  valo_scene_destroy(sc);
+  return px;
+}
+
+/* Pixels of a and b: *far the share differing by more than 1e-4 relative (an edge a ray
+ * meets on one side in one and on the other in the other), *mean the relative difference
+ * of the means. */
+static void differ(const float *a, const float *b, int n, double *far, double *mean) {
+  double sa = 0, sb = 0;
+  int nf = 0;
+  for (int i = 0; i < 3 * n; i++) {
+    sa += a[i]; sb += b[i];
+    if (fabsf(a[i] - b[i]) > 1e-4f * fmaxf(1e-3f, fabsf(b[i]))) nf++;
+  }
+  *far = (double)nf / (3 * n);
+  *mean = fabs(sa / sb - 1);
+}
+
+static int xml_equals_json(void) {
+  /* The JSON the XML means: Mitsuba's horizontal 50-degree field on a 48 x 32 film is a
+   * vertical one of 2 atan(tan 25 / 1.5); max_depth 5 counts the camera ray, valo's 4 does
+   * not; alpha 0.09 is roughness 0.3; bk7 in air is 1.5046 / 1.00028; the spot's beam is
+   * 3/4 of its cut-off (delta 7.5 degrees); the disk, with no BSDF, is Mitsuba's default
+   * diffuse 0.5. */
+  double vfov = 360 / M_PI * atan(tan(25 * M_PI / 180) / 1.5);
+  char json[4096];
+  snprintf(json, sizeof json,
+           "{\"camera\": {\"position\": [0, 2, 6], \"look_at\": [0, 0.5, 0], \"up\": [0, 1, 0], \"fov\": %.17g},\n"
+           " \"film\": {\"width\": 48, \"height\": 32, \"filter\": \"tent\", \"filter_radius\": 1},\n"
+           " \"render\": {\"integrator\": \"path\", \"max_depth\": 4, \"spp\": 4, \"sampler\": \"independent\"},\n"
+           " \"materials\": {\"white\": {\"type\": \"diffuse\", \"reflectance\": [0.7, 0.6, 0.5]},\n"
+           "   \"metal\": {\"type\": \"conductor\", \"eta\": [0.2, 0.9, 1.1], \"k\": [3.9, 2.4, 2.1], \"reflectance\": [0.8, 0.8, 0.8],\n"
+           "             \"roughness\": 0.3, \"distribution\": \"beckmann\"},\n"
+           "   \"glass\": {\"type\": \"dielectric\", \"ior\": %.17g},\n"
+           "   \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 8}},\n"
+           " \"shapes\": [{\"type\": \"rectangle\", \"transform\": {\"scale\": 4, \"rotate_x\": -90}, \"material\": \"white\"},\n"
+           "   {\"type\": \"cube\", \"transform\": {\"scale\": 0.5, \"rotate_y\": 30, \"translate\": [-1, 0.5, 0]}, \"material\": \"metal\"},\n"
+           "   {\"type\": \"sphere\", \"center\": [1, 0.6, 0], \"radius\": 0.6, \"material\": \"glass\"},\n"
+           "   {\"type\": \"disk\", \"transform\": {\"scale\": 0.5, \"rotate_x\": 90, \"translate\": [0, 3, 0]}, \"material\": \"lamp\"}],\n"
+           " \"lights\": [{\"type\": \"point\", \"position\": [2, 3, 2], \"intensity\": 5},\n"
+           "   {\"type\": \"spot\", \"position\": [-2, 3, 2], \"look_at\": [-2, 2, 2], \"intensity\": 10, \"cone_angle\": 30, \"cone_delta_angle\": 7.5},\n"
+           "   {\"type\": \"directional\", \"direction\": [0.3, -1, -0.2], \"irradiance\": 0.5}],\n"
+           " \"environment\": {\"type\": \"constant\", \"radiance\": [0.1, 0.15, 0.2]}}\n",
+           vfov, 1.5046 / 1.00028);
+  int w1, h1, w2, h2;
+  warnings_capture(1);
+  float *a = render_path(scratch_file("scene.xml", XML_SCENE), &w1, &h1);
+  int warned = warnings_text()[0] != 0;
+  warnings_capture(0);
+  CHECK(a, "the XML scene did not render");
+  CHECK(!warned, "the scene gave warnings (printed above): everything in it is read");
+  float *b = render_path(scratch_file("scene.json", json), &w2, &h2);
+  CHECK(b, "the JSON scene did not render");
+  CHECK(w1 == 48 && h1 == 32 && w2 == 48 && h2 == 32, "sizes %dx%d, %dx%d", w1, h1, w2, h2);
+  double far, mean;
+  differ(a, b, w1 * h1, &far, &mean);
+  fprintf(stderr, "XML against JSON: %.2f%% of pixel channels differ by more than 1e-4, means by %.2e\n", 100 * far, mean);
+  CHECK(far < 0.02 && mean < 1e-3, "the XML scene renders differently from the JSON it means");
+  /* and the test can tell: a metal of GGX in place of Beckmann */
+  char *ggx = strdup(json), *at = strstr(ggx, "\"beckmann\"");
+  memcpy(at, "\"ggx\"     ", 10);
+  float *c = render_path(scratch_file("ggx.json", ggx), &w2, &h2);
+  CHECK(c, "render");
+  differ(c, b, w1 * h1, &far, &mean);
+  CHECK(far > 0.05, "GGX and Beckmann metal rendered alike (%.2f%% of channels differ)", 100 * far);
+  free(ggx); free(a); free(b); free(c);
+  return 0;
+}
+
+/* Mitsuba 0.6's names (camelCase, lookAt) mean what Mitsuba 3's do: the same image. */
+static int mitsuba_06_names(void) {
+  char *old = strdup(XML_SCENE);
+  static const char *const from[] = {"version=\"3.0.0\"", "max_depth", "to_world", "to_world", "to_world", "to_world", "to_world",
+                                     "sample_count", "int_ior", "ext_ior", "specular_reflectance", "cutoff_angle", "<lookat", "<lookat"};
+  static const char *const to[] = {"version=\"0.6.0\"", "maxDepth", "toWorld", "toWorld", "toWorld", "toWorld", "toWorld",
+                                   "sampleCount", "intIOR", "extIOR", "specularReflectance", "cutoffAngle", "<lookAt", "<lookAt"};
+  for (size_t k = 0; k < sizeof from / sizeof from[0]; k++) {
+    char *p = strstr(old, from[k]);
+    CHECK(p, "no %s left", from[k]);
+    size_t a = strlen(from[k]), b = strlen(to[k]);
+    char *n = malloc(strlen(old) + b + 1);
+    memcpy(n, old, (size_t)(p - old));
+    strcpy(n + (p - old), to[k]);
+    strcat(n, p + a);
+    free(old);
+    old = n;
+  }
+  CHECK(!strstr(old, "to_world") && strstr(old, "lookAt"), "rewritten");
+  int w, h;
+  float *a = render_path(scratch_file("new.xml", XML_SCENE), &w, &h);
+  float *b = render_path(scratch_file("old.xml", old), &w, &h);
+  CHECK(a && b, "render");
+  CHECK(!memcmp(a, b, (size_t)w * h * 3 * sizeof(float)), "0.6 names render differently");
+  free(old); free(a); free(b);
+  return 0;
+}
+
+/* <default> values, $substitution and --define (valo_load_options.defines). */
+static int defaults_and_defines(void) {
+  const char *xml = "<scene version=\"3.0.0\">\n<default name=\"res\" value=\"24\"/>\n"
+                    "<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>\n"
+                    "<film type=\"hdrfilm\"><integer name=\"width\" value=\"$res\"/><integer name=\"height\" value=\"$h\"/></film></sensor>\n"
+                    "<emitter type=\"constant\"/>\n</scene>\n";
+  const char *p = scratch_file("defs.xml", xml);
+  valo_load_options lo;
+  valo_load_options_init(&lo);
+  valo_scene *sc;
+  valo_error err;
+  CHECK(valo_scene_load_with(p, &lo, &sc, &err) != VALO_OK, "loaded with $h undefined");
+  CHECK(strstr(err.message, "defs.xml:4:") && strstr(err.message, "$h has no <default"), "said: %s", err.message);
+  snprintf(lo.defines, sizeof lo.defines, "h=12 res=36");
+  CHECK(valo_scene_load_with(p, &lo, &sc, &err) == VALO_OK, "%s", err.message);
+  valo_options o;
+  valo_options_init(&o);
+  valo_scene_file_options(sc, &o);
+  CHECK(o.width == 36 && o.height == 12, "film %dx%d, not 36x12 (--define replaces the default)", o.width, o.height);
+  valo_scene_destroy(sc);
+  return 0;
+}
+
+/* What valo does not read is said, naming the line; what it cannot render is an error. */
+static int unread_is_said(void) {
+  const char *xml = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>\n"
+                    "<float name=\"shutter_open\" value=\"0\"/></sensor>\n"
+                    "<shape type=\"sphere\"><bsdf type=\"diffuse\"><float name=\"roughness\" value=\"0.5\"/></bsdf></shape>\n"
+                    "<emitter type=\"constant\"/>\n</scene>\n";
+  warnings_capture(1);
+  valo_scene *sc;
+  valo_error err;
+  valo_status st = valo_scene_load(scratch_file("unread.xml", xml), &sc, &err);
+  char said[2048];
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  CHECK(st == VALO_OK, "%s", err.message);
+  valo_scene_destroy(sc);
+  CHECK(strstr(said, "unread.xml:3: <float name=\"shutter_open\">: not read by valo"), "said: %s", said);
+  CHECK(strstr(said, "unread.xml:4: <float name=\"roughness\">: not read by valo"), "said: %s", said);
+  return 0;
+}
+
+/* Mitsuba's unit shapes, emitting radiance 2 from their front: the rectangle [-1, 1]^2
+ * facing +z fills the film with 2 seen from +z and 0 from behind; the cube [-1, 1]^3
+ * faces out; the disk of radius 1 seen from distance 2 under a 60-degree field covers
+ * pi / (2 x 2 tan 30)^2 = 3 pi / 16 of the film, so the film's mean is 2 x 3 pi / 16. */
+static int unit_shapes(void) {
+  static const char *const fmt =
+      "<scene version=\"3.0.0\">\n<sensor type=\"%s\"><float name=\"fov\" value=\"60\"/>\n"
+      "<transform name=\"to_world\"><lookat origin=\"0, 0, %s\" target=\"0, 0, 0\"/></transform>\n"
+      "<sampler type=\"independent\"><integer name=\"sample_count\" value=\"16\"/></sampler>\n"
+      "<film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"64\"/><rfilter type=\"box\"/></film></sensor>\n"
+      "<shape type=\"%s\"><emitter type=\"area\"><rgb name=\"radiance\" value=\"2\"/></emitter>%s</shape>\n</scene>\n";
+  struct { const char *shape, *z, *extra; double expect; } t[] = {
+      {"rectangle", "0.5", "", 2},   /* the film sees [-0.29, 0.29]^2 of the rectangle */
+      {"rectangle", "-0.5", "", 0},  /* behind it */
+      {"cube", "0.2", "<transform name=\"to_world\"><scale value=\"0.1\"/></transform>", 2}, /* outside, facing out */
+      {"disk", "2", "", 2 * 3 * M_PI / 16},
+  };
+  for (size_t k = 0; k < sizeof t / sizeof t[0]; k++) {
+    char xml[2048];
+    snprintf(xml, sizeof xml, fmt, "perspective", t[k].z, t[k].shape, t[k].extra);
+    int w, h;
+    float *px = render_path(scratch_file("unit.xml", xml), &w, &h);
+    CHECK(px, "render");
+    double s = 0;
+    for (int i = 0; i < 3 * w * h; i++) s += px[i];
+    s /= 3.0 * w * h;
+    free(px);
+    fprintf(stderr, "%s seen from z = %s: mean %.4f, expected %.4f\n", t[k].shape, t[k].z, s, t[k].expect);
+    CHECK(fabs(s - t[k].expect) < 0.01 * fmax(t[k].expect, 1) , "%s: mean %.4f, expected %.4f", t[k].shape, s, t[k].expect);
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
+                                    {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
+                                    {"unit_shapes", unit_shapes}, {NULL, NULL}};
+  return test_main(argc, argv, cases);
+}
