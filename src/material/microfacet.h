@@ -5,9 +5,13 @@
  *   "Sampling the GGX distribution of visible normals"), whose density is
  *   D_wo(wm) = G1(wo) / |cos wo| * D(wm) * max(0, wo . wm);
  * - Beckmann: D(wm) = exp(-tan^2/a^2) / (pi a^2 cos^4), Smith Lambda(w) = (erf(b) - 1)/2 +
- *   exp(-b^2) / (2 b sqrt(pi)) with b = 1 / (a tan) (Walter et al. 2007), sampled by the
- *   whole distribution, tan^2 = -a^2 ln(1 - u), density D(wm) cos(wm); a normal facing
- *   away from wo gives a direction whose density and value are 0 (a lost sample).
+ *   exp(-b^2) / (2 b sqrt(pi)) with b = 1 / (a tan) (Walter et al. 2007), also sampled by
+ *   visible normals (the same density with its G1): in the stretched frame where a = 1,
+ *   the slope along the incident direction's azimuth has the CDF
+ *   (1 + erf(x) + tan(t) exp(-x^2) / sqrt(pi)) / (1 + erf(cot t) + tan(t) exp(-cot^2 t) / sqrt(pi)),
+ *   inverted by safeguarded Newton steps in erf(x) from a fitted first guess (Jakob 2014,
+ *   "An improved visible normal sampling routine for the Beckmann distribution"), the
+ *   other slope is a unit Gaussian (erf(y) uniform).
  * Both use the height-correlated G = 1 / (1 + Lambda(wo) + Lambda(wi)). The mf_ functions
  * choose by `beck`. */
 #ifndef VALO_MICROFACET_H
@@ -65,10 +69,64 @@ static inline float beckmann_lambda(float a, vec3 w) {
   if (b > 6) return 0; /* below 1e-17 */
   return 0.5f * (erff(b) - 1) + expf(-b * b) / (2 * b * sqrtf(PI_F));
 }
-static inline vec3 beckmann_sample(float a, float u1, float u2) {
-  float t2 = -a * a * logf(fmaxf(1 - u1, 1e-30f));
-  float c = 1 / sqrtf(1 + t2), s = sqrtf(fmaxf(0.0f, 1 - c * c)), phi = 2 * PI_F * u2;
-  return v3(s * cosf(phi), s * sinf(phi), fmaxf(c, 1e-6f));
+/* The inverse error function on (-1, 1): Giles' single-precision polynomials (2010),
+ * relative error below 4e-7. */
+static inline float erfinv_f(float x) {
+  x = clampf(x, -0.99999994f, 0.99999994f);
+  float w = -logf((1 - x) * (1 + x)), p;
+  if (w < 5) {
+    w -= 2.5f;
+    p = 2.81022636e-08f;
+    p = 3.43273939e-07f + p * w; p = -3.5233877e-06f + p * w; p = -4.39150654e-06f + p * w; p = 0.00021858087f + p * w;
+    p = -0.00125372503f + p * w; p = -0.00417768164f + p * w; p = 0.246640727f + p * w; p = 1.50140941f + p * w;
+  } else {
+    w = sqrtf(w) - 3;
+    p = -0.000200214257f;
+    p = 0.000100950558f + p * w; p = 0.00134934322f + p * w; p = -0.00367342844f + p * w; p = 0.00573950773f + p * w;
+    p = -0.0076224613f + p * w; p = 0.00943887047f + p * w; p = 1.00167406f + p * w; p = 2.83297682f + p * w;
+  }
+  return p * x;
+}
+/* Slopes (unit roughness) of a normal visible from a direction at angle theta to +z,
+ * azimuth along +x. */
+static inline void beckmann_visible_slopes(float theta, float u1, float u2, float *sx, float *sy) {
+  const float inv_sqrt_pi = 0.564189584f;
+  if (theta < 1e-4f) {
+    float r = sqrtf(-logf(fmaxf(1 - u1, 1e-30f))), phi = 2 * PI_F * u2;
+    *sx = r * cosf(phi); *sy = r * sinf(phi);
+    return;
+  }
+  float tan_t = tanf(theta), cot_t = 1 / tan_t;
+  float lo = -1, hi = erff(cot_t); /* the bracket of b = erf(slope) */
+  float norm = 1 / (1 + hi + inv_sqrt_pi * tan_t * expf(-cot_t * cot_t));
+  float fit = 1 + theta * (-0.876f + theta * (0.4265f - 0.0594f * theta));
+  float b = hi - (1 + hi) * powf(1 - u1, fit);
+  for (int it = 0; it < 12; it++) {
+    if (!(b >= lo && b <= hi)) b = 0.5f * (lo + hi);
+    float x = erfinv_f(b);
+    float value = norm * (1 + b + inv_sqrt_pi * tan_t * expf(-x * x)) - u1;
+    if (fabsf(value) < 1e-6f) break;
+    if (value > 0) hi = b; else lo = b;
+    b -= value / (norm * (1 - x * tan_t));
+  }
+  *sx = erfinv_f(b);
+  *sy = erfinv_f(2 * fmaxf(u2, 1e-7f) - 1);
+}
+/* A visible normal for w (either hemisphere: w is mirrored to +z first). */
+static inline vec3 beckmann_sample_visible(float a, vec3 w, float u1, float u2) {
+  if (w.z < 0) w = v3_neg(w);
+  vec3 ws = v3_norm(v3(a * w.x, a * w.y, w.z)); /* stretched to unit roughness */
+  float theta = acosf(clampf(ws.z, -1, 1)), r = sqrtf(ws.x * ws.x + ws.y * ws.y);
+  float cp = r > 1e-7f ? ws.x / r : 1, sp = r > 1e-7f ? ws.y / r : 0;
+  float sx, sy;
+  beckmann_visible_slopes(theta, u1, u2, &sx, &sy);
+  float rx = cp * sx - sp * sy, ry = sp * sx + cp * sy; /* turned to w's azimuth */
+  return v3_norm(v3(-a * rx, -a * ry, 1));
+}
+static inline float beckmann_D_visible(float a, vec3 w, vec3 wm) {
+  float c = fabsf(w.z);
+  if (!(c > 0)) return 0;
+  return beckmann_D(a, wm) * fabsf(v3_dot(w, wm)) / (c * (1 + beckmann_lambda(a, w)));
 }
 
 static inline float mf_D(int beck, float a, vec3 wm) { return beck ? beckmann_D(a, wm) : ggx_D(a, wm); }
@@ -77,9 +135,9 @@ static inline float mf_G(int beck, float a, vec3 wo, vec3 wi) {
 }
 /* The density of sampled normal wm (for direction w). */
 static inline float mf_pdf_m(int beck, float a, vec3 w, vec3 wm) {
-  return beck ? beckmann_D(a, wm) * fabsf(wm.z) : ggx_D_visible(a, w, wm);
+  return beck ? beckmann_D_visible(a, w, wm) : ggx_D_visible(a, w, wm);
 }
 static inline vec3 mf_sample(int beck, float a, vec3 w, float u1, float u2) {
-  return beck ? beckmann_sample(a, u1, u2) : ggx_sample_visible(a, w, u1, u2);
+  return beck ? beckmann_sample_visible(a, w, u1, u2) : ggx_sample_visible(a, w, u1, u2);
 }
 #endif
