@@ -266,9 +266,40 @@ static int unit_shapes(void) {
   return 0;
 }
 
+/* valo convert (valo_scene_convert): the JSON written for an XML scene, in another folder,
+ * renders bit for bit as the XML does, its texture and mesh found through absolute names;
+ * what is not a Mitsuba scene or not a .json output is refused. */
+static int convert_to_json(void) {
+  const char *xml_path = VALO_SOURCE_DIR "/tests/data/materials/textured-quad.xml";
+  char out[1200];
+  snprintf(out, sizeof out, "%s/converted.json", scratch_dir());
+  valo_error err;
+  CHECK(valo_scene_convert(xml_path, NULL, out, &err) == VALO_OK, "%s", err.message);
+  char *text = read_text_file(out);
+  CHECK(text && strstr(text, "\"" VALO_SOURCE_DIR), "file names are not absolute: %s", text ? text : "(no file)");
+  free(text);
+  int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+  float *a = render_path(xml_path, &w1, &h1), *b = render_path(out, &w2, &h2);
+  CHECK(a && b && w1 == w2 && h1 == h2, "render");
+  CHECK(!memcmp(a, b, (size_t)w1 * h1 * 3 * sizeof(float)), "the converted JSON renders differently from the XML");
+  free(a); free(b);
+  /* the defines reach the translation; refusals */
+  valo_load_options lo;
+  valo_load_options_init(&lo);
+  snprintf(lo.defines, sizeof lo.defines, "spp=7");
+  CHECK(valo_scene_convert(scratch_file("conv.xml", XML_SCENE), &lo, out, &err) == VALO_OK, "%s", err.message);
+  text = read_text_file(out);
+  CHECK(text && strstr(text, "\"spp\":\t7"), "--define did not reach the JSON");
+  free(text);
+  CHECK(valo_scene_convert(scratch_file("s.json", "{}"), NULL, out, &err) != VALO_OK && strstr(err.message, "Mitsuba scene files"), "%s", err.message);
+  CHECK(valo_scene_convert(scratch_file("c2.xml", XML_SCENE), NULL, scratch_path("x.png"), &err) != VALO_OK && strstr(err.message, ".json"), "%s",
+        err.message);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"convert_to_json", convert_to_json}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -140,6 +140,10 @@ VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_opti
 /* Non-zero when the loaded scene has at least one light (emissive triangle, point, spot or
  * directional light, a non-black environment, or a medium that glows). */
 VALO_API int valo_scene_has_light(const valo_scene *scene);
+/* Writes the JSON scene (docs/scene-format.md) that the Mitsuba scene file at path means
+ * to out, atomically, with its file names made absolute; lo (may be NULL) gives its
+ * --define values. The same translation valo_scene_load makes of a .xml file. */
+VALO_API valo_status valo_scene_convert(const char *path, const valo_load_options *lo, const char *out, valo_error *err);
 VALO_API void valo_scene_destroy(valo_scene *scene);
 /* The options the scene file itself asks for (unset fields stay VALO_UNSET). */
 VALO_API void valo_scene_file_options(const valo_scene *scene, valo_options *out);

@@ -6,6 +6,8 @@
 #include "load/load.h"
 #include "core/error.h"
 #include <stdlib.h>
+#include <string.h>
+#include <strings.h>
 
 VALO_API const char *valo_version(void) { return VALO_VERSION_STRING; }
 
@@ -24,6 +26,19 @@ VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_opti
   }
   log_scope_leave(&scope);
   *out = vs;
+  return st;
+}
+
+VALO_API valo_status valo_scene_convert(const char *path, const valo_load_options *lo, const char *out, valo_error *err) {
+  if (err) { err->status = VALO_OK; err->message[0] = 0; }
+  if (!path || !out) return err_set(err, VALO_ERR_INVALID, "valo convert needs a scene and an output file");
+  size_t n = strlen(path), m = strlen(out);
+  if (n < 4 || strcasecmp(path + n - 4, ".xml")) return err_set(err, VALO_ERR_INVALID, "%s: valo converts Mitsuba scene files (.xml)", path);
+  if (m < 5 || strcasecmp(out + m - 5, ".json")) return err_set(err, VALO_ERR_INVALID, "%s: the output is a JSON scene file (.json)", out);
+  log_scope scope;
+  log_scope_enter(&scope, lo ? lo->on_warning : NULL, lo ? lo->on_warning_user : NULL);
+  valo_status st = mitsuba_to_json(path, lo ? lo->defines : NULL, out, err);
+  log_scope_leave(&scope);
   return st;
 }
 

@@ -37,7 +37,9 @@ static void usage_main(FILE *f) {
   fprintf(f,
           "valo %s — physically based global-illumination renderer\n\n"
           "Usage:\n"
-          "  valo render SCENE [options]   render a scene (JSON scene file, or an OBJ/glTF/PLY mesh)\n"
+          "  valo render SCENE [options]   render a scene (JSON scene file, Mitsuba .xml, or an OBJ/glTF/PLY mesh)\n"
+          "  valo convert SCENE.xml -o OUT.json [-D NAME=VALUE ...]\n"
+          "                                write the JSON scene a Mitsuba scene file means\n"
           "  valo --help                   this text\n"
           "  valo render --help            the render options\n"
           "  valo compare SCENE --integrators A,B (--time S | --spp N) -o DIR\n"
@@ -46,6 +48,40 @@ static void usage_main(FILE *f) {
           "  valo --version                print the version\n\n"
           "Exit codes: 0 success, 1 error (bad input, failed write), 2 usage error, 130 interrupted.\n",
           valo_version());
+}
+
+/* valo convert SCENE.xml -o OUT.json [-D NAME=VALUE ...] */
+static int cmd_convert(int argc, char **argv) {
+  const char *in = NULL, *out = NULL;
+  valo_load_options lo;
+  valo_load_options_init(&lo);
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+      printf("Usage: valo convert SCENE.xml -o OUT.json [-D NAME=VALUE ...]\n\n"
+             "Writes the JSON scene (docs/scene-format.md) that a Mitsuba scene file means: the same\n"
+             "translation valo render makes of it, with file names made absolute. -D (--define)\n"
+             "sets the file's <default> values, as for valo render.\n");
+      return 0;
+    }
+    if ((!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "-D") || !strcmp(a, "--define")) && i + 1 >= argc) {
+      fprintf(stderr, "valo: %s needs a value\n", a);
+      return EXIT_USAGE;
+    }
+    if (!strcmp(a, "-o") || !strcmp(a, "--output")) { out = argv[++i]; continue; }
+    if (!strcmp(a, "-D") || !strcmp(a, "--define")) {
+      valo_error e;
+      if (valo_option_set("--define", argv[++i], NULL, &lo, NULL, &e)) { fprintf(stderr, "valo: %s: %s\n", a, e.message); return EXIT_USAGE; }
+      continue;
+    }
+    if (a[0] == '-' || in) { fprintf(stderr, "valo: convert: unexpected \"%s\" (valo convert --help)\n", a); return EXIT_USAGE; }
+    in = a;
+  }
+  if (!in || !out) { fprintf(stderr, "valo: convert needs SCENE.xml and -o OUT.json (valo convert --help)\n"); return EXIT_USAGE; }
+  valo_error err;
+  if (valo_scene_convert(in, &lo, out, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
+  fprintf(stderr, "valo: wrote %s\n", out);
+  return 0;
 }
 
 typedef struct progress_state { int tty; int quiet; double last_print; int spp_total; double time_budget; int frames; } progress_state;
@@ -348,6 +384,7 @@ int main(int argc, char **argv) {
   }
   if (!strcmp(argv[1], "compare")) return cmd_compare(argc - 2, argv + 2);
   if (!strcmp(argv[1], "view")) return cmd_view(argc - 2, argv + 2);
+  if (!strcmp(argv[1], "convert")) return cmd_convert(argc - 2, argv + 2);
   fprintf(stderr, "valo: unknown command \"%s\" (see valo --help)\n", argv[1]);
   return EXIT_USAGE;
 }

@@ -19,6 +19,9 @@ valo_status load_json(scene *s, const char *path, valo_options *file, valo_error
 /* A Mitsuba scene (.xml, Mitsuba 3 or 0.6), translated into the JSON scene format;
  * defines ("NAME=VALUE ...", may be NULL) replace its <default> values. */
 valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *file, valo_error *err);
+/* Writes the JSON scene the Mitsuba scene at path means to out (atomically), its file
+ * names made absolute (valo convert). */
+valo_status mitsuba_to_json(const char *path, const char *defines, const char *out, valo_error *err);
 /* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
  * override_mat: material index for every triangle, or UINT32_MAX to keep the file's;
  * mesh_flags: LOAD_MESH_CAMERA, use the file's camera (its aspect sets the file's film

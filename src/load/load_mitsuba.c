@@ -9,6 +9,7 @@
 #include "load/load_json_internal.h"
 #include "load/mitsuba_internal.h"
 #include "core/error.h"
+#include "core/atomicfile.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -452,32 +453,88 @@ static void add_lines(mctx *c, const int at[2]) {
   }
 }
 
-valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *settings, valo_error *err) {
+/* Reads and translates path: *c holds the JSON tree (c->out) and the XML (free both with
+ * translation_free). */
+static valo_status translate_file(mctx *c, const char *path, const char *defines, valo_error *err) {
+  memset(c, 0, sizeof *c);
+  c->path = path; c->err = err; c->defines = defines;
   char *text;
   size_t len;
   TRY(scene_text_read(path, &text, &len, err));
-  mctx c = {.path = path, .err = err, .defines = defines};
-  valo_status st = xml_parse(path, text, len, &c.root, err);
+  valo_status st = xml_parse(path, text, len, &c->root, err);
   free(text);
   if (st) return st;
-  c.out = cJSON_CreateObject();
-  if (c.out) {
-    c.materials = cJSON_AddObjectToObject(c.out, "materials");
-    c.media = cJSON_AddObjectToObject(c.out, "media");
-    c.shapes = cJSON_AddArrayToObject(c.out, "shapes");
-    c.lights = cJSON_AddArrayToObject(c.out, "lights");
+  c->out = cJSON_CreateObject();
+  if (c->out) {
+    c->materials = cJSON_AddObjectToObject(c->out, "materials");
+    c->media = cJSON_AddObjectToObject(c->out, "media");
+    c->shapes = cJSON_AddArrayToObject(c->out, "shapes");
+    c->lights = cJSON_AddArrayToObject(c->out, "lights");
   }
-  if (!c.out || !c.materials || !c.media || !c.shapes || !c.lights) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
-  if (!st) st = read_document(&c);
+  if (!c->out || !c->materials || !c->media || !c->shapes || !c->lights) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  return read_document(c);
+}
+
+static void translation_free(mctx *c) {
+  cJSON_Delete(c->out);
+  xml_free(c->root);
+  free(c->shape_line);
+  free(c->light_line);
+  free(c->bsdf_names);
+}
+
+valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *settings, valo_error *err) {
+  mctx c;
+  valo_status st = translate_file(&c, path, defines, err);
   if (!st) {
     int at[2] = {-1, -1};
     st = load_json_tree(s, path, c.out, settings, at, err);
     if (st) add_lines(&c, at);
   }
-  cJSON_Delete(c.out);
-  xml_free(c.root);
-  free(c.shape_line);
-  free(c.light_line);
-  free(c.bsdf_names);
+  translation_free(&c);
+  return st;
+}
+
+/* A file name of the translated tree made absolute (the JSON file may live elsewhere). */
+static valo_status absolute(cJSON *item, const char *dir, valo_error *err) {
+  const char *v = cJSON_GetStringValue(item);
+  if (!v || v[0] == '/' || !dir[0]) return VALO_OK;
+  char full[4096];
+  snprintf(full, sizeof full, "%s/%s", dir, v);
+  if (!cJSON_SetValuestring(item, full)) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  return VALO_OK;
+}
+
+valo_status mitsuba_to_json(const char *path, const char *defines, const char *out, valo_error *err) {
+  mctx c;
+  valo_status st = translate_file(&c, path, defines, err);
+  char dir[4096] = "";
+  char *real = st ? NULL : realpath(path, NULL);
+  if (real) {
+    char *slash = strrchr(real, '/');
+    if (slash) snprintf(dir, sizeof dir, "%.*s", (int)(slash - real), real);
+    free(real);
+  }
+  /* Every value that names a file: shapes' "file", media's and the environment's "file",
+   * and a material's string values other than its type and named choices. */
+  static const char *const names[] = {"type", "preset", "distribution", "dispersion", NULL};
+  for (cJSON *sh = c.shapes ? c.shapes->child : NULL; !st && sh; sh = sh->next) st = absolute(cJSON_GetObjectItemCaseSensitive(sh, "file"), dir, err);
+  for (cJSON *m = c.media ? c.media->child : NULL; !st && m; m = m->next) st = absolute(cJSON_GetObjectItemCaseSensitive(m, "file"), dir, err);
+  if (!st) st = absolute(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(c.out, "environment"), "file"), dir, err);
+  for (cJSON *m = c.materials ? c.materials->child : NULL; !st && m; m = m->next)
+    for (cJSON *k = m->child; !st && k; k = k->next) {
+      int named = 0;
+      for (int i = 0; names[i]; i++) named |= !strcmp(k->string, names[i]);
+      if (!named) st = absolute(k, dir, err);
+    }
+  char *text = st ? NULL : cJSON_Print(c.out);
+  if (!st && !text) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
+  if (!st) {
+    size_t n = strlen(text);
+    text[n] = '\n'; /* cJSON_Print's NUL becomes the last line's end */
+    if (atomic_write(out, text, n + 1)) st = err_set(err, VALO_ERR_IO, "%s: cannot write: %s", out, strerror(errno));
+  }
+  free(text);
+  translation_free(&c);
   return st;
 }
