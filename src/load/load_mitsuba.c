@@ -261,16 +261,9 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   cJSON_AddStringToObject(sh, "material", name);
   for (int side = 0; side < 2; side++) {
     const char *key = side ? "exterior" : "interior";
-    xml_node *med = NULL;
-    for (xml_node *k = n->child; k && !med; k = k->next) {
-      const char *nm = xml_attr_get(k, "name");
-      if (!nm || strcmp(nm, key)) continue;
-      k->used = 1;
-      med = !strcmp(k->name, "ref") ? mi_find_id(c, xml_attr_get(k, "id") ? xml_attr_get(k, "id") : "") : k;
-      if (!med) return mi_bad(c, k, "refers to an id that no element has");
-      if (strcmp(med->name, "medium")) return mi_bad(c, k, "must be a <medium>");
-    }
+    xml_node *med = mi_prop(c, n, key); /* inline, or a ref (check_refs: it names an element) */
     if (!med) continue;
+    if (strcmp(med->name, "medium")) return mi_bad(c, med, "is the shape's %s: it must be a <medium>", key);
     TRY(mi_medium(c, med, name, sizeof name));
     cJSON_AddStringToObject(sh, key, name);
   }

@@ -372,6 +372,15 @@ valo_status mi_medium(mctx *c, xml_node *med, char *name, size_t n) {
 
 /* ---- emitters ---- */
 
+/* An emitter's constant colour `name` as o's `key`; Mitsuba's default is 1. */
+static valo_status color_or_one(mctx *c, xml_node *e, const char *name, cJSON *o, const char *key) {
+  cJSON *v;
+  TRY(mi_color(c, e, name, 1, &v));
+  if (!v && !(v = vec3_json(1, 1, 1))) return NOMEM;
+  cJSON_AddItemToObject(o, key, v);
+  return VALO_OK;
+}
+
 valo_status mi_emitter(mctx *c, xml_node *e) {
   const char *type = xml_attr_get(e, "type");
   if (!type) return mi_bad(c, e, "needs a type");
@@ -384,9 +393,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
     if (!env) return NOMEM;
     if (type[0] == 'c') {
       cJSON_AddStringToObject(env, "type", "constant");
-      cJSON *v;
-      TRY(mi_color(c, e, "radiance", 1, &v));
-      cJSON_AddItemToObject(env, "radiance", v ? v : vec3_json(1, 1, 1));
+      TRY(color_or_one(c, e, "radiance", env, "radiance"));
     } else {
       const char *file = NULL;
       double scale = 1;
@@ -419,14 +426,12 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
   c->light_line = ln;
   ln[c->nlight_line++] = e->line;
   double org[3] = {m[3], m[7], m[11]}, dir[3] = {m[2], m[6], m[10]};
-  cJSON *v;
   if (!strcmp(type, "point")) {
     vec3 p = v3((float)org[0], (float)org[1], (float)org[2]);
     TRY(mi_point(c, e, "position", &p));
     cJSON_AddStringToObject(l, "type", "point");
     cJSON_AddItemToObject(l, "position", vec3_json(p.x, p.y, p.z));
-    TRY(mi_color(c, e, "intensity", 1, &v));
-    cJSON_AddItemToObject(l, "intensity", v ? v : vec3_json(1, 1, 1));
+    TRY(color_or_one(c, e, "intensity", l, "intensity"));
   } else if (!strcmp(type, "spot")) {
     double cutoff = 20, beam = -1;
     TRY(mi_float(c, e, "cutoff_angle", &cutoff));
@@ -438,8 +443,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
     cJSON_AddStringToObject(l, "type", "spot");
     cJSON_AddItemToObject(l, "position", vec3_json(org[0], org[1], org[2]));
     cJSON_AddItemToObject(l, "look_at", vec3_json(org[0] + dir[0] / dl, org[1] + dir[1] / dl, org[2] + dir[2] / dl));
-    TRY(mi_color(c, e, "intensity", 1, &v));
-    cJSON_AddItemToObject(l, "intensity", v ? v : vec3_json(1, 1, 1));
+    TRY(color_or_one(c, e, "intensity", l, "intensity"));
     cJSON_AddNumberToObject(l, "cone_angle", cutoff);
     cJSON_AddNumberToObject(l, "cone_delta_angle", beam < cutoff ? cutoff - beam : 0);
   } else if (!strcmp(type, "directional")) {
@@ -447,8 +451,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
     TRY(mi_point(c, e, "direction", &d));
     cJSON_AddStringToObject(l, "type", "directional");
     cJSON_AddItemToObject(l, "direction", vec3_json(d.x, d.y, d.z));
-    TRY(mi_color(c, e, "irradiance", 1, &v));
-    cJSON_AddItemToObject(l, "irradiance", v ? v : vec3_json(1, 1, 1));
+    TRY(color_or_one(c, e, "irradiance", l, "irradiance"));
   } else if (!strcmp(type, "area")) {
     return mi_bad(c, e, "an area emitter belongs inside the <shape> that emits");
   } else {

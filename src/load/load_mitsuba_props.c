@@ -328,7 +328,7 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int rgb_only, cJSON
 xml_node *mi_child(mctx *c, xml_node *p, const char *tag, int nth) {
   for (xml_node *k = p->child; k; k = k->next) {
     xml_node *t = k;
-    if (!strcmp(k->name, "ref") && !xml_attr_get(k, "name")) {
+    if (!strcmp(k->name, "ref")) { /* named or not: the target's tag decides */
       const char *id = xml_attr_get(k, "id");
       t = id ? mi_find_id(c, id) : NULL;
       if (!t) continue;
