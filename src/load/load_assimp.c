@@ -8,6 +8,7 @@
 #include "load/load.h"
 #include "core/error.h"
 #include "core/memlimit.h"
+#include "core/mat34.h"
 #include <stdio.h>
 #include <sys/stat.h>
 #include <strings.h>
@@ -31,51 +32,6 @@
 
 #define MESH_MEMORY_FACTOR 8 /* a mesh file is counted at this many times its size (load_mesh) */
 
-typedef struct mat34 { float m[3][4]; } mat34;
-
-static mat34 m34_identity(void) {
-  mat34 r = {{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
-  return r;
-}
-static mat34 m34_mul(const mat34 *a, const mat34 *b) {
-  mat34 r;
-  for (int i = 0; i < 3; i++)
-    for (int j = 0; j < 4; j++) {
-      float v = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] + a->m[i][2] * b->m[2][j];
-      if (j == 3) v += a->m[i][3];
-      r.m[i][j] = v;
-    }
-  return r;
-}
-static vec3 m34_point(const mat34 *a, vec3 p) {
-  return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z + a->m[0][3],
-            a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z + a->m[1][3],
-            a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z + a->m[2][3]);
-}
-static vec3 m34_vector(const mat34 *a, vec3 p) {
-  return v3(a->m[0][0] * p.x + a->m[0][1] * p.y + a->m[0][2] * p.z, a->m[1][0] * p.x + a->m[1][1] * p.y + a->m[1][2] * p.z,
-            a->m[2][0] * p.x + a->m[2][1] * p.y + a->m[2][2] * p.z);
-}
-static float m34_det(const mat34 *a) {
-  const float(*m)[4] = a->m;
-  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-}
-/* Cofactor matrix = det * inverse transpose: transforms normals (normalised after). */
-static mat34 m34_normal_matrix(const mat34 *a) {
-  const float(*m)[4] = a->m;
-  mat34 r = m34_identity();
-  r.m[0][0] = m[1][1] * m[2][2] - m[1][2] * m[2][1];
-  r.m[0][1] = m[1][2] * m[2][0] - m[1][0] * m[2][2];
-  r.m[0][2] = m[1][0] * m[2][1] - m[1][1] * m[2][0];
-  r.m[1][0] = m[0][2] * m[2][1] - m[0][1] * m[2][2];
-  r.m[1][1] = m[0][0] * m[2][2] - m[0][2] * m[2][0];
-  r.m[1][2] = m[0][1] * m[2][0] - m[0][0] * m[2][1];
-  r.m[2][0] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
-  r.m[2][1] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
-  r.m[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-  return r;
-}
 static mat34 m34_from_ai(const struct aiMatrix4x4 *t) {
   mat34 r = {{{t->a1, t->a2, t->a3, t->a4}, {t->b1, t->b2, t->b3, t->b4}, {t->c1, t->c2, t->c3, t->c4}}};
   return r;
@@ -263,78 +219,54 @@ typedef struct load_ctx {
   valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
 } load_ctx;
 
+_Static_assert(sizeof(struct aiVector3D) == 3 * sizeof(float), "Assimp's vectors are read as 3 floats");
 static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 *xf) {
   scene *s = c->s;
   if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return VALO_OK;
+  uint32_t mat = c->override_mat != UINT32_MAX ? c->override_mat : c->mat_base + mesh->mMaterialIndex;
+  if (mat >= s->nmats) return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' names material %u that does not exist", c->path, mesh->mName.data, mesh->mMaterialIndex);
   if (scene_reserve(s, mesh->mNumVertices, mesh->mNumFaces)) return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
-  mat34 nm = m34_normal_matrix(xf);
-  int flip = m34_det(xf) < 0;
-  uint32_t base = s->nverts;
   /* glTF TANGENT (xyz, w): Assimp gives the tangent and the bitangent w (n x t); the
    * scene's tangent array is made when the first file gives one */
   int has_tan = c->gltf && mesh->mTangents && mesh->mBitangents && mesh->mNormals;
   if (has_tan && !s->tan_file && !(s->tan_file = calloc((size_t)s->cap_verts * 4, sizeof(float))))
     return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
-  for (unsigned v = 0; v < mesh->mNumVertices; v++) {
-    const struct aiVector3D *p = &mesh->mVertices[v];
-    vec3 pv = v3(p->x, p->y, p->z);
-    if (!v3_finite(pv))
-      return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' vertex %u is not finite (%g %g %g)", c->path,
-                     mesh->mName.data, v, (double)p->x, (double)p->y, (double)p->z);
-    pv = m34_point(xf, pv);
-    if (!v3_finite(pv)) return err_set(c->err, VALO_ERR_INVALID, "%s: vertex %u is not finite after the transform", c->path, v);
-    s->pos[base + v] = pv;
-    vec3 n = v3(0, 0, 0);
-    if (mesh->mNormals) {
-      n = v3(mesh->mNormals[v].x, mesh->mNormals[v].y, mesh->mNormals[v].z);
-      n = v3_finite(n) ? v3_norm(m34_vector(&nm, n)) : v3(0, 0, 0);
-      if (!v3_finite(n)) n = v3(0, 0, 0);
-    }
-    s->nrm[base + v] = n;
-    float *tf = s->tan_file ? &s->tan_file[4 * (size_t)(base + v)] : NULL;
-    if (tf) tf[0] = tf[1] = tf[2] = tf[3] = 0;
-    if (tf && has_tan && v3_len2(n) > 0) {
-      vec3 t = m34_vector(xf, v3(mesh->mTangents[v].x, mesh->mTangents[v].y, mesh->mTangents[v].z));
-      vec3 bt = m34_vector(xf, v3(mesh->mBitangents[v].x, mesh->mBitangents[v].y, mesh->mBitangents[v].z));
-      if (v3_finite(t) && v3_finite(bt) && v3_len2(t) > 0) {
-        tf[0] = t.x; tf[1] = t.y; tf[2] = t.z;
-        tf[3] = v3_dot(v3_cross(n, t), bt) < 0 ? -1.0f : 1.0f;
-      }
-    }
-    float u = 0, w = 0;
-    if (mesh->mTextureCoords[0]) { u = mesh->mTextureCoords[0][v].x; w = mesh->mTextureCoords[0][v].y; }
-    s->uv[2 * (base + v)] = isfinite(u) ? u : 0;
-    s->uv[2 * (base + v) + 1] = isfinite(w) ? w : 0;
-  }
-  s->nverts += mesh->mNumVertices;
-  uint32_t mat = c->override_mat != UINT32_MAX ? c->override_mat : c->mat_base + mesh->mMaterialIndex;
-  if (mat >= s->nmats) return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' names material %u that does not exist", c->path, mesh->mName.data, mesh->mMaterialIndex);
-  const material *mm = &s->mats[mat];
-  if (!mesh->mTextureCoords[0] && material_has_maps(mm))
-    log_warning("%s: mesh '%s' has no texture coordinates, so the maps of its material '%s' are ignored", c->path, mesh->mName.data, mm->name);
+  /* The triangles (points and lines skipped), their indices checked in the file's numbering. */
+  uint32_t *idx = malloc((size_t)mesh->mNumFaces * 3 * sizeof *idx + 1), nt = 0;
+  if (!idx) return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
   for (unsigned f = 0; f < mesh->mNumFaces; f++) {
     const struct aiFace *face = &mesh->mFaces[f];
-    if (face->mNumIndices != 3) continue; /* points and lines */
-    uint32_t i0 = face->mIndices[0], i1 = face->mIndices[1], i2 = face->mIndices[2];
-    if (i0 >= mesh->mNumVertices || i1 >= mesh->mNumVertices || i2 >= mesh->mNumVertices)
-      return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' face %u has a vertex index out of range (mesh has %u vertices)",
-                     c->path, mesh->mName.data, f, mesh->mNumVertices);
-    if (flip) { uint32_t t = i1; i1 = i2; i2 = t; }
-    uint32_t ti = s->ntris;
-    s->idx[3 * ti] = base + i0; s->idx[3 * ti + 1] = base + i1; s->idx[3 * ti + 2] = base + i2;
-    vec3 ng = scene_tri_ng(s, ti);
-    float a2 = v3_len2(ng);
-    if (!(a2 > 0) || !isfinite(a2)) { c->degenerate++; continue; }
-    uint8_t fl = 0;
-    if (mesh->mNormals && !c->flat && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
-      fl |= TRI_HAS_NORMALS;
-    if (mesh->mTextureCoords[0]) fl |= TRI_HAS_UVS;
-    s->tri_mat[ti] = mat;
-    s->tri_flags[ti] = fl;
-    s->ntris++;
-    c->added++;
+    if (face->mNumIndices != 3) continue;
+    for (int k = 0; k < 3; k++) {
+      if (face->mIndices[k] >= mesh->mNumVertices) {
+        free(idx);
+        return err_set(c->err, VALO_ERR_INVALID, "%s: mesh '%s' face %u has a vertex index out of range (mesh has %u vertices)",
+                       c->path, mesh->mName.data, f, mesh->mNumVertices);
+      }
+      idx[3 * nt + k] = face->mIndices[k];
+    }
+    nt++;
   }
-  return VALO_OK;
+  char where[1400];
+  snprintf(where, sizeof where, "%s: mesh '%s'", c->path, mesh->mName.data);
+  const struct aiVector3D *uv = mesh->mTextureCoords[0];
+  mesh_data md = {where, mesh->mNumVertices, nt, (const float *)mesh->mVertices, (const float *)mesh->mNormals,
+                  uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat};
+  uint32_t base = s->nverts;
+  valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
+  free(idx);
+  for (unsigned v = 0; st == VALO_OK && has_tan && v < mesh->mNumVertices; v++) {
+    vec3 n = s->nrm[base + v];
+    float *tf = &s->tan_file[4 * (size_t)(base + v)];
+    if (!(v3_len2(n) > 0)) continue;
+    vec3 t = m34_vector(xf, v3(mesh->mTangents[v].x, mesh->mTangents[v].y, mesh->mTangents[v].z));
+    vec3 bt = m34_vector(xf, v3(mesh->mBitangents[v].x, mesh->mBitangents[v].y, mesh->mBitangents[v].z));
+    if (v3_finite(t) && v3_finite(bt) && v3_len2(t) > 0) {
+      tf[0] = t.x; tf[1] = t.y; tf[2] = t.z;
+      tf[3] = v3_dot(v3_cross(n, t), bt) < 0 ? -1.0f : 1.0f;
+    }
+  }
+  return st;
 }
 
 static valo_status walk(load_ctx *c, const struct aiNode *node, const mat34 *parent) {
@@ -533,8 +465,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
       if (c.override_mat == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
     }
   }
-  mat34 x = m34_identity();
-  if (xf12) memcpy(x.m, xf12, sizeof x.m);
+  mat34 x = m34_from(xf12);
   if (!ai->mRootNode) { st = err_set(err, VALO_ERR_PARSE, "%s: the file has no scene graph", path); goto done; }
   st = walk(&c, ai->mRootNode, &x);
   if (st) goto done;

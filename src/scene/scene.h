@@ -206,6 +206,24 @@ camera scene_camera_fit(const scene *s, float aspect);
  * else `still` (the lens of `still` is kept either way). */
 camera scene_camera_at(const scene *s, const camera *still, float f);
 
+/* A triangle mesh in a file's own arrays, for scene_add_mesh: 3 floats per vertex for
+ * positions and normals (NULL: none), uv_stride floats per vertex for texture coordinates
+ * (v up, as valo reads them; NULL: none), 3 indices per triangle. where names it in
+ * messages ("file: mesh 'x'"); flat: shade with the triangles' own normals. */
+typedef struct mesh_data {
+  const char *where;
+  uint32_t nverts, ntris;
+  const float *pos, *nrm, *uv;
+  int uv_stride;
+  const uint32_t *idx;
+  int flat;
+} mesh_data;
+/* Appends m placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps each
+ * triangle's front side), every triangle of material mat (< s->nmats). Non-finite
+ * positions and indices out of range are errors; zero-area triangles are skipped.
+ * *added and *degenerate count the triangles kept and skipped. */
+valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf, uint32_t mat, uint64_t *added, uint64_t *degenerate,
+                           valo_error *err);
 /* Adds a tessellated sphere (icosphere with `subdiv` subdivisions); flip: normals
  * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,

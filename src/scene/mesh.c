@@ -1,0 +1,60 @@
+/* mesh.c — owns appending a triangle mesh, given in a file's own arrays, to the scene:
+ * placed by a transform (normals by its normal matrix, the winding kept facing the same
+ * way under a mirroring one), non-finite data refused, degenerate triangles skipped.
+ * Every mesh loader (Assimp's formats, Mitsuba's serialized meshes) comes through here. */
+#include "scene/scene.h"
+#include "core/error.h"
+#include "core/mat34.h"
+
+valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint32_t mat, uint64_t *added, uint64_t *degenerate,
+                           valo_error *err) {
+  if (scene_reserve(s, m->nverts, m->ntris)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", m->where);
+  mat34 xf = m34_from(xf12), nm = m34_normal_matrix(&xf);
+  int flip = m34_det(&xf) < 0;
+  uint32_t base = s->nverts;
+  for (uint32_t v = 0; v < m->nverts; v++) {
+    const float *p = &m->pos[3 * (size_t)v];
+    vec3 pv = v3(p[0], p[1], p[2]);
+    if (!v3_finite(pv))
+      return err_set(err, VALO_ERR_INVALID, "%s vertex %u is not finite (%g %g %g)", m->where, v, (double)p[0], (double)p[1], (double)p[2]);
+    pv = m34_point(&xf, pv);
+    if (!v3_finite(pv)) return err_set(err, VALO_ERR_INVALID, "%s vertex %u is not finite after the transform", m->where, v);
+    s->pos[base + v] = pv;
+    vec3 n = v3(0, 0, 0);
+    if (m->nrm) {
+      const float *q = &m->nrm[3 * (size_t)v];
+      n = v3(q[0], q[1], q[2]);
+      n = v3_finite(n) ? v3_norm(m34_vector(&nm, n)) : v3(0, 0, 0);
+      if (!v3_finite(n)) n = v3(0, 0, 0);
+    }
+    s->nrm[base + v] = n;
+    if (s->tan_file) memset(&s->tan_file[4 * (size_t)(base + v)], 0, 4 * sizeof(float));
+    float u = 0, w = 0;
+    if (m->uv) { u = m->uv[(size_t)m->uv_stride * v]; w = m->uv[(size_t)m->uv_stride * v + 1]; }
+    s->uv[2 * (base + v)] = isfinite(u) ? u : 0;
+    s->uv[2 * (base + v) + 1] = isfinite(w) ? w : 0;
+  }
+  s->nverts += m->nverts;
+  if (!m->uv && material_has_maps(&s->mats[mat]))
+    log_warning("%s has no texture coordinates, so the maps of its material '%s' are ignored", m->where, s->mats[mat].name);
+  for (uint32_t f = 0; f < m->ntris; f++) {
+    uint32_t i0 = m->idx[3 * (size_t)f], i1 = m->idx[3 * (size_t)f + 1], i2 = m->idx[3 * (size_t)f + 2];
+    if (i0 >= m->nverts || i1 >= m->nverts || i2 >= m->nverts)
+      return err_set(err, VALO_ERR_INVALID, "%s triangle %u has a vertex index out of range (%u vertices)", m->where, f, m->nverts);
+    if (flip) { uint32_t t = i1; i1 = i2; i2 = t; }
+    uint32_t ti = s->ntris;
+    s->idx[3 * ti] = base + i0; s->idx[3 * ti + 1] = base + i1; s->idx[3 * ti + 2] = base + i2;
+    vec3 ng = scene_tri_ng(s, ti);
+    float a2 = v3_len2(ng);
+    if (!(a2 > 0) || !isfinite(a2)) { (*degenerate)++; continue; }
+    uint8_t fl = 0;
+    if (m->nrm && !m->flat && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
+      fl |= TRI_HAS_NORMALS;
+    if (m->uv) fl |= TRI_HAS_UVS;
+    s->tri_mat[ti] = mat;
+    s->tri_flags[ti] = fl;
+    s->ntris++;
+    (*added)++;
+  }
+  return VALO_OK;
+}
