@@ -11,6 +11,10 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint
   if (scene_reserve(s, m->nverts, m->ntris)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", m->where);
   mat34 xf = m34_from(xf12), nm = m34_normal_matrix(&xf);
   int flip = m34_det(&xf) < 0;
+  /* Normals go by the inverse transpose: the cofactor matrix over the determinant, whose
+   * sign matters (a mirroring transform would otherwise turn them against the faces). */
+  for (int i = 0; flip && i < 3; i++)
+    for (int j = 0; j < 3; j++) nm.m[i][j] = -nm.m[i][j];
   uint32_t base = s->nverts;
   for (uint32_t v = 0; v < m->nverts; v++) {
     const float *p = &m->pos[3 * (size_t)v];
