@@ -14,7 +14,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "tests", "data", "mitsuba-xml")
 # name: (scene file under ../shared/scenes, its defaults); tests/test_mitsuba.c passes the
 # same values with --define.
-SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "path", "resx": "320", "resy": "180"})}
+SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "path", "resx": "320", "resy": "180"}),
+          "torus": ("torus/mitsuba-source/scene.xml", {"integrator": "path", "resx": "160", "resy": "120"})}
 
 
 def main():

@@ -135,7 +135,7 @@ static int bad_mitsuba(void) {
   static const struct { const char *name, *xml, *said1, *said2; } cases[] = {
       {"mx1.xml", "<scene version=\"3.0.0\">\n<shape type=\"obj\">\n</scene>\n", "mx1.xml:3:3", "end tag does not match <shape> of line 2"},
       {"mx2.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"serialized\"><string name=\"filename\" value=\"a.serialized\"/></shape>\n</scene>",
-       "mx2.xml:3: <shape type=\"serialized\">", "convert them to PLY or OBJ"},
+       "a.serialized: cannot open", "(the <shape> at line 3)"},
       {"mx3.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"hair\"/></shape>\n</scene>", "mx3.xml:3: <bsdf type=\"hair\">",
        "valo has no such BSDF"},
       {"mx4.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"$kind\"/>\n</scene>", "mx4.xml:3", "$kind has no <default"},

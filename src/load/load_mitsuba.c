@@ -201,7 +201,8 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   TRY(mi_transform(c, n, "to_world", m, &has_xf));
   int flip = 0;
   TRY(mi_bool(c, n, "flip_normals", &flip));
-  if (!strcmp(type, "obj") || !strcmp(type, "ply")) {
+  int serialized = !strcmp(type, "serialized");
+  if (!strcmp(type, "obj") || !strcmp(type, "ply") || serialized) {
     const char *file = NULL;
     TRY(mi_string(c, n, "filename", &file));
     if (!file) return mi_bad(c, n, "needs <string name=\"filename\">");
@@ -211,6 +212,12 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     if (fn) cJSON_AddTrueToObject(sh, "face_normals");
     (void)mi_prop(c, n, "flip_tex_coords"); /* Mitsuba's default flip undoes OBJ's bottom-up v, as valo reads it */
     cJSON_AddStringToObject(sh, "file", file);
+    int index = 0;
+    if (serialized) {
+      TRY(mi_int(c, n, "shape_index", &index));
+      if (index < 0) return mi_bad(c, n, "shape_index must not be negative");
+      cJSON_AddNumberToObject(sh, "shape_index", index);
+    }
     if (has_xf) TRY(matrix_json(c, m, sh));
   } else if (!strcmp(type, "sphere")) {
     vec3 ctr = v3(0, 0, 0);
@@ -237,11 +244,8 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     cJSON_AddStringToObject(sh, "type", type);
     if (has_xf) TRY(matrix_json(c, m, sh));
     if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
-  } else if (!strcmp(type, "serialized")) {
-    return mi_bad(c, n, "Mitsuba's serialized meshes are not read; convert them to PLY or OBJ (Mitsuba's mesh export, or "
-                        "Blender's Mitsuba add-on)");
   } else {
-    return mi_bad(c, n, "valo reads obj, ply, sphere, rectangle, cube and disk shapes");
+    return mi_bad(c, n, "valo reads obj, ply, serialized, sphere, rectangle, cube and disk shapes");
   }
   /* Material: the shape's BSDF (or Mitsuba's default), with its area emitter's radiance. */
   xml_node *b = mi_child(c, n, "bsdf", 0);
@@ -250,7 +254,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   if (e) {
     const char *et = xml_attr_get(e, "type");
     if (!et || strcmp(et, "area")) return mi_bad(c, e, "a shape's emitter must be an area emitter");
-    TRY(mi_color(c, e, "radiance", 0, &emit));
+    TRY(mi_color(c, e, "radiance", MI_EMITTER, &emit));
     if (!emit && !(emit = vec_json(1, 1, 1))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     mi_warn_unused(c, e);
   }
@@ -273,10 +277,11 @@ static valo_status read_shape(mctx *c, xml_node *n) {
 
 /* ---- the document ---- */
 
-/* Mitsuba 0.6 names: camelCase becomes snake_case ("toWorld" -> "to_world", "intIOR" -> "int_ior"). */
+/* Mitsuba 0.6 names: camelCase becomes snake_case ("toWorld" -> "to_world", "intIOR" -> "int_ior").
+ * A <default>'s name is the file's own parameter ($photonCount), not a property: kept. */
 static void upgrade_names(xml_node *n) {
   for (; n; n = n->next) {
-    for (int i = 0; i < n->nattrs; i++) {
+    for (int i = 0; i < n->nattrs && strcmp(n->name, "default"); i++) {
       if (strcmp(n->attrs[i].name, "name")) continue;
       const char *v = n->attrs[i].value;
       char *o = malloc(2 * strlen(v) + 1), *q = o;

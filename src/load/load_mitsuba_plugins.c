@@ -74,7 +74,7 @@ static valo_status set_color(mctx *c, xml_node *b, const char *mname, cJSON *m, 
 /* The specular tint Mitsuba allows on its smooth and rough dielectrics: valo has none. */
 static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
   cJSON *v;
-  TRY(mi_color(c, b, name, 1, &v));
+  TRY(mi_color(c, b, name, MI_RGB_ONLY, &v));
   if (!v) return VALO_OK;
   int one = 1;
   for (int i = 0; i < 3; i++) one &= cJSON_GetArrayItem(v, i)->valuedouble == 1;
@@ -142,8 +142,8 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     const char *mat = "none";
     TRY(mi_string(c, b, "material", &mat));
     cJSON *eta = NULL, *k = NULL;
-    TRY(mi_color(c, b, "eta", 1, &eta));
-    valo_status st = mi_color(c, b, "k", 1, &k);
+    TRY(mi_color(c, b, "eta", MI_RGB_ONLY, &eta));
+    valo_status st = mi_color(c, b, "k", MI_RGB_ONLY, &k);
     if (st) { cJSON_Delete(eta); return st; }
     if (eta || k) {
       if (!eta || !k) { cJSON_Delete(eta); cJSON_Delete(k); return mi_bad(c, b, "give both eta and k"); }
@@ -292,7 +292,7 @@ static valo_status const_color(mctx *c, xml_node *med, const char *name, double 
     key = "value";
   }
   cJSON *col;
-  TRY(mi_color(c, src, key, 1, &col));
+  TRY(mi_color(c, src, key, MI_RGB_ONLY, &col));
   if (col) {
     for (int i = 0; i < 3; i++) v[i] = cJSON_GetArrayItem(col, i)->valuedouble;
     cJSON_Delete(col);
@@ -375,7 +375,7 @@ valo_status mi_medium(mctx *c, xml_node *med, char *name, size_t n) {
 /* An emitter's constant colour `name` as o's `key`; Mitsuba's default is 1. */
 static valo_status color_or_one(mctx *c, xml_node *e, const char *name, cJSON *o, const char *key) {
   cJSON *v;
-  TRY(mi_color(c, e, name, 1, &v));
+  TRY(mi_color(c, e, name, MI_RGB_ONLY | MI_EMITTER, &v));
   if (!v && !(v = vec3_json(1, 1, 1))) return NOMEM;
   cJSON_AddItemToObject(o, key, v);
   return VALO_OK;

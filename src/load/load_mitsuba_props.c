@@ -271,8 +271,9 @@ static cJSON *rgb_json(double r, double g, double b) {
   return cJSON_CreateDoubleArray(v, 3);
 }
 
-valo_status mi_color(mctx *c, xml_node *p, const char *name, int rgb_only, cJSON **out) {
+valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out) {
   *out = NULL;
+  int rgb_only = how & MI_RGB_ONLY;
   xml_node *k = mi_prop(c, p, name);
   if (!k) return VALO_OK;
   if (!strcmp(k->name, "ref")) return mi_bad(c, k, "refers to an id that no element has");
@@ -318,6 +319,10 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int rgb_only, cJSON
     if (!val || strchr(val, ':')) return mi_bad(c, k, "valo reads a spectrum given as one value; give wavelength-dependent colours as <rgb>");
     if (mi_numbers(val, v, 1) != 1) return mi_bad(c, k, "value must be a number");
     v[1] = v[2] = v[0];
+    /* The equal-energy spectrum's XYZ (1, 1, 1) in linear sRGB (Mitsuba 3 reads
+     * 1.20479, 0.948291, 0.908916 from its CIE tables). */
+    static const double E[3] = {1.2047843, 0.9483008, 0.9088427};
+    if (how & MI_EMITTER) for (int i = 0; i < 3; i++) v[i] *= E[i];
   } else {
     return mi_bad(c, k, "must be a colour (<rgb>, <spectrum>, <float>%s)", rgb_only ? "" : " or a bitmap <texture>");
   }
