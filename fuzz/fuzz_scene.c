@@ -3,7 +3,7 @@
  * commits the scene. FUZZ_NAME (set by the build) picks the file name, and so the path
  * the loader takes: scene.json (the JSON loader), scene.xml (the Mitsuba reader), mesh.obj (valo's OBJ/MTL pre-reader,
  * then Assimp), mesh.ply (valo's PLY check, then Assimp), mesh.gltf or mesh.glb (valo's
- * glTF check, then Assimp). With FUZZ_MTL the input is mesh.mtl, the material library of
+ * glTF check, then Assimp), mesh.serialized (Mitsuba's serialized meshes, every shape). With FUZZ_MTL the input is mesh.mtl, the material library of
  * a fixed OBJ that names it (valo's MTL reading, then Assimp's MTL reader, which a fuzzed
  * OBJ reaches only through a file already on disk). With FUZZ_OTHER the first byte picks a
  * format valo does not check (mesh.stl, .off, .dae, .x, .fbx, .3ds: the trial import in a

@@ -73,12 +73,12 @@ static valo_status ser_inflate(const ser_file *f, uint32_t i, unsigned char **ou
   *out = NULL;
   size_t entry = f->version == 4 ? 8 : 4, at = f->table + entry * i;
   uint64_t off = f->version == 4 ? rd64(f->b + at) : rd32(f->b + at);
-  if (off + 4 >= f->table || f->b[off] + 256 * f->b[off + 1] != SER_MAGIC || f->b[off + 2] + 256 * f->b[off + 3] != f->version)
+  if (off >= f->table || f->table - off <= 4 || f->b[off] + 256 * f->b[off + 1] != SER_MAGIC || f->b[off + 2] + 256 * f->b[off + 3] != f->version)
     return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its offset (%llu) does not lead to a shape's header", f->path, i, (unsigned long long)off);
   const char *z = (const char *)f->b + off + 4;
   size_t zlen = f->table - off - 4;
   if (zlen > INT_MAX) zlen = INT_MAX;
-  unsigned char *buf = malloc(SER_PEEK);
+  unsigned char *buf = calloc(1, SER_PEEK); /* zeroed: stb leaves its failure reason as it was on a few paths */
   if (!buf) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   int n = stbi_zlib_decode_buffer((char *)buf, SER_PEEK, z, (int)zlen);
   const char *why = stbi_failure_reason();
