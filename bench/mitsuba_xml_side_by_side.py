@@ -12,7 +12,7 @@
 # Optional tooling (Python is not needed to build, render or test valo):
 #   pip install mitsuba numpy
 #   DRJIT_LIBLLVM_PATH=~/.rustup/toolchains/stable-x86_64-unknown-linux-gnu/lib/libLLVM.so.22.1-rust-1.95.0-stable \
-#   python3 bench/mitsuba_xml_side_by_side.py [--valo build/valo] [--spp 64,256,1024] [--seeds 2] [--threads 2]
+#   python3 bench/mitsuba_xml_side_by_side.py [--valo build/valo] [--spp 64,256,1024] [--seeds 2] [--threads 2] [--only NAME]
 import argparse, importlib.util, os, subprocess, tempfile, time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -34,6 +34,7 @@ def main():
     ap.add_argument("--seed", type=int, default=12345)
     ap.add_argument("--seeds", type=int, default=2)
     ap.add_argument("--shared", default=os.path.join(ROOT, "..", "shared"))
+    ap.add_argument("--only", default="", help="one scene of scripts/mitsuba-shared-xml.py")
     a = ap.parse_args()
     import numpy as np
     import mitsuba as mi
@@ -46,8 +47,10 @@ def main():
     print("| scene | spp | Mitsuba s | Mitsuba relMSE | valo (file's sampler) s | relMSE | valo (Sobol) s | relMSE |")
     print("|---|---|---|---|---|---|---|---|")
     summary = []
-    for name, (rel, defs) in shared.SCENES.items():
-        path = os.path.join(a.shared, "scenes", rel)
+    for name, (rel, defs0) in shared.SCENES.items():
+        if a.only and a.only != name:
+            continue
+        path, defs = shared.resolve(rel, defs0, a.shared)
         ref = np.array(mi.Bitmap(os.path.join(ROOT, "tests", "data", "mitsuba-xml", name + "-mitsuba.exr")))[:, :, :3].astype(np.float32)
         s = mi.load_file(path, **defs)
         defines = sum([["-D", "%s=%s" % kv] for kv in defs.items()], [])

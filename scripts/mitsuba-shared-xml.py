@@ -21,6 +21,14 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           "sponza-serialized": ("@tests/data/mitsuba-xml/sponza-serialized.xml", {"resx": "128", "resy": "72"})}
 
 
+def resolve(path, defs, shared):
+    """The scene file of a SCENES entry and its <default> values (a repository file, "@...",
+    is given the shared folder as $shared)."""
+    if path.startswith("@"):
+        return os.path.join(ROOT, path[1:]), dict(defs, shared=os.path.abspath(shared))
+    return os.path.join(shared, "scenes", path), dict(defs)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--spp", type=int, default=8192)
@@ -34,10 +42,8 @@ def main():
     for name, (path, defs) in SCENES.items():
         if a.only and a.only != name:
             continue
-        if path.startswith("@"):  # a file of the repository's, given the shared folder
-            scene = mi.load_file(os.path.join(ROOT, path[1:]), shared=os.path.abspath(a.shared), **defs)
-        else:
-            scene = mi.load_file(os.path.join(a.shared, "scenes", path), **defs)
+        file, values = resolve(path, defs, a.shared)
+        scene = mi.load_file(file, **values)
         img = None
         passes = max(1, a.spp // 4096)
         for k in range(passes):
