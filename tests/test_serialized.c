@@ -105,7 +105,7 @@ static int near3(vec3 a, double x, double y, double z) { return near1(a.x, x) &&
 
 static int load(const char *path, int index, const float *xf, int flat, scene **out, valo_error *err) {
   *out = scene_new(path);
-  return load_serialized(*out, path, index, xf, UINT32_MAX, flat, err);
+  return load_serialized(*out, path, index, xf, UINT32_MAX, flat ? LOAD_MESH_FLAT : 0, err);
 }
 
 static int reads_shapes(void) {
@@ -230,6 +230,67 @@ static int bad_files(void) {
   return 0;
 }
 
+/* The cube [-1, 1]^3, each face split along a diagonal, so that a corner meets one
+ * triangle of one face and two of another. */
+static const double CP[] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
+static const uint32_t CI[] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 6, 2, 3, 7, 6, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+
+/* A mesh without normals, shaded smooth as Mitsuba shades it: at each vertex the mean of
+ * its faces' normals weighted by their angles there, so a cube's corner points along the
+ * diagonal however its faces are split (weights by area or by count would tilt it). */
+static int computed_normals(void) {
+  shape cube = {0, "cube", 8, 12, CP, NULL, NULL, NULL, CI, 0, 0};
+  const char *path = write_file("cube.serialized", 4, &cube, 1);
+  const float mirror[12] = {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+  for (int m = 0; m < 2; m++) {
+    scene *s = scene_new(path);
+    valo_error err;
+    CHECK(load_serialized(s, path, 0, m ? mirror : NULL, UINT32_MAX, LOAD_MESH_SMOOTH, &err) == VALO_OK, "%s", err.message);
+    for (uint32_t v = 0; v < 8; v++) {
+      vec3 p = s->pos[v], n = s->nrm[v];
+      double k = 1 / sqrt(3.0);
+      CHECK(near1(n.x, k * p.x) && near1(n.y, k * p.y) && near1(n.z, k * p.z), "%s: vertex %u at (%g %g %g): normal (%g %g %g)", m ? "mirrored" : "as written",
+            v, (double)p.x, (double)p.y, (double)p.z, (double)n.x, (double)n.y, (double)n.z);
+    }
+    for (uint32_t t = 0; t < 12; t++) CHECK(s->tri_flags[t] == TRI_HAS_NORMALS, "triangle %u flags %d", t, s->tri_flags[t]);
+    scene_free(s);
+  }
+  /* An OBJ's corners are separate vertices until joined: the same normals through the JSON
+   * key and through a Mitsuba scene; none without the key or with face_normals. */
+  char obj[1024] = "", *o = obj;
+  for (int v = 0; v < 8; v++) o += sprintf(o, "v %g %g %g\n", CP[3 * v], CP[3 * v + 1], CP[3 * v + 2]);
+  for (int t = 0; t < 12; t++) o += sprintf(o, "f %u %u %u\n", CI[3 * t] + 1, CI[3 * t + 1] + 1, CI[3 * t + 2] + 1);
+  scratch_file("cube.obj", obj);
+  static const char *const scenes[][2] = {
+      {"cube-smooth.json", "{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0]}, \"shapes\": [{\"file\": \"cube.obj\", \"smooth_normals\": true}]}"},
+      {"cube-flat.json", "{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0]}, \"shapes\": [{\"file\": \"cube.obj\"}]}"},
+      {"cube-smooth.xml", "<scene version=\"3.0.0\"><sensor type=\"perspective\"/><shape type=\"obj\"><string name=\"filename\" value=\"cube.obj\"/></shape></scene>"},
+      {"cube-flat.xml", "<scene version=\"3.0.0\"><sensor type=\"perspective\"/><shape type=\"obj\"><string name=\"filename\" value=\"cube.obj\"/>"
+                        "<boolean name=\"face_normals\" value=\"true\"/></shape></scene>"}};
+  for (int k = 0; k < 4; k++) {
+    const char *sp = scratch_file(scenes[k][0], scenes[k][1]);
+    scene *s;
+    valo_options f;
+    valo_options_init(&f);
+    valo_error err;
+    CHECK(scene_load(sp, NULL, &s, &f, &err) == VALO_OK, "%s: %s", scenes[k][0], err.message);
+    int smooth = strstr(scenes[k][0], "smooth") != NULL;
+    CHECK(s->ntris == 12, "%s: %u triangles", scenes[k][0], s->ntris);
+    for (uint32_t t = 0; t < 12; t++) {
+      CHECK((s->tri_flags[t] & TRI_HAS_NORMALS) == (smooth ? TRI_HAS_NORMALS : 0), "%s: triangle %u flags %d", scenes[k][0], t, s->tri_flags[t]);
+      for (int c = 0; c < 3 && smooth; c++) {
+        uint32_t v = s->idx[3 * t + c];
+        vec3 p = s->pos[v], n = s->nrm[v];
+        double q = 1 / sqrt(3.0);
+        CHECK(near1(n.x, q * p.x) && near1(n.y, q * p.y) && near1(n.z, q * p.z), "%s: corner at (%g %g %g): normal (%g %g %g)", scenes[k][0], (double)p.x,
+              (double)p.y, (double)p.z, (double)n.x, (double)n.y, (double)n.z);
+      }
+    }
+    scene_free(s);
+  }
+  return 0;
+}
+
 /* A triangle's corners: position, normal, uv. */
 typedef struct tri_rec { float v[3][8]; } tri_rec;
 static void tri_of(const scene *s, uint32_t t, tri_rec *r) {
@@ -278,6 +339,6 @@ static int torus_matches_obj(void) {
 }
 
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"reads_shapes", reads_shapes}, {"bad_files", bad_files}, {"torus_matches_obj", torus_matches_obj}, {NULL, NULL}};
+  static const test_case cases[] = {{"reads_shapes", reads_shapes}, {"bad_files", bad_files}, {"computed_normals", computed_normals}, {"torus_matches_obj", torus_matches_obj}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -4,6 +4,7 @@
  * warning for properties valo does not read, and Mitsuba's unit shapes. Against Mitsuba
  * itself: test_mitsuba from_xml and veach_mis_xml. */
 #include "harness.h"
+#include "load/load.h"
 #include "load/xml.h"
 #include "valo/valo.h"
 #include <math.h>
@@ -237,6 +238,32 @@ static int unread_is_said(void) {
  * facing +z fills the film with 2 seen from +z and 0 from behind; the cube [-1, 1]^3
  * faces out; the disk of radius 1 seen from distance 2 under a 60-degree field covers
  * pi / (2 x 2 tan 30)^2 = 3 pi / 16 of the film, so the film's mean is 2 x 3 pi / 16. */
+/* A perspective sensor without fov: Mitsuba's focal_length, 50mm by default, is a 35 mm
+ * film's diagonal (43.27 mm across); both fov and focal_length is an error. */
+static int focal_length(void) {
+  static const struct { const char *sensor; double diag_mm; } cases[] = {
+      {"<sensor type=\"perspective\"/>", 50}, {"<sensor type=\"perspective\"><string name=\"focal_length\" value=\"28mm\"/></sensor>", 28}};
+  for (int k = 0; k < 2; k++) {
+    char xml[512];
+    snprintf(xml, sizeof xml, "<scene version=\"3.0.0\">%s<shape type=\"sphere\"/><emitter type=\"constant\"/></scene>", cases[k].sensor);
+    scene *s;
+    valo_options f;
+    valo_options_init(&f);
+    valo_error err;
+    CHECK(scene_load(scratch_file("focal.xml", xml), NULL, &s, &f, &err) == VALO_OK, "%s", err.message);
+    /* Mitsuba's default film is 768 x 576: the diagonal's half-angle tangent times 3/5. */
+    double want = 360 / M_PI * atan(sqrt(36.0 * 36 + 24 * 24) / (2 * cases[k].diag_mm) * 0.6);
+    CHECK(fabs(s->cam.fov_deg - want) < 1e-3, "focal length %g mm: vertical fov %g, not %g", cases[k].diag_mm, (double)s->cam.fov_deg, want);
+    scene_free(s);
+  }
+  const char *both = "<scene version=\"3.0.0\"><sensor type=\"perspective\"><float name=\"fov\" value=\"30\"/>"
+                     "<string name=\"focal_length\" value=\"35mm\"/></sensor><shape type=\"sphere\"/></scene>";
+  valo_scene *sc;
+  valo_error err;
+  CHECK(valo_scene_load(scratch_file("both.xml", both), &sc, &err) != VALO_OK && strstr(err.message, "fov or focal_length"), "fov and focal_length accepted");
+  return 0;
+}
+
 static int unit_shapes(void) {
   static const char *const fmt =
       "<scene version=\"3.0.0\">\n<sensor type=\"%s\"><float name=\"fov\" value=\"60\"/>\n"
@@ -300,6 +327,6 @@ static int convert_to_json(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"convert_to_json", convert_to_json}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -25,8 +25,10 @@ valo_status mitsuba_to_json(const char *path, const char *defines, const char *o
 /* Loads a mesh file into s with transform xf (4x3 row-major, NULL = identity);
  * override_mat: material index for every triangle, or UINT32_MAX to keep the file's;
  * mesh_flags: LOAD_MESH_CAMERA, use the file's camera (its aspect sets the file's film
- * size); LOAD_MESH_FLAT, shade with the triangles' own normals, not the file's. */
-enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2 };
+ * size); LOAD_MESH_FLAT, shade with the triangles' own normals, not the file's;
+ * LOAD_MESH_SMOOTH, a file without normals is shaded with normals computed from its faces
+ * (angle-weighted over the vertices its faces share, as Mitsuba does). */
+enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2, LOAD_MESH_SMOOTH = 4 };
 valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int mesh_flags, valo_options *file,
                       valo_error *err);
 #endif

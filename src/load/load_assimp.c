@@ -216,6 +216,7 @@ typedef struct load_ctx {
   valo_error *err;
   int gltf;          /* a .gltf/.glb file: its cameras and materials need glTF meanings */
   int flat;          /* LOAD_MESH_FLAT: the file's vertex normals are not used */
+  int smooth;        /* LOAD_MESH_SMOOTH: normals computed where the file has none */
   valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
 } load_ctx;
 
@@ -251,7 +252,7 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   snprintf(where, sizeof where, "%s: mesh '%s'", c->path, mesh->mName.data);
   const struct aiVector3D *uv = mesh->mTextureCoords[0];
   mesh_data md = {where, mesh->mNumVertices, nt, (const float *)mesh->mVertices, (const float *)mesh->mNormals,
-                  uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat};
+                  uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat, c->smooth};
   uint32_t base = s->nverts;
   valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
   free(idx);
@@ -404,6 +405,9 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   valo_status pst = ply_check_file(path, &ply_fixed, &ply_fixed_len, err);
   if (pst) return pst;
   unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  /* Normals computed from the faces need the vertices the faces share: an OBJ's corners
+   * are separate vertices to Assimp until joined. */
+  if (mesh_flags & LOAD_MESH_SMOOTH) flags |= aiProcess_JoinIdenticalVertices;
   const char *ext = strrchr(path, '.');
   /* OBJ files are read by valo first (obj_check.c): checks with line numbers, repairs,
    * the MTL PBR extension; Assimp then parses the repaired text. */
@@ -439,7 +443,7 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
     return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
                    ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, file};
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)

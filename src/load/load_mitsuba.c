@@ -121,13 +121,19 @@ static valo_status read_sensor(mctx *c, xml_node *s) {
   } else {
     double fov = -1;
     TRY(mi_float(c, s, "fov", &fov));
+    const char *axis = "x", *focal = NULL;
+    TRY(mi_string(c, s, "fov_axis", &axis));
+    TRY(mi_string(c, s, "focal_length", &focal));
+    if (fov >= 0 && focal) return mi_bad(c, s, "give fov or focal_length, not both");
     if (fov < 0) {
-      if (mi_prop(c, s, "focal_length")) return mi_bad(c, s, "give the field of view as <float name=\"fov\">; valo does not read focal_length");
-      return mi_bad(c, s, "needs <float name=\"fov\">");
+      /* A 35 mm film's focal length (Mitsuba's default 50mm): the diagonal's field of view. */
+      char *end;
+      double f = strtod(focal ? focal : "50", &end);
+      if (!(f > 0) || (*end && strcmp(end, "mm"))) return mi_bad(c, s, "focal_length \"%s\" must be a length in mm (\"50mm\")", focal);
+      fov = 360 / M_PI * atan(sqrt(36.0 * 36 + 24 * 24) / (2 * f));
+      axis = "diagonal";
     }
     if (!(fov > 0 && fov < 180)) return mi_bad(c, s, "fov must be in (0, 180) degrees");
-    const char *axis = "x";
-    TRY(mi_string(c, s, "fov_axis", &axis));
     double t = tan(fov * M_PI / 360), scale; /* tan(vertical / 2) = t * scale */
     if (!strcmp(axis, "x")) scale = 1 / aspect;
     else if (!strcmp(axis, "y")) scale = 1;
@@ -210,6 +216,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     int fn = 0;
     TRY(mi_bool(c, n, "face_normals", &fn));
     if (fn) cJSON_AddTrueToObject(sh, "face_normals");
+    else cJSON_AddTrueToObject(sh, "smooth_normals"); /* Mitsuba computes normals a file lacks */
     (void)mi_prop(c, n, "flip_tex_coords"); /* Mitsuba's default flip undoes OBJ's bottom-up v, as valo reads it */
     cJSON_AddStringToObject(sh, "file", file);
     int index = 0;

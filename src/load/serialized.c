@@ -146,7 +146,7 @@ static float *take_floats(const unsigned char **p, uint64_t n, uint64_t fsz) {
   return v;
 }
 
-static valo_status ser_shape(scene *s, const ser_file *f, uint32_t i, const float *xf, uint32_t mat, int flat, valo_error *err) {
+static valo_status ser_shape(scene *s, const ser_file *f, uint32_t i, const float *xf, uint32_t mat, int mesh_flags, valo_error *err) {
   unsigned char *buf;
   size_t len;
   valo_status st = ser_inflate(f, i, &buf, &len, err);
@@ -171,7 +171,7 @@ static valo_status ser_shape(scene *s, const ser_file *f, uint32_t i, const floa
     memcpy(idx, p, 12 * (size_t)nt);
     for (uint32_t v = 0; uv && v < nv; v++) uv[2 * v + 1] = 1 - uv[2 * v + 1]; /* Mitsuba's v runs down the image */
     uint64_t added = 0, degenerate = 0;
-    mesh_data md = {where, nv, nt, pos, nrm, uv, 2, idx, flat || (flags & SER_FACE_NORMALS)};
+    mesh_data md = {where, nv, nt, pos, nrm, uv, 2, idx, (mesh_flags & LOAD_MESH_FLAT) || (flags & SER_FACE_NORMALS), (mesh_flags & LOAD_MESH_SMOOTH) != 0};
     st = scene_add_mesh(s, &md, xf, mat, &added, &degenerate, err);
     if (!st && !added) st = err_set(err, VALO_ERR_INVALID, "%s: no usable triangles (%llu degenerate)", where, (unsigned long long)degenerate);
     if (!st && degenerate) log_warning("%s: skipped %llu degenerate (zero-area) triangles", where, (unsigned long long)degenerate);
@@ -187,7 +187,7 @@ uint32_t serialized_count(const char *path, valo_error *err) {
   return st ? 0 : f.count;
 }
 
-valo_status load_serialized(scene *s, const char *path, int shape_index, const float *xf, uint32_t mat, int flat, valo_error *err) {
+valo_status load_serialized(scene *s, const char *path, int shape_index, const float *xf, uint32_t mat, int mesh_flags, valo_error *err) {
   ser_file f;
   valo_status st = ser_open(&f, path, err);
   if (!st && shape_index >= 0 && (uint32_t)shape_index >= f.count)
@@ -197,7 +197,7 @@ valo_status load_serialized(scene *s, const char *path, int shape_index, const f
     if ((mat = scene_add_material(s, &d)) == UINT32_MAX) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
   }
   for (uint32_t i = shape_index < 0 ? 0 : (uint32_t)shape_index; !st && i < (shape_index < 0 ? f.count : (uint32_t)shape_index + 1); i++)
-    st = ser_shape(s, &f, i, xf, mat, flat, err);
+    st = ser_shape(s, &f, i, xf, mat, mesh_flags, err);
   free(f.b);
   return st;
 }

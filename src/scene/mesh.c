@@ -1,10 +1,43 @@
 /* mesh.c — owns appending a triangle mesh, given in a file's own arrays, to the scene:
  * placed by a transform (normals by its normal matrix, the winding kept facing the same
  * way under a mirroring one), non-finite data refused, degenerate triangles skipped.
+ * Where a file gives no normals they may be computed from the faces (Mitsuba's rule).
  * Every mesh loader (Assimp's formats, Mitsuba's serialized meshes) comes through here. */
 #include "scene/scene.h"
 #include "core/error.h"
 #include "core/mat34.h"
+
+/* The angle between unit vectors a and b (stable near 0 and pi). */
+static float unit_angle(vec3 a, vec3 b) { return 2 * atan2f(v3_len(v3_sub(a, b)), v3_len(v3_add(a, b))); }
+
+/* Vertex normals for a mesh whose file gives none: at each vertex the mean of its faces'
+ * unit normals, each weighted by the face's angle there (Thuermer and Wuethrich 1998, as
+ * Mitsuba does), over the vertices its faces share; from the placed (and, under a
+ * mirroring transform, rewound) triangles, so they face as the triangles do. */
+static void smooth_normals(scene *s, const mesh_data *m, uint32_t base, int flip) {
+  for (uint32_t f = 0; f < m->ntris; f++) {
+    uint32_t i[3] = {m->idx[3 * (size_t)f], m->idx[3 * (size_t)f + 1], m->idx[3 * (size_t)f + 2]};
+    if (i[0] >= m->nverts || i[1] >= m->nverts || i[2] >= m->nverts) continue; /* refused below */
+    if (flip) { uint32_t t = i[1]; i[1] = i[2]; i[2] = t; }
+    vec3 p[3] = {s->pos[base + i[0]], s->pos[base + i[1]], s->pos[base + i[2]]};
+    vec3 n = v3_cross(v3_sub(p[1], p[0]), v3_sub(p[2], p[0]));
+    float l2 = v3_len2(n);
+    if (!(l2 > 0) || !isfinite(l2)) continue;
+    n = v3_scale(n, 1 / sqrtf(l2));
+    for (int k = 0; k < 3; k++) {
+      vec3 a = v3_sub(p[(k + 1) % 3], p[k]), b = v3_sub(p[(k + 2) % 3], p[k]);
+      float la = v3_len(a), lb = v3_len(b);
+      if (!(la > 0) || !(lb > 0)) continue;
+      float w = unit_angle(v3_scale(a, 1 / la), v3_scale(b, 1 / lb));
+      s->nrm[base + i[k]] = v3_add(s->nrm[base + i[k]], v3_scale(n, w));
+    }
+  }
+  for (uint32_t v = 0; v < m->nverts; v++) {
+    vec3 n = s->nrm[base + v];
+    float l2 = v3_len2(n);
+    s->nrm[base + v] = l2 > 0 && isfinite(l2) ? v3_scale(n, 1 / sqrtf(l2)) : v3(0, 0, 0);
+  }
+}
 
 valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint32_t mat, uint64_t *added, uint64_t *degenerate,
                            valo_error *err) {
@@ -39,6 +72,8 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint
     s->uv[2 * (base + v) + 1] = isfinite(w) ? w : 0;
   }
   s->nverts += m->nverts;
+  int computed = !m->nrm && m->smooth && !m->flat;
+  if (computed) smooth_normals(s, m, base, flip);
   if (!m->uv && material_has_maps(&s->mats[mat]))
     log_warning("%s has no texture coordinates, so the maps of its material '%s' are ignored", m->where, s->mats[mat].name);
   for (uint32_t f = 0; f < m->ntris; f++) {
@@ -52,7 +87,7 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint
     float a2 = v3_len2(ng);
     if (!(a2 > 0) || !isfinite(a2)) { (*degenerate)++; continue; }
     uint8_t fl = 0;
-    if (m->nrm && !m->flat && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
+    if ((m->nrm || computed) && !m->flat && v3_len2(s->nrm[base + i0]) > 0 && v3_len2(s->nrm[base + i1]) > 0 && v3_len2(s->nrm[base + i2]) > 0)
       fl |= TRI_HAS_NORMALS;
     if (m->uv) fl |= TRI_HAS_UVS;
     s->tri_mat[ti] = mat;

@@ -209,14 +209,16 @@ camera scene_camera_at(const scene *s, const camera *still, float f);
 /* A triangle mesh in a file's own arrays, for scene_add_mesh: 3 floats per vertex for
  * positions and normals (NULL: none), uv_stride floats per vertex for texture coordinates
  * (v up, as valo reads them; NULL: none), 3 indices per triangle. where names it in
- * messages ("file: mesh 'x'"); flat: shade with the triangles' own normals. */
+ * messages ("file: mesh 'x'"); flat: shade with the triangles' own normals; smooth: when
+ * nrm is NULL, shade with vertex normals computed from the faces, angle-weighted (as
+ * Mitsuba does for a mesh file without normals). */
 typedef struct mesh_data {
   const char *where;
   uint32_t nverts, ntris;
   const float *pos, *nrm, *uv;
   int uv_stride;
   const uint32_t *idx;
-  int flat;
+  int flat, smooth;
 } mesh_data;
 /* Appends m placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps each
  * triangle's front side), every triangle of material mat (< s->nmats). Non-finite
