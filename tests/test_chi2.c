@@ -24,7 +24,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 61
+#define CHI2_TESTS 64
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -539,6 +539,73 @@ static double light_pf(void *c, vec3 d) {
   vec3 pl = v3_add(x->p, v3_scale(d, t));
   return light_pdf_area(&x->l, x->p, pl, v3_norm(scene_tri_ng(x->s, x->l.tri)));
 }
+/* An emitting sphere's cone (light.h): from a point near it (a wide cone) and from one
+ * 100 radii away (a cone of 3e-4 sr, where 1 - cos loses digits in float unless
+ * computed as valo does), directions uniform in (1 - cos theta) / (1 - cos max) and in
+ * phi about the axis, none outside, the density 1 / (2 pi (1 - cos max)); the
+ * sphere's selection probability the sum of its triangles', in the grid and by power. */
+typedef struct cone_ctx { light_cone k; } cone_ctx;
+static int cone_sf(void *c, sampler *s, vec3 *d) {
+  float u1 = sampler_1d(s), u2 = sampler_1d(s);
+  *d = light_cone_sample(&((cone_ctx *)c)->k, u1, u2);
+  return 1;
+}
+static double cone_pf(void *c, vec3 d) {
+  const light_cone *k = &((cone_ctx *)c)->k;
+  return v3_dot(d, k->axis) >= 1 - k->one_minus_cos ? k->pdf : 0;
+}
+static int sphere_cone(void) {
+  scene *s = scene_new("chi2-sphere");
+  material m = material_default();
+  m.emission = c3(1, 1, 1);
+  uint32_t mi = scene_add_material(s, &m);
+  valo_error err;
+  vec3 ctr = v3(0.3f, -0.2f, 0.5f);
+  CHECK(scene_add_sphere(s, ctr, 0.5f, 2, 0, 1, mi, &err) == VALO_OK, "%s", err.message);
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->nlights == 320 && s->nspheres == 1 && s->spheres[0].l1 == 320, "%u lights; the sphere's %u..%u", s->nlights, s->spheres[0].l0, s->spheres[0].l1);
+  int rc = 0;
+  for (int mode = 0; mode < 2; mode++) {
+    light_sampler ls;
+    CHECK(light_sampler_init(&ls, s, mode ? LIGHT_SELECT_POWER : LIGHT_SELECT_GRID) == 0 && ls.power_cdf, "init");
+    static const float dist[2] = {0.8f, 50.0f};
+    for (int far = 0; far < 2; far++) {
+      vec3 p = v3_add(ctr, v3_scale(v3_norm(v3(0.3f, 1, -0.4f)), dist[far]));
+      cone_ctx c;
+      CHECK(light_sphere_at(&ls, s, 17, p, &c.k), "no cone from %g radii", dist[far] / 0.5);
+      double sum = 0;
+      for (uint32_t i = 0; i < s->nlights; i++) sum += light_select_pmf(&ls, s, i, p);
+      double range = light_range_pmf(&ls, 0, s->nlights, p);
+      CHECK(fabs(range - sum) < 1e-5 && fabs(range - 1) < 1e-5, "%s: the sphere's pmf %.7f, its lights' %.7f", mode ? "power" : "grid", range, sum);
+      if (mode) continue;
+      double want = 2 * M_PI * (1 - sqrt(1 - 0.25 / ((double)dist[far] * dist[far])));
+      CHECK(fabs(1 / (c.k.pdf * want) - 1) < 1e-4, "cone of %g sr, pdf %g", want, (double)c.k.pdf);
+      if (!far) rc |= run_chi2("sphere light's cone from 1.6 radii", &c, cone_sf, cone_pf);
+      /* In the cone's own terms: (1 - cos) / (1 - cos max) and phi, 10 x 10 cells. */
+      double obs[100] = {0}, ex[100];
+      long n = nsamples() / 4;
+      frame f = frame_from_n(c.k.axis);
+      for (long i = 0; i < n; i++) {
+        sampler sm = sampler_make(99, (uint64_t)i, 0);
+        vec3 d;
+        cone_sf(&c, &sm, &d);
+        vec3 l = frame_to_local(&f, d);
+        double omc = (double)(l.x * l.x + l.y * l.y) / (1 + l.z); /* 1 - cos without cancellation */
+        double ph = atan2(l.y, l.x);
+        if (ph < 0) ph += 2 * M_PI;
+        int a = (int)(omc / c.k.one_minus_cos * 10), b = (int)(ph / (2 * M_PI) * 10);
+        CHECK(a <= 10, "a direction outside the cone (%g of its 1 - cos)", omc / c.k.one_minus_cos);
+        obs[(a > 9 ? 9 : a) * 10 + (b > 9 ? 9 : b)]++;
+      }
+      for (int i = 0; i < 100; i++) ex[i] = n / 100.0;
+      rc |= chi2_check(far ? "sphere light's cone from 100 radii, its own cells" : "sphere light's cone from 1.6 radii, its own cells", obs, ex, 100);
+    }
+    light_sampler_free(&ls);
+  }
+  scene_free(s);
+  return rc;
+}
+
 static int light_sampling(void) {
   scene *s = scene_new("chi2");
   scene_reserve(s, 3, 1);
@@ -1009,7 +1076,7 @@ int main(int argc, char **argv) {
                                     {"mirror_mixture", mirror_mixture},
                                     {"energy_conservation", energy_conservation},
                                     {"delta_lobes", delta_lobes},
-                                    {"light_sampling", light_sampling},
+                                    {"light_sampling", light_sampling}, {"sphere_cone", sphere_cone},
                                     {"alias_table", alias_table_chi2},
                                     {"chi2_rejects_wrong_pdf", chi2_rejects_wrong_pdf},
                                     {"rough_conductor", rough_conductor},

@@ -67,6 +67,10 @@ typedef struct valo_options {
                              than 64: "grid" (default: a distribution per cell of a grid
                              over the scene, by power over distance squared) or "power"
                              (by power alone) */
+  char sphere_lights[16]; /* how next-event estimation samples an emitting sphere seen
+                             from outside: "cone" (default: a direction in the cone it
+                             subtends, traced to the sphere) or "triangles" (each of its
+                             triangles as an area light) */
   int aovs;               /* non-zero: also record the AOVs (albedo, normal, depth) that
                              valo_render_write can then write; with the VALO_AOVS_AO bit
                              also ambient occlusion and the bent normal (one more ray

@@ -35,19 +35,54 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return accel_occluded(c->acc, &r);
 }
 
-uint32_t direct_light_sample(const render_ctx *c, vec3 p, sampler *smp, float *pmf, light_li *ls) {
+/* An emitting sphere's sample: a direction in its cone k, and the first solid surface
+ * along it, which must be one of the sphere's triangles. */
+static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, const isect *it, float u1, float u2, thread_stats *ts,
+                              float *pmf, light_li *ls) {
+  const scene *s = c->s;
+  vec3 wi = light_cone_sample(k, u1, u2);
+  ray r = {it ? offset_origin_isect(it, wi) : p, wi, INFINITY};
+  hit h;
+  isect hi;
+  float before;
+  if (!ctx_intersect_solid(c, r, &h, &hi, &before, ts)) return UINT32_MAX;
+  int32_t lid = s->tri_light[h.tri];
+  if (lid < (int32_t)k->sp->l0 || lid >= (int32_t)k->sp->l1) return UINT32_MAX; /* blocked, or past the faces' edge */
+  memset(ls, 0, sizeof *ls);
+  ls->wi = wi;
+  ls->dist = before + h.t;
+  ls->p_light = hi.p;
+  ls->n_light = hi.ng;
+  ls->L = light_area_radiance(s, &s->lights[lid], hi.ng, v3_neg(wi), hi.u, hi.v);
+  ls->pdf = k->pdf;
+  ls->visible = 1;
+  *pmf = light_range_pmf(&c->ls, k->sp->l0, k->sp->l1, p);
+  return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
+}
+
+uint32_t direct_light_sample(const render_ctx *c, vec3 p, const isect *it, sampler *smp, thread_stats *ts, float *pmf, light_li *ls) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
   uint32_t li = light_select(&c->ls, c->s, p, ul, pmf);
-  if (li == UINT32_MAX || !light_sample(c->s, &c->s->lights[li], p, u1, u2, ls)) return UINT32_MAX;
+  if (li == UINT32_MAX) return UINT32_MAX;
+  light_cone k;
+  if (light_sphere_at(&c->ls, c->s, li, p, &k)) return sphere_sample(c, &k, p, it, u1, u2, ts, pmf, ls);
+  if (!light_sample(c->s, &c->s->lights[li], p, u1, u2, ls)) return UINT32_MAX;
+  ls->visible = 0;
   return li;
+}
+
+float ctx_light_pdf_area(const render_ctx *c, uint32_t li, vec3 p, vec3 p_light, vec3 n_light) {
+  light_cone k;
+  if (light_sphere_at(&c->ls, c->s, li, p, &k)) return light_range_pmf(&c->ls, k.sp->l0, k.sp->l1, p) * k.pdf;
+  return ctx_light_pmf(c, li, p) * light_pdf_area(&c->s->lights[li], p, p_light, n_light);
 }
 
 int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, int mis, direct_sample *out) {
   float pmf;
   light_li ls;
-  if (direct_light_sample(c, it->p, smp, &pmf, &ls) == UINT32_MAX) return 0;
+  if (direct_light_sample(c, it->p, it, smp, ts, &pmf, &ls) == UINT32_MAX) return 0;
   vec3 wi_l = frame_to_local(fr, ls.wi), wo_l = frame_to_local(fr, wo);
   rgb f = bsdf_eval(b, wo_l, wi_l);
   ts->surface_samples++;
@@ -68,12 +103,14 @@ int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b
   out->p_light = ls.p_light;
   out->n_light = ls.n_light;
   out->far = isinf(ls.dist);
+  out->visible = ls.visible;
   return 1;
 }
 
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out) {
-  return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) && !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts);
+  return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) &&
+         (out->visible || !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts));
 }
 
 static rgb direct_rgb(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

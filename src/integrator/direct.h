@@ -21,8 +21,14 @@ int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *be
  * origin) */
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);
 /* Picks a light for point p (the sampler's next 1D value) and samples it (the next 2D):
- * returns its index with *pmf and *ls, or UINT32_MAX when nothing came out. */
-uint32_t direct_light_sample(const render_ctx *c, vec3 p, sampler *smp, float *pmf, light_li *ls);
+ * returns its index with *pmf and *ls, or UINT32_MAX when nothing came out. it: the
+ * surface p lies on (NULL in a medium). A light of an emitting sphere seen from outside
+ * is sampled through the sphere's cone (light.h, light_sphere_at): a ray is traced, and
+ * *pmf is the sphere's; ls->visible says the light was found unblocked. */
+uint32_t direct_light_sample(const render_ctx *c, vec3 p, const isect *it, sampler *smp, thread_stats *ts, float *pmf, light_li *ls);
+/* The density (per steradian at p) with which direct_light_sample picks the point p_light
+ * (normal n_light) of area light li: the MIS weight of a BSDF-sampled hit there. */
+float ctx_light_pdf_area(const render_ctx *c, uint32_t li, vec3 p, vec3 p_light, vec3 n_light);
 /* Probability that estimate_direct picks light index li at shading point p. */
 static inline float ctx_light_pmf(const render_ctx *c, uint32_t li, vec3 p) { return light_select_pmf(&c->ls, c->s, li, p); }
 
@@ -35,12 +41,12 @@ rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const f
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
-typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi, p_light, n_light; int far; } direct_sample;
+typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi, p_light, n_light; int far, visible; } direct_sample;
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out);
 /* sample_direct without the shadow ray: the caller tests the segment to out->p_light
  * (out->n_light; out->far: the light is at infinity) itself (through media:
- * path_media.c). */
+ * path_media.c); out->visible: nothing solid lies on it. */
 int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, int mis, direct_sample *out);
 /* The same estimate with weight 1 (light sampling alone): for integrators that never

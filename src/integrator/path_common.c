@@ -22,7 +22,7 @@ static float path_emission_weight(const render_ctx *c, const path_state *st, int
   if (st->specular) return 1;
   const scene *s = c->s;
   if (env) return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)c->ls.env_index, st->prev_p) * light_pdf_env(s, &s->lights[c->ls.env_index], d));
-  return power_heuristic(st->prev_pdf, ctx_light_pmf(c, (uint32_t)lid, st->prev_p) * light_pdf_area(&s->lights[lid], st->prev_p, it->p, it->ng));
+  return power_heuristic(st->prev_pdf, ctx_light_pdf_area(c, (uint32_t)lid, st->prev_p, it->p, it->ng));
 }
 
 void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *st, const hit *h, const isect *it, rgb *Le, float *w) {

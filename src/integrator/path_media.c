@@ -54,7 +54,7 @@ static spec4 medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sa
                            thread_stats *ts) {
   float pmf;
   light_li ls;
-  if (direct_light_sample(c, p, smp, &pmf, &ls) == UINT32_MAX) return spec_const(0);
+  if (direct_light_sample(c, p, NULL, smp, ts, &pmf, &ls) == UINT32_MAX) return spec_const(0);
   float f = phase_hg(v3_dot(wo, ls.wi), c->s->media[med].g), light_pdf = pmf * ls.pdf;
   if (!(f > 0) || !(light_pdf > 0)) return spec_const(0);
   spec4 tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), key, wl, ts);

@@ -124,6 +124,14 @@ int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode
   ls->power = w;
   ls->n = s->nlights;
   ls->local = s->nlights <= LIGHT_LOCAL_MAX;
+  ls->sphere_cones = 1;
+  int spheres = 0;
+  for (uint32_t g = 0; g < s->nspheres; g++) spheres |= s->spheres[g].l1 > s->spheres[g].l0;
+  if (spheres && !ls->local) {
+    if (!(ls->power_cdf = malloc(s->nlights * sizeof *ls->power_cdf))) return -1;
+    double acc = 0;
+    for (uint32_t i = 0; i < s->nlights; i++) ls->power_cdf[i] = acc += alias_pmf(&ls->table, i);
+  }
   if (!ls->local && mode == LIGHT_SELECT_GRID && grid_build(ls, s)) return -1;
   return 0;
 }
@@ -131,6 +139,8 @@ void light_sampler_free(light_sampler *ls) {
   alias_free(&ls->table);
   free(ls->power);
   free(ls->grid_cdf);
+  free(ls->power_cdf);
+  ls->power_cdf = NULL;
   ls->power = NULL;
   ls->grid_cdf = NULL;
 }
@@ -223,6 +233,39 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
   if (!ls->local) return alias_pmf(&ls->table, li);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   return total > 0 ? w[li] / total : 0;
+}
+
+float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p) {
+  if (ls->table.n == 0 || ls->local || !ls->power_cdf || l1 <= l0) return 0;
+  double power = ls->power_cdf[l1 - 1] - (l0 ? ls->power_cdf[l0 - 1] : 0);
+  const float *row = ls->grid_cdf ? grid_row(ls, p) : NULL;
+  if (!row) return (float)power;
+  /* light_select_at draws from the row's running sums: a range is drawn with exactly the
+   * difference of its ends */
+  float cell = row[l1 - 1] - (l0 ? row[l0 - 1] : 0);
+  return (float)(LIGHT_GRID_POWER * power + (1 - LIGHT_GRID_POWER) * cell);
+}
+
+int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k) {
+  if (!ls->sphere_cones || !ls->power_cdf || li >= s->nlights) return 0;
+  const light *l = &s->lights[li];
+  if (l->type != LIGHT_AREA || !l->sphere) return 0;
+  const sphere_shape *sp = &s->spheres[l->sphere - 1];
+  vec3 d = v3_sub(sp->c, p);
+  float d2 = v3_len2(d), rr = sp->r * (1 + LIGHT_SPHERE_MARGIN);
+  if (!(d2 > rr * rr) || !isfinite(d2)) return 0;
+  float sin2 = sp->r * sp->r / d2, cos_max = sqrtf(fmaxf(0.0f, 1 - sin2));
+  k->sp = sp;
+  k->axis = v3_scale(d, 1 / sqrtf(d2));
+  k->one_minus_cos = sin2 / (1 + cos_max); /* without cancellation for a small, far sphere */
+  k->pdf = 1 / (2 * PI_F * k->one_minus_cos);
+  return isfinite(k->pdf) && k->pdf > 0;
+}
+
+vec3 light_cone_sample(const light_cone *k, float u1, float u2) {
+  float omc = u1 * k->one_minus_cos, c = 1 - omc, sn = sqrtf(fmaxf(0.0f, omc * (2 - omc))), phi = 2 * PI_F * u2;
+  frame f = frame_from_n(k->axis);
+  return v3_norm(frame_to_world(&f, v3(sn * cosf(phi), sn * sinf(phi), c)));
 }
 
 static float spot_falloff(const light *l, float cos_t) {

@@ -30,6 +30,8 @@
 typedef enum light_select_mode { LIGHT_SELECT_GRID, LIGHT_SELECT_POWER } light_select_mode;
 typedef struct light_sampler {
   alias_table table; int env_index; float *power; uint32_t n; int local;
+  int sphere_cones;     /* emitting spheres sampled whole (light_sphere_at); set after init */
+  double *power_cdf;    /* running sums of the power pmf, when the scene has emitting spheres */
   float *grid_cdf;      /* per cell, n running sums normalised to 1 (cells with nothing: all 0) */
   int gdim[3];
   vec3 glo, ginv;       /* grid origin and cells per unit length */
@@ -47,6 +49,32 @@ light_site light_locate(const light_sampler *ls, vec3 p);
 uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf);
 /* The probability light_select picks light li at p. */
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p);
+/* The probability light_select picks any of the lights [l0, l1) at p (not in the local
+ * mode). */
+float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p);
+
+/* Emitting spheres (scene.spheres whose lights are [l0, l1)) are sampled whole where
+ * they can be: when ls->sphere_cones is set, the sampler is not the local one and p lies
+ * outside the sphere by more than LIGHT_SPHERE_MARGIN of its radius, next-event
+ * estimation (direct.c) that picks any of its lights takes a direction uniformly in the
+ * cone the sphere subtends from p instead, and the sphere's first triangle along it as
+ * the light sample: the faces lie inside the sphere, so the cone holds every direction
+ * that reaches them, and a direction that meets anything else first brings nothing. The
+ * density of a direction is then light_range_pmf(l0, l1, p) * cone.pdf, for light
+ * sampling and for the MIS weight of a BSDF-sampled hit alike. Mitsuba samples its
+ * analytic spheres so (its sphere's sample_direction); for a small lamp seen from afar
+ * area sampling spends half its samples on the far side and weighs the rest by cos. */
+#define LIGHT_SPHERE_MARGIN 1e-3f
+typedef struct light_cone {
+  const sphere_shape *sp;
+  vec3 axis;           /* unit, from p towards the centre */
+  float one_minus_cos; /* 1 - cos of the cone's half-angle */
+  float pdf;           /* 1 / (2 pi one_minus_cos), per steradian */
+} light_cone;
+/* 1 and *k when light li at p is sampled through its sphere's cone; else 0. */
+int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k);
+/* A unit direction uniform in the cone (u1 in [0,1) from its axis outwards). */
+vec3 light_cone_sample(const light_cone *k, float u1, float u2);
 
 typedef struct light_li {
   vec3 wi;       /* unit direction from the reference point towards the light */
@@ -56,6 +84,8 @@ typedef struct light_li {
   rgb L;         /* incident radiance (area/env) or intensity/d^2 (delta lights) */
   float pdf;     /* solid-angle density (area/env), 1 for delta lights */
   int delta;
+  int visible;   /* found as the first solid surface along a traced ray (an emitting
+                    sphere's cone sample, direct.c): no shadow ray needed */
 } light_li;
 
 /* Samples light l as seen from p; returns 0 if it contributes nothing. */

@@ -22,7 +22,7 @@ void scene_free(scene *s) {
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
   for (uint32_t i = 0; i < s->nmedia; i++) density_grid_free(s->media[i].grid);
-  free(s->media); free(s->shape_media); free(s->tri_media);
+  free(s->media); free(s->shape_media); free(s->tri_media); free(s->spheres);
   envmap_destroy(s->env_map);
   for (uint32_t i = 0; i < s->ntex; i++) texture_free(&s->tex[i]);
   free(s->tex);
@@ -267,6 +267,19 @@ valo_status scene_commit(scene *s, valo_error *err) {
     if (!(l.area > 0)) continue;
     s->tri_light[t] = (int32_t)s->nlights;
     if (scene_add_light(s, &l)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  }
+  /* An emitting sphere whose triangles are all lights, in order, is one light source to
+   * sampling (light.h, light_sphere_at). */
+  for (uint32_t g = 0; g < s->nspheres; g++) {
+    sphere_shape *sp = &s->spheres[g];
+    sp->l0 = sp->l1 = 0;
+    if (sp->flip || sp->end <= sp->first || s->tri_light[sp->first] < 0) continue;
+    uint32_t l0 = (uint32_t)s->tri_light[sp->first], t = sp->first;
+    while (t < sp->end && s->tri_light[t] == (int32_t)(l0 + (t - sp->first))) t++;
+    if (t < sp->end) continue;
+    sp->l0 = l0;
+    sp->l1 = l0 + (sp->end - sp->first);
+    for (uint32_t l = sp->l0; l < sp->l1; l++) s->lights[l].sphere = g + 1;
   }
   valo_status mst = commit_media(s, err);
   if (mst) return mst;

@@ -84,7 +84,16 @@ typedef struct light {
   vec3 ng, n;      /* scene_tri_ng and its unit vector */
   vec3 centroid;   /* (v0 + v1 + v2) / 3 */
   int tex_ke;      /* its material's emission texture, -1: none */
+  uint32_t sphere; /* area, after commit: 1 + the index of the emitting sphere (scene.spheres)
+                      whose triangles it is one of, when that sphere is sampled whole; 0: none */
 } light;
+
+/* A sphere of scene_add_sphere: its triangles [first, end), its centre and radius (its
+ * vertices lie on the sphere, its faces inside it); flip: facing inwards. After commit,
+ * when it emits outwards and each of its triangles is an area light, its lights are
+ * [l0, l1), in triangle order, and light sampling may take it whole (light.h); else
+ * l0 == l1. */
+typedef struct sphere_shape { vec3 c; float r; uint32_t first, end; int flip; uint32_t l0, l1; } sphere_shape;
 
 typedef struct camera {
   vec3 pos, look_at, up;
@@ -152,6 +161,8 @@ typedef struct scene {
   uint32_t nmedia;
   shape_media *shape_media;/* shapes that bound media, in triangle order */
   uint32_t nshape_media;
+  sphere_shape *spheres;   /* the spheres scene_add_sphere made, nspheres of them */
+  uint32_t nspheres;
   int32_t *tri_media;      /* after commit, when a shape bounds a medium: 2 per triangle,
                               interior and exterior medium (MEDIUM_KEEP: no boundary);
                               else NULL */
