@@ -207,6 +207,7 @@ static int bad_files(void) {
   struct { const char *name, *said; shape s; int index; } bad[] = {
       {"early.serialized", "ends early", {F_NRM, "q", 4, 2, QP, QN, NULL, NULL, QI, 6, 0}, 0},
       {"more.serialized", "more data than its header says", {F_NRM, "q", 4, 2, QP, QN, NULL, NULL, QI, 0, 300000}, 0},
+      {"one-more.serialized", "more data than its header says", {F_NRM, "q", 4, 2, QP, QN, NULL, NULL, QI, 0, 1}, 0},
       {"huge.serialized", "up to 2^32 - 1", {0, "q", 4, 2, QP, NULL, NULL, NULL, QI, 1ull << 40, 0}, 0},
       {"ratio.serialized", "more than its", {0, "q", 4, 2, QP, NULL, NULL, NULL, QI, 1ull << 31, 0}, 0},
       {"index.serialized", "shape 0 'q' triangle 1 has a vertex index out of range (4 vertices)", {0, "q", 4, 2, QP, NULL, NULL, NULL, far_idx, 0, 0}, 0},

@@ -35,8 +35,11 @@ valo_status scene_load(const char *path, const valo_load_options *lo, scene **ou
     return err_set(err, VALO_ERR_INVALID, "--define sets a Mitsuba scene's <default> values; %s is not a Mitsuba scene (.xml)", path);
   }
   s->up_z = !strcmp(lo->up, "z");
-  valo_status st = xml ? load_mitsuba(s, path, lo->defines, file, err) : json ? load_json(s, path, file, err) : str_ends_with(path, ".serialized") ? load_serialized(s, path, -1, NULL, UINT32_MAX, LOAD_MESH_SMOOTH, err)
-           : load_mesh(s, path, NULL, UINT32_MAX, LOAD_MESH_CAMERA, file, err);
+  valo_status st;
+  if (xml) st = load_mitsuba(s, path, lo->defines, file, err);
+  else if (json) st = load_json(s, path, file, err);
+  else if (str_ends_with(path, ".serialized")) st = load_serialized(s, path, -1, NULL, UINT32_MAX, LOAD_MESH_SMOOTH, err); /* every shape */
+  else st = load_mesh(s, path, NULL, UINT32_MAX, LOAD_MESH_CAMERA, file, err);
   if (st == VALO_OK && lo->env_file[0]) {
     /* --env replaces whatever environment the scene had. */
     envmap_destroy(s->env_map);

@@ -78,57 +78,66 @@ static valo_status ser_inflate(const ser_file *f, uint32_t i, unsigned char **ou
   const char *z = (const char *)f->b + off + 4;
   size_t zlen = f->table - off - 4;
   if (zlen > INT_MAX) zlen = INT_MAX;
-  unsigned char *buf = calloc(1, SER_PEEK); /* zeroed: stb leaves its failure reason as it was on a few paths */
+  /* The header, from a bounded first decode (zeroed: stb leaves its failure reason as it
+   * was on a few paths). */
+  valo_status st = VALO_OK;
+  unsigned char *buf = calloc(1, SER_PEEK);
   if (!buf) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   int n = stbi_zlib_decode_buffer((char *)buf, SER_PEEK, z, (int)zlen);
   const char *why = stbi_failure_reason();
   int partial = n < 0 && why && !strcmp(why, "output buffer limit"); /* at least SER_PEEK - 65535 bytes decoded */
+  size_t have = n >= 0 ? (size_t)n : partial ? SER_PEEK - 65535 : 0, p = 4;
+  uint64_t need = 0;
   if (n < 0 && !partial) {
-    free(buf);
-    return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its compressed data is damaged (%s)", f->path, i, why ? why : "zlib");
+    st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its compressed data is damaged (%s)", f->path, i, why ? why : "zlib");
+    goto done;
   }
-  size_t have = n >= 0 ? (size_t)n : SER_PEEK - 65535, p = 4;
-  if (have < 4 + 16) { free(buf); return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends inside its header", f->path, i); }
-  uint32_t flags = rd32(buf);
+  if (have < 4 + 16) {
+    st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends inside its header", f->path, i);
+    goto done;
+  }
   if (f->version == 4) {
     while (p < have && p < SER_NAME_MAX && buf[p]) p++;
-    if (p >= have || buf[p]) { free(buf); return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its name is not ended within %d bytes", f->path, i, SER_NAME_MAX); }
+    if (p >= have || buf[p]) {
+      st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its name is not ended within %d bytes", f->path, i, SER_NAME_MAX);
+      goto done;
+    }
     p++;
   }
-  if (p + 16 > have) { free(buf); return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends inside its header", f->path, i); }
+  if (p + 16 > have) {
+    st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends inside its header", f->path, i);
+    goto done;
+  }
+  uint32_t flags = rd32(buf);
   uint64_t nv = rd64(buf + p), nt = rd64(buf + p + 8);
   if (nv > UINT32_MAX || nt > UINT32_MAX) {
-    free(buf);
-    return err_set(err, VALO_ERR_PARSE, "%s: shape %u: %llu vertices and %llu triangles (valo reads up to 2^32 - 1 of each)", f->path, i,
-                   (unsigned long long)nv, (unsigned long long)nt);
+    st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: %llu vertices and %llu triangles (valo reads up to 2^32 - 1 of each)", f->path, i,
+                 (unsigned long long)nv, (unsigned long long)nt);
+    goto done;
   }
   uint64_t fsz = flags & SER_DOUBLE ? 8 : 4;
   uint64_t per_vertex = 3 + (flags & SER_NORMALS ? 3 : 0) + (flags & SER_UVS ? 2 : 0) + (flags & SER_COLORS ? 3 : 0);
-  uint64_t need = p + 16 + nv * per_vertex * fsz + nt * 12;
+  need = p + 16 + nv * per_vertex * fsz + nt * 12;
   if (need > 1032 * (uint64_t)zlen + 64) {
-    free(buf);
-    return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its header claims %llu bytes, more than its %zu compressed bytes can hold", f->path, i,
-                   (unsigned long long)need, zlen);
+    st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its header claims %llu bytes, more than its %zu compressed bytes can hold", f->path, i,
+                 (unsigned long long)need, zlen);
+    goto done;
   }
-  valo_status st = mem_check(need, f->path, "a serialized shape's data", err);
-  if (st) { free(buf); return st; }
+  if ((st = mem_check(need, f->path, "a serialized shape's data", err))) goto done;
   if (n < 0 || (size_t)n != need) { /* decode again into exactly the size the header claims */
-    if (n >= 0 && (size_t)n < need) {
-      free(buf);
-      return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends early (%d of %llu bytes)", f->path, i, n, (unsigned long long)need);
-    }
     free(buf);
     if (!(buf = malloc(need + 1))) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", f->path);
     n = stbi_zlib_decode_buffer((char *)buf, (int)(need + 1), z, (int)zlen);
-    if (n < 0 || (size_t)n != need) {
-      why = stbi_failure_reason();
-      free(buf);
-      if (n >= 0) return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends early (%d of %llu bytes)", f->path, i, n, (unsigned long long)need);
-      if (why && !strcmp(why, "output buffer limit"))
-        return err_set(err, VALO_ERR_PARSE, "%s: shape %u: it holds more data than its header says (%llu bytes)", f->path, i, (unsigned long long)need);
-      return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its compressed data is damaged (%s)", f->path, i, why ? why : "zlib");
-    }
+    why = stbi_failure_reason();
+    if (n >= 0 && (size_t)n < need)
+      st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its data ends early (%d of %llu bytes)", f->path, i, n, (unsigned long long)need);
+    else if ((n >= 0 && (size_t)n > need) || (n < 0 && why && !strcmp(why, "output buffer limit")))
+      st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: it holds more data than its header says (%llu bytes)", f->path, i, (unsigned long long)need);
+    else if (n < 0)
+      st = err_set(err, VALO_ERR_PARSE, "%s: shape %u: its compressed data is damaged (%s)", f->path, i, why ? why : "zlib");
   }
+done:
+  if (st) { free(buf); return st; }
   *out = buf;
   *out_len = need;
   return VALO_OK;

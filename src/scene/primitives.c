@@ -3,6 +3,7 @@
  * 3x4 transform. */
 #include "scene/scene.h"
 #include "core/error.h"
+#include "core/mat34.h"
 #include <math.h>
 #include <stdlib.h>
 
@@ -59,21 +60,17 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
 }
 
 
-static vec3 xf_point(const float *xf, vec3 p) {
-  return v3(xf[0] * p.x + xf[1] * p.y + xf[2] * p.z + xf[3], xf[4] * p.x + xf[5] * p.y + xf[6] * p.z + xf[7],
-            xf[8] * p.x + xf[9] * p.y + xf[10] * p.z + xf[11]);
-}
-
 /* Appends flat triangles (no shading normals) over nv vertices with their UVs. */
 static valo_status add_flat(scene *s, const vec3 *p, const float *uv, uint32_t nv, const uint32_t *idx, uint32_t nt, const float *xf,
                             int flip, uint32_t mat, valo_error *err) {
-  float det = xf[0] * (xf[5] * xf[10] - xf[6] * xf[9]) - xf[1] * (xf[4] * xf[10] - xf[6] * xf[8]) + xf[2] * (xf[4] * xf[9] - xf[5] * xf[8]);
+  mat34 m = m34_from(xf);
+  float det = m34_det(&m);
   if (!(fabsf(det) > 0) || !isfinite(det)) return err_set(err, VALO_ERR_INVALID, "%s: a shape's transform is singular (it flattens the shape)", s->path);
   if (det < 0) flip = !flip; /* a mirroring transform keeps the front side, as for meshes */
   if (scene_reserve(s, nv, nt)) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   uint32_t base = s->nverts;
   for (uint32_t v = 0; v < nv; v++) {
-    s->pos[base + v] = xf_point(xf, p[v]);
+    s->pos[base + v] = m34_point(&m, p[v]);
     if (!v3_finite(s->pos[base + v])) return err_set(err, VALO_ERR_INVALID, "%s: a shape's vertex is not finite after its transform", s->path);
     s->nrm[base + v] = v3(0, 0, 0);
     s->uv[2 * (base + v)] = uv[2 * v];
@@ -94,8 +91,6 @@ static valo_status add_flat(scene *s, const vec3 *p, const float *uv, uint32_t n
 #define DISK_SEGMENTS 256
 
 valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, uint32_t mat, valo_error *err) {
-  static const float id[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-  if (!xf) xf = id;
   if (kind == PRIM_RECTANGLE) {
     const vec3 p[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
