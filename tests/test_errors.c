@@ -150,7 +150,7 @@ static int bad_mitsuba(void) {
       {"mx9.xml", "<scene version=\"3.0.0\">\n<shape type=\"sphere\"/>\n</scene>", "mx9.xml:1: <scene>", "has no <sensor>"},
       {"mx10.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><transform name=\"to_world\"><scale x=\"1\" y=\"2\" z=\"1\"/></transform></shape>\n</scene>",
        "mx10.xml:3: <shape type=\"sphere\">", "no ellipsoids"},
-      {"mx11.xml", "<scene version=\"3.0.0\">\n<include filename=\"other.xml\"/>\n</scene>", "mx11.xml:2: <include>", "merge the included file"},
+      {"mx11.xml", "<scene version=\"3.0.0\">\n<include filename=\"other.xml\"/>\n</scene>", "other.xml", "(the <include> at "},
       {"mx12.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/></shape>\n</scene>", "none.obj",
        "(the <shape> at line 3)"},
       {"mx13.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><float name=\"radius\" value=\"-1\"/></shape>\n</scene>", "mx13.xml",

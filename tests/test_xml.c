@@ -1,8 +1,8 @@
 /* test_xml.c — Mitsuba scene files (.xml): the XML reader (entities, comments, errors with
  * line and column), the translation into valo's scene (an XML scene renders as the JSON
  * scene it means), Mitsuba 0.6's camelCase names, <default> values and --define, the
- * warning for properties valo does not read, and Mitsuba's unit shapes. Against Mitsuba
- * itself: test_mitsuba from_xml and veach_mis_xml. */
+ * warning for properties valo does not read, Mitsuba's unit shapes, and <include>. Against
+ * Mitsuba itself: test_mitsuba from_xml and veach_mis_xml. */
 #include "harness.h"
 #include "load/load.h"
 #include "load/xml.h"
@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static int parser(void) {
   const char *ok = "<?xml version='1.0'?>\n<!-- a comment -->\n<scene version=\"3.0.0\">\n"
@@ -324,9 +325,77 @@ static int convert_to_json(void) {
   return 0;
 }
 
+/* <include>: XML_SCENE cut into five files (a scene root's children spliced in, a
+ * single <bsdf> root, one in a subfolder including another, one written in Mitsuba 0.6's
+ * names) renders bit for bit as the whole; a missing file, a file that includes itself and
+ * an error inside an included file are said with the file and line they are in. */
+static int includes(void) {
+  char *whole = strdup(XML_SCENE), *main_xml = malloc(strlen(XML_SCENE) + 400);
+  CHECK(whole && main_xml, "memory");
+  /* the pieces: from the first <bsdf> to the first <shape>, the shapes, the emitters */
+  char *b0 = strstr(whole, "  <bsdf type=\"twosided\""), *b1 = strstr(whole, "  <bsdf type=\"roughconductor\""),
+       *s0 = strstr(whole, "  <shape type=\"rectangle\""), *s3 = strstr(whole, "  <shape type=\"disk\""),
+       *e0 = strstr(whole, "  <emitter type=\"point\"");
+  CHECK(b0 && b1 && s0 && s3 && e0, "XML_SCENE's layout");
+  char dir[1100];
+  snprintf(dir, sizeof dir, "%s/inc", scratch_dir());
+  mkdir(dir, 0755);
+  char buf[4096];
+  snprintf(buf, sizeof buf, "<scene version=\"3.0.0\">\n%.*s</scene>\n", (int)(b1 - b0), b0);
+  scratch_file("inc-white.xml", buf);
+  /* the metal in 0.6's names, as a lone <bsdf> root */
+  snprintf(buf, sizeof buf, "<bsdf version=\"0.6.0\" type=\"roughconductor\" id=\"metal\"><float name=\"alpha\" value=\"0.09\"/>"
+                            "<rgb name=\"eta\" value=\"0.2 0.9 1.1\"/>\n<rgb name=\"k\" value=\"3.9, 2.4, 2.1\"/>"
+                            "<rgb name=\"specularReflectance\" value=\"0.8, 0.8, 0.8\"/></bsdf>\n");
+  scratch_file("inc-metal.xml", buf);
+  snprintf(buf, sizeof buf, "<scene version=\"3.0.0\">\n%.*s  <include filename=\"inc-lamp.xml\"/>\n</scene>\n", (int)(s3 - s0), s0);
+  scratch_file("inc/shapes.xml", buf);
+  snprintf(buf, sizeof buf, "%.*s", (int)(e0 - s3), s3);
+  scratch_file("inc-lamp.xml", buf);
+  snprintf(main_xml, strlen(XML_SCENE) + 400, "%.*s  <include filename=\"inc-white.xml\"/>\n  <include filename=\"inc-metal.xml\"/>\n"
+           "  <include filename=\"inc/shapes.xml\"/>\n%s", (int)(b0 - whole), whole, e0);
+  int w1, h1, w2, h2;
+  warnings_capture(1);
+  float *a = render_path(scratch_file("inc-main.xml", main_xml), &w1, &h1);
+  int warned = warnings_text()[0] != 0;
+  warnings_capture(0);
+  float *b = render_path(scratch_file("inc-whole.xml", XML_SCENE), &w2, &h2);
+  CHECK(a && b, "render");
+  CHECK(!warned, "warnings (printed above)");
+  CHECK(w1 == w2 && h1 == h2 && !memcmp(a, b, (size_t)w1 * h1 * 3 * sizeof(float)), "the included pieces render differently from the whole");
+  free(a); free(b);
+  /* and the test can tell: the metal without its 0.6 name upgraded is warned about */
+  snprintf(buf, sizeof buf, "<bsdf type=\"roughconductor\" id=\"metal\"><rgb name=\"specularReflectance\" value=\"0.8\"/></bsdf>\n");
+  scratch_file("inc-metal.xml", buf);
+  warnings_capture(1);
+  valo_scene *sc;
+  valo_error err;
+  valo_status st = valo_scene_load(scratch_file("inc-main.xml", main_xml), &sc, &err);
+  char said[2048];
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  CHECK(st == VALO_OK, "%s", err.message);
+  valo_scene_destroy(sc);
+  CHECK(strstr(said, "inc-metal.xml:1: <rgb name=\"specularReflectance\">: not read"), "said: %s", said);
+  static const struct { const char *inc, *text, *want[2]; } bad[] = {
+      {"inc-none.xml", NULL, {"inc-none.xml", "(the <include> at "}},
+      {"inc-self.xml", "<scene version=\"3.0.0\">\n<include filename=\"inc-self.xml\"/>\n</scene>\n", {"inc-self.xml:2: <include>", "more than 15 deep"}},
+      {"inc-bad.xml", "<scene version=\"3.0.0\">\n\n<shape/>\n</scene>\n", {"inc-bad.xml:3: <shape>", "needs a type"}},
+      {"inc-broken.xml", "<scene version=\"3.0.0\">\n<shape>\n</scene>\n", {"inc-broken.xml:3:", "(the <include> at "}},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    if (bad[i].text) scratch_file(bad[i].inc, bad[i].text);
+    snprintf(buf, sizeof buf, "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<include filename=\"%s\"/>\n</scene>\n", bad[i].inc);
+    CHECK(valo_scene_load(scratch_file("inc-top.xml", buf), &sc, &err) != VALO_OK, "%s: loaded", bad[i].inc);
+    CHECK(strstr(err.message, bad[i].want[0]) && strstr(err.message, bad[i].want[1]), "%s: said: %s", bad[i].inc, err.message);
+  }
+  free(whole); free(main_xml);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

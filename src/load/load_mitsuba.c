@@ -1,7 +1,6 @@
 /* load_mitsuba.c — owns reading Mitsuba scene files (.xml, Mitsuba 3 and 0.6): the
- * document's structure (defaults and $substitution, ids and refs, 0.6's camelCase
- * names), and the sensor, film, sampler,
- * integrator and shapes; load_mitsuba_props.c reads properties and transforms,
+ * document's structure (<include>, defaults and $substitution, ids and refs, 0.6's
+ * camelCase names), and the sensor, film, sampler, integrator and shapes; load_mitsuba_props.c reads properties and transforms,
  * load_mitsuba_plugins.c translates BSDFs, media and emitters.
  * The result is a valo JSON scene tree read by load_json_tree (docs/scene-format.md,
  * "Mitsuba scenes", lists what is read and how). */
@@ -17,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* ---- sensor, film, sampler, integrator ---- */
 
@@ -198,10 +198,10 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   cJSON *sh = cJSON_CreateObject();
   if (!sh) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   cJSON_AddItemToArray(c->shapes, sh);
-  int *l = realloc(c->shape_line, (size_t)(c->nshape_line + 1) * sizeof *l);
+  const xml_node **l = realloc(c->shape_at, (size_t)(c->nshape_at + 1) * sizeof *l);
   if (!l) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
-  c->shape_line = l;
-  l[c->nshape_line++] = n->line;
+  c->shape_at = l;
+  l[c->nshape_at++] = n;
   double m[16];
   int has_xf;
   TRY(mi_transform(c, n, "to_world", m, &has_xf));
@@ -306,6 +306,85 @@ static void upgrade_names(xml_node *n) {
   }
 }
 
+/* Marks every element of the tree at n (n's siblings too) as read from file. */
+static void set_file(xml_node *n, const char *file) {
+  for (; n; n = n->next) {
+    n->file = file;
+    set_file(n->child, file);
+  }
+}
+
+/* Mitsuba's <include filename="..."/>, at any depth: the element is replaced by the
+ * file's content, its root's children when the root is <scene>, else the root itself
+ * (each file's names upgraded by its own version). As Mitsuba's file resolver does, a
+ * relative name is found from the main file's folder, in every included file too (so
+ * are the meshes and textures they name); at most MI_INCLUDE_DEPTH levels deep and
+ * MI_INCLUDE_FILES inclusions in all (Mitsuba has only the first bound; the second keeps
+ * a file that includes the next one twice, fifteen times over, from growing without end). */
+#define MI_INCLUDE_DEPTH 15
+#define MI_INCLUDE_FILES 4096
+static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
+  for (xml_node **pp = &parent->child; *pp;) {
+    xml_node *n = *pp;
+    if (strcmp(n->name, "include")) {
+      TRY(expand_includes(c, n, depth));
+      pp = &n->next;
+      continue;
+    }
+    const char *f = xml_attr_get(n, "filename");
+    if (!f || !*f) return mi_bad(c, n, "needs a filename");
+    if (strchr(f, '$')) return mi_bad(c, n, "a $parameter in an included file's name is not read");
+    if (depth >= MI_INCLUDE_DEPTH) return mi_bad(c, n, "includes nested more than %d deep (does a file include itself?)", MI_INCLUDE_DEPTH);
+    if (c->nincluded >= MI_INCLUDE_FILES) return mi_bad(c, n, "more than %d files included", MI_INCLUDE_FILES);
+    const char *slash = strrchr(c->path, '/');
+    int dl = f[0] == '/' || !slash ? 0 : (int)(slash - c->path + 1);
+    size_t len = (size_t)dl + strlen(f) + 1;
+    char *path = malloc(len), **inc = realloc(c->included, (size_t)(c->nincluded + 1) * sizeof *inc);
+    if (inc) c->included = inc;
+    if (!path || !inc) { free(path); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+    snprintf(path, len, "%.*s%s", dl, c->path, f);
+    c->included[c->nincluded++] = path;
+    struct stat sb;
+    if (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode)) return mi_bad(c, n, "%s is not a file", path);
+    char *text;
+    size_t tl;
+    xml_node *r = NULL;
+    valo_status st = scene_text_read(path, &text, &tl, c->err);
+    if (!st) {
+      st = xml_parse(path, text, tl, &r, c->err);
+      free(text);
+    }
+    if (st) {
+      size_t ml = strlen(c->err->message);
+      snprintf(c->err->message + ml, sizeof c->err->message - ml, " (the <include> at %s:%d)", n->file ? n->file : c->path, n->line);
+      return st;
+    }
+    set_file(r, path);
+    const char *ver = xml_attr_get(r, "version");
+    int whole = !strcmp(r->name, "scene");
+    if (ver && atoi(ver) < 2) upgrade_names(whole ? r->child : r);
+    if (whole) {
+      st = expand_includes(c, r, depth + 1);
+    } else {
+      /* the root as the only child of a stand-in, so that it can be replaced in turn */
+      xml_node hold = {.name = "", .child = r};
+      r->parent = &hold;
+      st = expand_includes(c, &hold, depth + 1);
+      r = hold.child;
+    }
+    if (st) { xml_free(r); return st; }
+    xml_node *first = whole ? r->child : r, *last = NULL;
+    if (whole) { r->child = NULL; xml_free(r); }
+    for (xml_node *k = first; k; k = k->next) { k->parent = parent; last = k; }
+    *pp = first ? first : n->next;
+    if (last) last->next = n->next;
+    n->next = NULL;
+    xml_free(n);
+    if (last) pp = &last->next;
+  }
+  return VALO_OK;
+}
+
 /* The command line's NAME=VALUE for name (length n), or NULL: *len gets the value's length. */
 static const char *define_of(const char *defines, const char *name, size_t n, size_t *len) {
   for (const char *p = defines; p && *p;) {
@@ -387,6 +466,7 @@ static valo_status read_document(mctx *c) {
   if (strcmp(r->name, "scene")) return mi_bad(c, r, "the root element of a Mitsuba scene is <scene>");
   const char *ver = xml_attr_get(r, "version");
   if (ver && atoi(ver) < 2) upgrade_names(r->child);
+  TRY(expand_includes(c, r, 0));
   mdef defs[256];
   int nd = 0;
   for (xml_node *k = r->child; k; k = k->next) {
@@ -433,8 +513,6 @@ static valo_status read_document(mctx *c) {
     } else if (!strcmp(k->name, "bsdf") || !strcmp(k->name, "texture") || !strcmp(k->name, "medium") || !strcmp(k->name, "phase") ||
                !strcmp(k->name, "volume")) {
       continue; /* read where a shape or sensor refers to it */
-    } else if (!strcmp(k->name, "include")) {
-      return mi_bad(c, k, "<include> is not read: merge the included file into this one");
     } else {
       return mi_bad(c, k, "valo does not read this element here (sensor, integrator, shape, emitter, bsdf, texture, medium, default)");
     }
@@ -448,12 +526,15 @@ static valo_status read_document(mctx *c) {
 
 /* Adds the XML line of the shape or light the JSON stage was reading to its message. */
 static void add_lines(mctx *c, const int at[2]) {
-  int *lines[2] = {c->shape_line, c->light_line}, nl[2] = {c->nshape_line, c->nlight_line};
+  const xml_node **nodes[2] = {c->shape_at, c->light_at};
+  int nl[2] = {c->nshape_at, c->nlight_at};
   for (int j = 0; j < 2; j++) {
     int i = at[j];
     if (i < 0 || i >= nl[j]) continue;
     size_t len = strlen(c->err->message);
-    snprintf(c->err->message + len, sizeof c->err->message - len, " (the %s at line %d)", j ? "<emitter>" : "<shape>", lines[j][i]);
+    const xml_node *n = nodes[j][i];
+    snprintf(c->err->message + len, sizeof c->err->message - len, " (the %s at line %d%s%s)", j ? "<emitter>" : "<shape>", n->line,
+             n->file ? " of " : "", n->file ? n->file : "");
     return;
   }
 }
@@ -483,8 +564,10 @@ static valo_status translate_file(mctx *c, const char *path, const char *defines
 static void translation_free(mctx *c) {
   cJSON_Delete(c->out);
   xml_free(c->root);
-  free(c->shape_line);
-  free(c->light_line);
+  free(c->shape_at);
+  free(c->light_at);
+  for (int i = 0; i < c->nincluded; i++) free(c->included[i]);
+  free(c->included);
   free(c->bsdf_names);
 }
 

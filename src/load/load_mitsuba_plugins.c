@@ -421,10 +421,10 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
   cJSON *l = cJSON_CreateObject();
   if (!l) return NOMEM;
   cJSON_AddItemToArray(c->lights, l);
-  int *ln = realloc(c->light_line, (size_t)(c->nlight_line + 1) * sizeof *ln);
+  const xml_node **ln = realloc(c->light_at, (size_t)(c->nlight_at + 1) * sizeof *ln);
   if (!ln) return NOMEM;
-  c->light_line = ln;
-  ln[c->nlight_line++] = e->line;
+  c->light_at = ln;
+  ln[c->nlight_at++] = e;
   double org[3] = {m[3], m[7], m[11]}, dir[3] = {m[2], m[6], m[10]};
   if (!strcmp(type, "point")) {
     vec3 p = v3((float)org[0], (float)org[1], (float)org[2]);

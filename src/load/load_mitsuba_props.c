@@ -28,7 +28,7 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) {
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   if (!n) return err_set(c->err, VALO_ERR_INVALID, "%s: %s", c->path, msg);
-  return err_set(c->err, VALO_ERR_INVALID, "%s:%d: %s: %s", c->path, n->line, label(n, lb, sizeof lb), msg);
+  return err_set(c->err, VALO_ERR_INVALID, "%s:%d: %s: %s", n->file ? n->file : c->path, n->line, label(n, lb, sizeof lb), msg);
 }
 
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
@@ -37,7 +37,7 @@ void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  log_warning("%s:%d: %s: %s", c->path, n->line, label(n, lb, sizeof lb), msg);
+  log_warning("%s:%d: %s: %s", n->file ? n->file : c->path, n->line, label(n, lb, sizeof lb), msg);
 }
 
 static xml_node *find_id(xml_node *n, const char *id) {

@@ -14,8 +14,11 @@ typedef struct mctx {
   valo_error *err;
   xml_node *root;
   cJSON *out, *materials, *shapes, *lights, *media;
-  int *shape_line, nshape_line; /* the XML line of each valo shape (error messages) */
-  int *light_line, nlight_line;
+  const xml_node **shape_at; /* the XML element of each valo shape (error messages) */
+  const xml_node **light_at;
+  int nshape_at, nlight_at;
+  char **included; /* the <include>d files' paths (xml_node.file points at them) */
+  int nincluded;
   struct { const char *id; char name[96]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
 } mctx;

@@ -17,6 +17,8 @@ typedef struct xml_node {
   struct xml_node *child, *next, *parent; /* children in document order */
   int line;
   int used; /* set by a reader that took this node's meaning (unused ones are warned about) */
+  const char *file; /* the file it was read from, when a reader spliced it in from another
+                       (Mitsuba's <include>); NULL: the document's own */
 } xml_node;
 
 /* Parses text (len bytes, NUL-terminated) into a tree whose root is the document's one
