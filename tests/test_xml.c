@@ -327,7 +327,8 @@ static int convert_to_json(void) {
 
 /* <include>: XML_SCENE cut into five files (a scene root's children spliced in, a
  * single <bsdf> root, one in a subfolder including another, one written in Mitsuba 0.6's
- * names) renders bit for bit as the whole; a missing file, a file that includes itself and
+ * names) renders bit for bit as the whole; unnamed BSDFs on the same line of two files
+ * are two materials; a missing file, a file that includes itself and
  * an error inside an included file are said with the file and line they are in. */
 static int includes(void) {
   char *whole = strdup(XML_SCENE), *main_xml = malloc(strlen(XML_SCENE) + 400);
@@ -383,6 +384,20 @@ static int includes(void) {
       {"inc-bad.xml", "<scene version=\"3.0.0\">\n\n<shape/>\n</scene>\n", {"inc-bad.xml:3: <shape>", "needs a type"}},
       {"inc-broken.xml", "<scene version=\"3.0.0\">\n<shape>\n</scene>\n", {"inc-broken.xml:3:", "(the <include> at "}},
   };
+  /* Unnamed BSDFs on the same line of two files are two materials. */
+  scratch_file("inc-green.xml", "<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.1 0.7 0.1\"/></bsdf></shape>\n</scene>\n");
+  const char *two = scratch_file("inc-two.xml", "<scene version=\"3.0.0\">\n<shape type=\"sphere\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.7 0.1 0.1\"/></bsdf></shape>\n"
+                                                "<sensor type=\"perspective\"/><include filename=\"inc-green.xml\"/>\n</scene>\n");
+  char out[1200];
+  snprintf(out, sizeof out, "%s/inc-two.json", scratch_dir());
+  CHECK(mitsuba_to_json(two, NULL, out, &err) == VALO_OK, "%s", err.message);
+  FILE *f = fopen(out, "rb");
+  CHECK(f, "%s", out);
+  size_t got = fread(buf, 1, sizeof buf - 1, f);
+  fclose(f);
+  buf[got] = 0;
+  CHECK(strstr(buf, "\"bsdf@line2\"") && strstr(buf, "\"bsdf@inc-green.xml:line2\"") && strstr(buf, "0.7, 0.1, 0.1") && strstr(buf, "0.1, 0.7, 0.1"),
+        "both files' line-2 BSDFs should be materials: %s", buf);
   for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
     if (bad[i].text) scratch_file(bad[i].inc, bad[i].text);
     snprintf(buf, sizeof buf, "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<include filename=\"%s\"/>\n</scene>\n", bad[i].inc);

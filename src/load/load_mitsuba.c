@@ -152,7 +152,7 @@ static valo_status read_sensor(mctx *c, xml_node *s) {
   (void)mi_prop(c, s, "far_clip");
   xml_node *med = mi_child(c, s, "medium", 0);
   if (med) {
-    char name[96];
+    char name[192];
     TRY(mi_medium(c, med, name, sizeof name));
     if (!cJSON_AddStringToObject(cam, "medium", name)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   }
@@ -265,7 +265,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     if (!emit && !(emit = vec_json(1, 1, 1))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     mi_warn_unused(c, e);
   }
-  char name[96];
+  char name[192];
   valo_status st = mi_material(c, b, emit, n, name, sizeof name);
   cJSON_Delete(emit);
   if (st) return st;

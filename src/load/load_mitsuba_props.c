@@ -31,6 +31,20 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) {
   return err_set(c->err, VALO_ERR_INVALID, "%s:%d: %s: %s", n->file ? n->file : c->path, n->line, label(n, lb, sizeof lb), msg);
 }
 
+const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
+  if (!n->file) {
+    snprintf(buf, len, "line%d", n->line);
+    return buf;
+  }
+  /* the included file's name as its <include> gave it: the main file's folder is where
+   * every relative name starts (expand_includes) */
+  const char *slash = strrchr(c->path, '/');
+  size_t dl = slash ? (size_t)(slash - c->path + 1) : 0;
+  const char *f = !strncmp(n->file, c->path, dl) ? n->file + dl : n->file;
+  snprintf(buf, len, "%.60s:line%d", f, n->line);
+  return buf;
+}
+
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
   char msg[600], lb[200];
   va_list ap;

@@ -19,13 +19,16 @@ typedef struct mctx {
   int nshape_at, nlight_at;
   char **included; /* the <include>d files' paths (xml_node.file points at them) */
   int nincluded;
-  struct { const char *id; char name[96]; } *bsdf_names; /* materials made from bsdfs with an id */
+  struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
 } mctx;
 
 /* "file:line: <tag name="..">: what" */
 valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* Where n is, for names of the materials and media made from unnamed elements: "line12",
+ * or "part.xml:line12" in an included file (so two files' line 12 are told apart). */
+const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len);
 /* The node with id (any tag), or NULL. */
 xml_node *mi_find_id(mctx *c, const char *id);
 /* The property child named `name` of plugin p (marked used), following a <ref name=..>
