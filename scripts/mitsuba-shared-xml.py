@@ -18,7 +18,9 @@ OUT = os.path.join(ROOT, "tests", "data", "mitsuba-xml")
 SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "path", "resx": "320", "resy": "180"}),
           # Sponza's own scene file, changed only where Mitsuba 3 cannot render it (the file says
           # how), reading its serialized mesh and textures from ../shared.
-          "sponza-serialized": ("@tests/data/mitsuba-xml/sponza-serialized.xml", {"resx": "128", "resy": "72"})}
+          "sponza-serialized": ("@tests/data/mitsuba-xml/sponza-serialized.xml", {"resx": "128", "resy": "72"}),
+          # instancing and <include>, with the bunny from ../shared
+          "instances": ("@tests/data/mitsuba-xml/instances.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -237,6 +237,14 @@ static int sponza_serialized_xml(void) {
                              "shared=" VALO_SHARED_DIR " resx=128 resy=72", 256, 0.02);
 }
 
+/* Instancing and <include> (tests/data/mitsuba-xml/instances.xml): three instances of a
+ * shapegroup of the bunny and a cube, moved, turned and scaled. */
+static int instances_xml(void) {
+  if (!shared_file("scenes/models/stanford-bunny.obj")) return TEST_SKIP;
+  return against_mitsuba_xml("instances", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/instances.xml", "shared=" VALO_SHARED_DIR " resx=160 resy=96",
+                             256, 0.02);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -248,6 +256,6 @@ int main(int argc, char **argv) {
                                     {"spot_light", spot_light}, {"sun_light", sun_light}, {"ortho_camera", ortho_camera}, {"smoke_ball", smoke_ball}, {"absorbing_glass", absorbing_glass}, {"cloud_grid", cloud_grid}, {"gaussian_filter", gaussian_filter}, {"textured_quad", textured_quad},
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
-                                    {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {NULL, NULL}};
+                                    {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -1,7 +1,7 @@
 /* test_xml.c — Mitsuba scene files (.xml): the XML reader (entities, comments, errors with
  * line and column), the translation into valo's scene (an XML scene renders as the JSON
  * scene it means), Mitsuba 0.6's camelCase names, <default> values and --define, the
- * warning for properties valo does not read, Mitsuba's unit shapes, and <include>. Against
+ * warning for properties valo does not read, Mitsuba's unit shapes, <include>, and instancing. Against
  * Mitsuba itself: test_mitsuba from_xml and veach_mis_xml. */
 #include "harness.h"
 #include "load/load.h"
@@ -408,9 +408,92 @@ static int includes(void) {
   return 0;
 }
 
+/* Instancing: a shapegroup of a mesh, a cube and a sphere placed by three instances
+ * renders as the nine shapes written out with the instances' to_world after their own;
+ * a property the group's shapes do not read is warned about once, not per instance;
+ * emitters and groups inside a group, an instance without its group or of something
+ * else are refused with their line. */
+static int instances(void) {
+  scratch_file("tri.obj", "v -0.5 0 0\nv 0.5 0 0\nv 0 0.8 0.1\nf 1 2 3\n");
+  const char *head = "<scene version=\"3.0.0\">\n"
+                     "  <sensor type=\"perspective\"><float name=\"fov\" value=\"50\"/>\n"
+                     "    <transform name=\"to_world\"><lookat origin=\"0, 3, 7\" target=\"0, 0.5, 0\" up=\"0, 1, 0\"/></transform>\n"
+                     "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"4\"/></sampler>\n"
+                     "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"48\"/><integer name=\"height\" value=\"32\"/></film></sensor>\n"
+                     "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.8\"/></emitter>\n"
+                     "  <shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"5\"/><rotate x=\"1\" angle=\"-90\"/></transform></shape>\n";
+  static const char *const own[3] = {"<translate x=\"-0.6\"/>", "<scale value=\"0.3\"/><translate x=\"0.6\" y=\"0.3\"/>", ""};
+  static const char *const place[3] = {"<rotate y=\"1\" angle=\"30\"/><translate x=\"-2\"/>", "<scale value=\"1.5\"/>",
+                                       "<rotate y=\"1\" angle=\"-70\"/><translate x=\"2\" z=\"-1\"/>"};
+  static const char *const body[3] = {"<shape type=\"obj\"><string name=\"filename\" value=\"tri.obj\"/><float name=\"unread\" value=\"1\"/>%s</shape>",
+                                      "<shape type=\"cube\">%s<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.8 0.2 0.1\"/></bsdf></shape>",
+                                      "<shape type=\"sphere\"><point name=\"center\" x=\"0\" y=\"1.2\" z=\"0\"/><float name=\"radius\" value=\"0.3\"/>%s</shape>"};
+  char *a = malloc(16384), *b = malloc(16384), piece[1024], xf[512];
+  CHECK(a && b, "memory");
+  snprintf(a, 16384, "%s  <shape type=\"shapegroup\" id=\"g\">\n", head);
+  snprintf(b, 16384, "%s", head);
+  for (int s = 0; s < 3; s++) {
+    snprintf(xf, sizeof xf, s == 2 ? "%s" : "<transform name=\"to_world\">%s</transform>", own[s]);
+    snprintf(piece, sizeof piece, body[s], xf);
+    strcat(a, "    "); strcat(a, piece); strcat(a, "\n");
+  }
+  strcat(a, "  </shape>\n");
+  for (int i = 0; i < 3; i++) {
+    snprintf(piece, sizeof piece, "  <shape type=\"instance\"><ref id=\"g\"/><transform name=\"to_world\">%s</transform></shape>\n", place[i]);
+    strcat(a, piece);
+    for (int s = 0; s < 3; s++) {
+      snprintf(xf, sizeof xf, "<transform name=\"to_world\">%s%s</transform>", own[s], place[i]);
+      snprintf(piece, sizeof piece, body[s], xf);
+      strcat(b, "  "); strcat(b, piece); strcat(b, "\n");
+    }
+  }
+  strcat(a, "</scene>\n");
+  strcat(b, "</scene>\n");
+  int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+  warnings_capture(1);
+  float *ia = render_path(scratch_file("inst.xml", a), &w1, &h1);
+  char said[4096];
+  snprintf(said, sizeof said, "%s", warnings_text());
+  warnings_capture(0);
+  float *ib = render_path(scratch_file("inst-out.xml", b), &w2, &h2);
+  CHECK(ia && ib && w1 == w2 && h1 == h2, "render");
+  double far, mean;
+  differ(ia, ib, w1 * h1, &far, &mean);
+  fprintf(stderr, "instances against the shapes written out: %.2f%% of pixel channels differ by more than 1e-4, means by %.2e\n", 100 * far, mean);
+  CHECK(far < 0.02 && mean < 1e-4, "the instances render differently from the shapes they place");
+  const char *w = strstr(said, "<float name=\"unread\">");
+  CHECK(w && !strstr(w + 1, "<float name=\"unread\">"), "the group's unread property should be warned about once: %s", said);
+  /* the test can tell: the instances without their to_world */
+  char *c = strdup(a), *at;
+  while ((at = strstr(c, "<shape type=\"instance\"><ref id=\"g\"/><transform name=\"to_world\">"))) memcpy(at + 36 + 17, "nothing_", 8);
+  warnings_capture(1);
+  float *ic = render_path(scratch_file("inst-c.xml", c), &w2, &h2);
+  warnings_capture(0);
+  CHECK(ic, "render");
+  differ(ic, ib, w1 * h1, &far, &mean);
+  CHECK(far > 0.05, "instances without their to_world rendered alike (%.2f%% of channels differ)", 100 * far);
+  free(ia); free(ib); free(ic); free(c);
+  static const struct { const char *group, *use, *want[2]; } bad[] = {
+      {"<shape type=\"sphere\"><emitter type=\"area\"/></shape>", "<shape type=\"instance\"><ref id=\"g\"/></shape>", {"bad-inst.xml:4: <shape type=\"sphere\">", "emitting"}},
+      {"<shape type=\"shapegroup\" id=\"h\"/>", "", {"bad-inst.xml:4: <shape type=\"shapegroup\" id=\"h\">", "cannot hold groups"}},
+      {"<shape type=\"sphere\"/>", "<shape type=\"instance\"/>", {"bad-inst.xml:6: <shape type=\"instance\">", "needs a <ref"}},
+      {"<shape type=\"sphere\"/>", "<bsdf type=\"diffuse\" id=\"d\"/><shape type=\"instance\"><ref id=\"d\"/></shape>", {"bad-inst.xml:6: <ref id=\"d\">", "shapegroup"}},
+      {"<emitter type=\"point\"/>", "", {"bad-inst.xml:4: <emitter type=\"point\">", "holds shapes"}},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    snprintf(a, 16384, "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n<shape type=\"shapegroup\" id=\"g\">\n%s\n</shape>\n%s\n</scene>\n", bad[i].group, bad[i].use);
+    valo_scene *sc;
+    valo_error err;
+    CHECK(valo_scene_load(scratch_file("bad-inst.xml", a), &sc, &err) != VALO_OK, "case %zu loaded", i);
+    CHECK(strstr(err.message, bad[i].want[0]) && strstr(err.message, bad[i].want[1]), "case %zu said: %s", i, err.message);
+  }
+  free(a); free(b);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -205,6 +205,14 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   double m[16];
   int has_xf;
   TRY(mi_transform(c, n, "to_world", m, &has_xf));
+  if (c->outer) {
+    /* an instance's shape: the instance's to_world after the shape's own */
+    double a[16];
+    memcpy(a, m, sizeof a);
+    for (int i = 0; i < 4; i++)
+      for (int j = 0; j < 4; j++) m[4 * i + j] = c->outer[4 * i] * a[j] + c->outer[4 * i + 1] * a[4 + j] + c->outer[4 * i + 2] * a[8 + j] + c->outer[4 * i + 3] * a[12 + j];
+    has_xf = 1;
+  }
   int flip = 0;
   TRY(mi_bool(c, n, "flip_normals", &flip));
   int serialized = !strcmp(type, "serialized");
@@ -280,6 +288,61 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   }
   mi_warn_unused(c, n);
   return VALO_OK;
+}
+
+/* Mitsuba's instancing: a <shape type="shapegroup" id=".."> holds shapes that are not
+ * rendered where they stand; each <shape type="instance"> with a <ref> to it and a
+ * to_world places them all once more. valo has no instances in its scene: each is read
+ * as copies of the group's shapes, placed by the instance's to_world after their own
+ * (memory and load time grow with the count). As in Mitsuba, a group holds neither
+ * emitters nor groups or instances. The group's unread properties are warned about once. */
+static valo_status check_group(mctx *c, xml_node *g) {
+  if (!g->used) g->used = 1; /* 2 once an instance has read its shapes */
+  for (xml_node *k = g->child; k; k = k->next) {
+    if (!strcmp(k->name, "shape")) {
+      const char *t = xml_attr_get(k, "type");
+      if (t && (!strcmp(t, "shapegroup") || !strcmp(t, "instance"))) return mi_bad(c, k, "a shapegroup cannot hold groups or instances (nor can Mitsuba's)");
+      for (xml_node *e = k->child; e; e = e->next)
+        if (!strcmp(e->name, "emitter") || (!strcmp(e->name, "ref") && mi_find_id(c, xml_attr_get(e, "id")) &&
+                                            !strcmp(mi_find_id(c, xml_attr_get(e, "id"))->name, "emitter")))
+          return mi_bad(c, k, "an emitting shape cannot be instanced (nor can it in Mitsuba)");
+    } else if (strcmp(k->name, "ref")) {
+      return mi_bad(c, k, "a shapegroup holds shapes");
+    }
+  }
+  return VALO_OK;
+}
+
+static valo_status read_instance(mctx *c, xml_node *n) {
+  xml_node *g = NULL;
+  for (xml_node *k = n->child; k; k = k->next)
+    if (!strcmp(k->name, "ref")) {
+      if (g) return mi_bad(c, k, "an instance refers to one shapegroup");
+      xml_node *t = mi_find_id(c, xml_attr_get(k, "id"));
+      const char *tt = t ? xml_attr_get(t, "type") : NULL;
+      if (!t || strcmp(t->name, "shape") || !tt || strcmp(tt, "shapegroup")) return mi_bad(c, k, "an instance refers to a <shape type=\"shapegroup\">");
+      k->used = 1;
+      g = t;
+    }
+  if (!g) return mi_bad(c, n, "needs a <ref id=\"...\"/> to its shapegroup");
+  double m[16];
+  TRY(mi_transform(c, n, "to_world", m, NULL));
+  mi_warn_unused(c, n);
+  int again = g->used == 2;
+  TRY(check_group(c, g));
+  g->used = 2;
+  c->outer = m;
+  c->quiet = again;
+  valo_status st = VALO_OK;
+  for (xml_node *k = g->child; k && !st; k = k->next) {
+    xml_node *sh = !strcmp(k->name, "ref") ? mi_find_id(c, xml_attr_get(k, "id")) : k;
+    if (!sh || strcmp(sh->name, "shape")) { st = mi_bad(c, k, "a shapegroup holds shapes"); break; }
+    k->used = 1;
+    st = read_shape(c, sh);
+  }
+  c->outer = NULL;
+  c->quiet = 0;
+  return st;
 }
 
 /* ---- the document ---- */
@@ -505,8 +568,11 @@ static valo_status read_document(mctx *c) {
       k->used = 1;
       TRY(read_integrator(c, k));
     } else if (!strcmp(k->name, "shape")) {
+      const char *type = xml_attr_get(k, "type");
       k->used = 1;
-      TRY(read_shape(c, k));
+      if (type && !strcmp(type, "shapegroup")) TRY(check_group(c, k)); /* placed by its instances */
+      else if (type && !strcmp(type, "instance")) TRY(read_instance(c, k));
+      else TRY(read_shape(c, k));
     } else if (!strcmp(k->name, "emitter")) {
       k->used = 1;
       TRY(mi_emitter(c, k));

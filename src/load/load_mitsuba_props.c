@@ -46,6 +46,7 @@ const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
 }
 
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
+  if (c->quiet) return;
   char msg[600], lb[200];
   va_list ap;
   va_start(ap, fmt);

@@ -19,6 +19,8 @@ typedef struct mctx {
   int nshape_at, nlight_at;
   char **included; /* the <include>d files' paths (xml_node.file points at them) */
   int nincluded;
+  const double *outer; /* while a shapegroup's shapes are read for an instance: its to_world */
+  int quiet;           /* no warnings (an instance after a shapegroup's first) */
   struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
 } mctx;
