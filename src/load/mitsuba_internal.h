@@ -25,6 +25,10 @@ typedef struct mctx {
   int nbsdf_names;
 } mctx;
 
+/* The document before its elements are read (load_mitsuba_doc.c): the root is <scene>,
+ * 0.6 names upgraded, <include>s spliced in, <default>s (and --define) substituted for
+ * $name, every <ref> checked to name an element. */
+valo_status mi_document_prepare(mctx *c);
 /* "file:line: <tag name="..">: what" */
 valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
