@@ -215,21 +215,26 @@ static int defaults_and_defines(void) {
   return 0;
 }
 
+/* Loads path, keeping the warnings it gave in said. */
+static valo_status load_saying(const char *path, char *said, size_t n, valo_error *err) {
+  warnings_capture(1);
+  valo_scene *sc;
+  valo_status st = valo_scene_load(path, &sc, err);
+  snprintf(said, n, "%s", warnings_text());
+  warnings_capture(0);
+  if (st == VALO_OK) valo_scene_destroy(sc);
+  return st;
+}
+
 /* What valo does not read is said, naming the line; what it cannot render is an error. */
 static int unread_is_said(void) {
   const char *xml = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/>\n"
                     "<float name=\"shutter_open\" value=\"0\"/></sensor>\n"
                     "<shape type=\"sphere\"><bsdf type=\"diffuse\"><float name=\"roughness\" value=\"0.5\"/></bsdf></shape>\n"
                     "<emitter type=\"constant\"/>\n</scene>\n";
-  warnings_capture(1);
-  valo_scene *sc;
-  valo_error err;
-  valo_status st = valo_scene_load(scratch_file("unread.xml", xml), &sc, &err);
   char said[2048];
-  snprintf(said, sizeof said, "%s", warnings_text());
-  warnings_capture(0);
-  CHECK(st == VALO_OK, "%s", err.message);
-  valo_scene_destroy(sc);
+  valo_error err;
+  CHECK(load_saying(scratch_file("unread.xml", xml), said, sizeof said, &err) == VALO_OK, "%s", err.message);
   CHECK(strstr(said, "unread.xml:3: <float name=\"shutter_open\">: not read by valo"), "said: %s", said);
   CHECK(strstr(said, "unread.xml:4: <float name=\"roughness\">: not read by valo"), "said: %s", said);
   return 0;
@@ -368,15 +373,10 @@ static int includes(void) {
   /* and the test can tell: the metal without its 0.6 name upgraded is warned about */
   snprintf(buf, sizeof buf, "<bsdf type=\"roughconductor\" id=\"metal\"><rgb name=\"specularReflectance\" value=\"0.8\"/></bsdf>\n");
   scratch_file("inc-metal.xml", buf);
-  warnings_capture(1);
-  valo_scene *sc;
-  valo_error err;
-  valo_status st = valo_scene_load(scratch_file("inc-main.xml", main_xml), &sc, &err);
   char said[2048];
-  snprintf(said, sizeof said, "%s", warnings_text());
-  warnings_capture(0);
-  CHECK(st == VALO_OK, "%s", err.message);
-  valo_scene_destroy(sc);
+  valo_error err;
+  valo_scene *sc;
+  CHECK(load_saying(scratch_file("inc-main.xml", main_xml), said, sizeof said, &err) == VALO_OK, "%s", err.message);
   CHECK(strstr(said, "inc-metal.xml:1: <rgb name=\"specularReflectance\">: not read"), "said: %s", said);
   static const struct { const char *inc, *text, *want[2]; } bad[] = {
       {"inc-none.xml", NULL, {"inc-none.xml", "(the <include> at "}},
