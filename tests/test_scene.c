@@ -2,7 +2,8 @@
  * transform order (scale, rotate x/y/z, translate), MTL meanings of McGuire's Cornell
  * boxes (Kd, Ke front-sided emitters, illum 5 mirror, illum 7 glass), automatic framing
  * of a mesh without a camera, polygon triangulation, and the camera's film point of a world
- * point (ReSTIR's reprojection) as the inverse of its rays, perspective and orthographic. */
+ * point (ReSTIR's reprojection) as the inverse of its rays, perspective and orthographic, and
+ * a mesh file placed again from its kept import as a second reading would place it. */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"
@@ -416,12 +417,58 @@ static int camera_project_inverts_ray(void) {
   return 0;
 }
 
+/* A mesh file placed again from load_mesh_cached's kept import lands exactly as a second
+ * reading of the file would: CornellBox-Original with its MTL materials and the bunny with
+ * computed normals, each placed twice (turned and moved the second time), with a cache and
+ * without, give the same vertices, normals, UVs, triangles and materials bit for bit; the
+ * cache holds each file once. */
+static int mesh_cache_places_alike(void) {
+  const char *files[2] = {shared_file("scenes/cornell/CornellBox-Original.obj"), shared_file("scenes/models/stanford-bunny.obj")};
+  if (!files[0] || !files[1]) return TEST_SKIP;
+  static const float xf[2][12] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}, {0.6f, 0, -0.8f, 3, 0, 1, 0, -1, 0.8f, 0, 0.6f, 0.25f}};
+  scene *s[2];
+  valo_error err;
+  mesh_cache *cache = NULL;
+  for (int k = 0; k < 2; k++) {
+    s[k] = scene_new("cache");
+    for (int f = 0; f < 2; f++)
+      for (int i = 0; i < 2; i++) {
+        int flags = f ? LOAD_MESH_SMOOTH : 0;
+        valo_status st = k ? load_mesh_cached(s[k], files[f], xf[i], UINT32_MAX, flags, NULL, &cache, &err)
+                           : load_mesh(s[k], files[f], xf[i], UINT32_MAX, flags, NULL, &err);
+        CHECK(st == VALO_OK, "%s", err.message);
+      }
+  }
+  CHECK(s[0]->ntris == s[1]->ntris && s[0]->nverts == s[1]->nverts && s[0]->nmats == s[1]->nmats, "%u/%u triangles, %u/%u vertices, %u/%u materials",
+        s[0]->ntris, s[1]->ntris, s[0]->nverts, s[1]->nverts, s[0]->nmats, s[1]->nmats);
+  size_t nv = s[0]->nverts, nt = s[0]->ntris;
+  CHECK(!memcmp(s[0]->pos, s[1]->pos, nv * sizeof(vec3)) && !memcmp(s[0]->nrm, s[1]->nrm, nv * sizeof(vec3)) &&
+            !memcmp(s[0]->uv, s[1]->uv, nv * 2 * sizeof(float)),
+        "vertices differ");
+  CHECK(!memcmp(s[0]->idx, s[1]->idx, nt * 3 * sizeof(uint32_t)) && !memcmp(s[0]->tri_mat, s[1]->tri_mat, nt * sizeof(uint32_t)), "triangles differ");
+  for (uint32_t m = 0; m < s[0]->nmats; m++)
+    CHECK(!strcmp(s[0]->mats[m].name, s[1]->mats[m].name) && !memcmp(&s[0]->mats[m].emission, &s[1]->mats[m].emission, sizeof(rgb)) &&
+              !memcmp(&s[0]->mats[m].kd, &s[1]->mats[m].kd, sizeof(rgb)),
+          "material %u differs", m);
+  /* the kept import is what is placed: a file removed after its first placement is placed again */
+  const char *tmp = scratch_file("cache-tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  CHECK(load_mesh_cached(s[1], tmp, NULL, UINT32_MAX, 0, NULL, &cache, &err) == VALO_OK, "%s", err.message);
+  remove(tmp);
+  uint32_t before = s[1]->ntris;
+  CHECK(load_mesh_cached(s[1], tmp, xf[1], UINT32_MAX, 0, NULL, &cache, &err) == VALO_OK && s[1]->ntris == before + 1, "not placed from the kept import: %s",
+        err.message);
+  mesh_cache_free(cache);
+  scene_free(s[0]);
+  scene_free(s[1]);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"mtl_before_newmtl", mtl_before_newmtl},
                                     {"obj_mtl_indented", obj_mtl_indented},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
                                     {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings},
-                                    {"camera_project_inverts_ray", camera_project_inverts_ray}, {NULL, NULL}};
+                                    {"camera_project_inverts_ray", camera_project_inverts_ray}, {"mesh_cache_places_alike", mesh_cache_places_alike}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

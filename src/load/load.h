@@ -31,4 +31,12 @@ valo_status mitsuba_to_json(const char *path, const char *defines, const char *o
 enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2, LOAD_MESH_SMOOTH = 4 };
 valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int mesh_flags, valo_options *file,
                       valo_error *err);
+/* load_mesh, with each file's import kept in *cache (made on first use; NULL: none kept)
+ * by path and LOAD_MESH_SMOOTH, so that a file placed again (a JSON scene naming it twice,
+ * Mitsuba's instances) is not read again: the same import, placed by its own xf, exactly
+ * as a second reading would place it. Free with mesh_cache_free. */
+typedef struct mesh_cache mesh_cache;
+valo_status load_mesh_cached(scene *s, const char *path, const float *xf, uint32_t override_mat, int mesh_flags, valo_options *file,
+                             mesh_cache **cache, valo_error *err);
+void mesh_cache_free(mesh_cache *cache);
 #endif

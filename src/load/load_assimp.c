@@ -4,7 +4,7 @@
  * illum 7 glass, illum 2 Phong), a file camera, and the input checks (NaN/Inf vertices,
  * out-of-range indices, degenerate or empty meshes). OBJ, PLY and glTF are checked by
  * valo before Assimp reads them; any other format is first imported in a child process
- * (import_probe.h). */
+ * (import_probe.h). An import can be kept for the file's next placement (mesh_cache). */
 #include "load/load.h"
 #include "core/error.h"
 #include "core/memlimit.h"
@@ -385,8 +385,32 @@ static valo_status take_file_lights(load_ctx *c, const mat34 *xf) {
   return VALO_OK;
 }
 
-valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
-                      valo_error *err) {
+/* One mesh file as Assimp imported it, with valo's checked text of it (OBJ, glTF, PLY). */
+typedef struct imported {
+  char *path;
+  int flags; /* the LOAD_MESH_ flags that change the import (LOAD_MESH_SMOOTH) */
+  const struct aiScene *ai;
+  obj_check oc;
+  int obj, gltf, placed;
+} imported;
+struct mesh_cache { imported *e; int n; };
+
+static void imported_free(imported *im) {
+  if (im->ai) aiReleaseImport(im->ai);
+  obj_check_free(&im->oc);
+  free(im->path);
+}
+
+void mesh_cache_free(mesh_cache *mc) {
+  if (!mc) return;
+  for (int i = 0; i < mc->n; i++) imported_free(&mc->e[i]);
+  free(mc->e);
+  free(mc);
+}
+
+/* Checks and imports path (everything before the triangles are placed). */
+static valo_status import_file(const char *path, int mesh_flags, imported *im, valo_error *err) {
+  memset(im, 0, sizeof *im);
   /* Loading and building peak at a multiple of the file's size (MESH_MEMORY_FACTOR; 7-11
    * measured on the bunny, the dragon and Sponza: README.md); a file that would not fit
    * is refused before it is read. */
@@ -411,79 +435,114 @@ valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t ov
   const char *ext = strrchr(path, '.');
   /* OBJ files are read by valo first (obj_check.c): checks with line numbers, repairs,
    * the MTL PBR extension; Assimp then parses the repaired text. */
-  int obj = ext && !strcasecmp(ext, ".obj");
-  int gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
-  obj_check oc;
-  memset(&oc, 0, sizeof oc);
+  im->obj = ext && !strcasecmp(ext, ".obj");
+  im->gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
+  obj_check *oc = &im->oc;
   struct aiFileIO io;
-  if (obj) {
-    valo_status cst = obj_check_read(path, &oc, err);
+  if (im->obj) {
+    valo_status cst = obj_check_read(path, oc, err);
     if (cst) return cst;
-    obj_check_fileio(&oc, &io);
-  } else if (gltf) { /* checked by valo first (gltf_check.h); the file and its buffers served as read */
-    valo_status gst = gltf_check_file(path, !strcasecmp(ext, ".glb"), &oc, err);
+    obj_check_fileio(oc, &io);
+  } else if (im->gltf) { /* checked by valo first (gltf_check.h); the file and its buffers served as read */
+    valo_status gst = gltf_check_file(path, !strcasecmp(ext, ".glb"), oc, err);
     if (gst) return gst;
-    obj_check_fileio(&oc, &io);
+    obj_check_fileio(oc, &io);
   } else if (ply_fixed) { /* the PLY as Assimp must read it, served like a repaired OBJ */
-    snprintf(oc.files[0].path, sizeof oc.files[0].path, "%s", path);
-    oc.files[0].text = ply_fixed;
-    oc.files[0].len = ply_fixed_len;
-    oc.nfiles = 1;
-    obj_check_fileio(&oc, &io);
+    snprintf(oc->files[0].path, sizeof oc->files[0].path, "%s", path);
+    oc->files[0].text = ply_fixed;
+    oc->files[0].len = ply_fixed_len;
+    oc->nfiles = 1;
+    obj_check_fileio(oc, &io);
   }
-  int checked = obj || gltf || ply_fixed;
+  int checked = im->obj || im->gltf || ply_fixed;
   if (!checked) { /* any other format: tried in a child process first (import_probe.h) */
     valo_status ist = import_probe(path, flags, err);
     if (ist) return ist;
   }
-  const struct aiScene *ai = checked ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
-  if (!ai) {
+  im->ai = checked ? aiImportFileEx(path, flags, &io) : aiImportFile(path, flags);
+  if (!im->ai) {
     const char *msg = aiGetErrorString();
-    obj_check_free(&oc);
+    obj_check_free(oc);
     return err_set(err, VALO_ERR_PARSE, "%s: not a mesh file valo can read (%s) (the importer said: %s)", path,
                    ext ? ext + 1 : "no extension", msg && *msg ? msg : "unknown format");
   }
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file};
+  im->flags = mesh_flags & LOAD_MESH_SMOOTH;
+  return VALO_OK;
+}
+
+/* Places an imported file's triangles (and its materials, camera and lights) in s. */
+static valo_status place(scene *s, imported *im, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
+                         valo_error *err) {
+  const struct aiScene *ai = im->ai;
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, im->gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
-      if (scene_add_material(s, &(material){0}) == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      if (scene_add_material(s, &(material){0}) == UINT32_MAX) return err_set(err, VALO_ERR_NOMEM, "out of memory");
     char dir[1024] = "";
     const char *slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
-      material m = convert_material(ai->mMaterials[i], obj ? &oc : NULL);
+      material m = convert_material(ai->mMaterials[i], im->obj ? &im->oc : NULL);
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, obj ? &oc : NULL);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, im->obj ? &im->oc : NULL);
       s->tex_user[0] = 0;
       s->mats[c.mat_base + i] = m;
       if (s->tex_fatal.status) {
         if (err) *err = s->tex_fatal;
-        st = s->tex_fatal.status;
-        goto done;
+        return s->tex_fatal.status;
       }
     }
     if (ai->mNumMaterials == 0) {
       material d = material_default();
       c.override_mat = scene_add_material(s, &d);
-      if (c.override_mat == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      if (c.override_mat == UINT32_MAX) return err_set(err, VALO_ERR_NOMEM, "out of memory");
     }
   }
   mat34 x = m34_from(xf12);
-  if (!ai->mRootNode) { st = err_set(err, VALO_ERR_PARSE, "%s: the file has no scene graph", path); goto done; }
+  if (!ai->mRootNode) return err_set(err, VALO_ERR_PARSE, "%s: the file has no scene graph", path);
   st = walk(&c, ai->mRootNode, &x);
-  if (st) goto done;
-  if (c.added == 0) {
-    st = err_set(err, VALO_ERR_INVALID, "%s: no usable triangles (%llu degenerate); is it a point cloud, a tristrip or empty?",
-                 path, (unsigned long long)c.degenerate);
-    goto done;
-  }
-  if (c.degenerate)
+  if (st) return st;
+  if (c.added == 0)
+    return err_set(err, VALO_ERR_INVALID, "%s: no usable triangles (%llu degenerate); is it a point cloud, a tristrip or empty?", path,
+                   (unsigned long long)c.degenerate);
+  if (c.degenerate && !im->placed)
     log_warning("%s: skipped %llu degenerate (zero-area) triangles", path, (unsigned long long)c.degenerate);
+  im->placed = 1;
   if ((mesh_flags & LOAD_MESH_CAMERA) && ai->mNumCameras > 0) take_file_camera(&c, &x);
-  st = take_file_lights(&c, &x);
-done:
-  aiReleaseImport(ai);
-  obj_check_free(&oc);
+  return take_file_lights(&c, &x);
+}
+
+valo_status load_mesh_cached(scene *s, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
+                             mesh_cache **cache, valo_error *err) {
+  if (cache) {
+    mesh_cache *mc = *cache;
+    for (int i = 0; mc && i < mc->n; i++)
+      if (mc->e[i].flags == (mesh_flags & LOAD_MESH_SMOOTH) && !strcmp(mc->e[i].path, path))
+        return place(s, &mc->e[i], path, xf12, override_mat, mesh_flags, file, err);
+  }
+  imported im;
+  valo_status st = import_file(path, mesh_flags, &im, err);
+  if (st) return st;
+  if (cache) {
+    /* kept for the file's next placement (a failed keep only costs a second import) */
+    mesh_cache *mc = *cache ? *cache : calloc(1, sizeof *mc);
+    imported *e = mc ? realloc(mc->e, (size_t)(mc->n + 1) * sizeof *e) : NULL;
+    if (mc) *cache = mc;
+    if (e) {
+      mc->e = e;
+      if ((im.path = strdup(path))) {
+        e[mc->n] = im;
+        return place(s, &e[mc->n++], path, xf12, override_mat, mesh_flags, file, err);
+      }
+    }
+  }
+  st = place(s, &im, path, xf12, override_mat, mesh_flags, file, err);
+  imported_free(&im);
   return st;
+}
+
+valo_status load_mesh(scene *s, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
+                      valo_error *err) {
+  return load_mesh_cached(s, path, xf12, override_mat, mesh_flags, file, NULL, err);
 }

@@ -342,7 +342,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
     if (str_ends_with(full, ".serialized")) return load_serialized(c->s, full, index < 0 ? 0 : index, xf, mat, mflags, c->err);
     if (index >= 0) return json_bad(c, where, "\"shape_index\" picks a shape of a Mitsuba .serialized file");
     int flags = (c->cam_from_file && !c->s->has_camera ? LOAD_MESH_CAMERA : 0) | mflags;
-    return load_mesh(c->s, full, xf, mat, flags, c->file, c->err);
+    return load_mesh_cached(c->s, full, xf, mat, flags, c->file, &c->meshes, c->err);
   }
   if (!strcmp(type, "sphere")) {
     vec3 center = v3(0, 0, 0);
@@ -571,6 +571,7 @@ valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_o
     s->has_env = 1;
   }
 done:
+  mesh_cache_free(c.meshes);
   return st;
 }
 

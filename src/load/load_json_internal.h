@@ -11,6 +11,7 @@ typedef struct jctx {
   int cam_from_file;           /* camera.from_file: take the first shape file's camera */
   float cam_fov, cam_height, cam_aperture, cam_focus; /* its overrides (fov, height <= 0: keep
                                                          the file's) */
+  mesh_cache *meshes;          /* the mesh files imported so far (load_mesh_cached) */
 } jctx;
 
 /* The getters: a missing key leaves *out as it is; a present one of the wrong type or
