@@ -567,7 +567,7 @@ static int sphere_cone(void) {
   int rc = 0;
   for (int mode = 0; mode < 2; mode++) {
     light_sampler ls;
-    CHECK(light_sampler_init(&ls, s, mode ? LIGHT_SELECT_POWER : LIGHT_SELECT_GRID) == 0 && ls.power_cdf, "init");
+    CHECK(light_sampler_init(&ls, s, mode ? LIGHT_SELECT_POWER : LIGHT_SELECT_GRID, 1) == 0 && ls.unit0, "init");
     static const float dist[2] = {0.8f, 50.0f};
     for (int far = 0; far < 2; far++) {
       vec3 p = v3_add(ctr, v3_scale(v3_norm(v3(0.3f, 1, -0.4f)), dist[far]));
@@ -733,7 +733,7 @@ static int light_selection_facing(void) {
   valo_error err;
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   light_sampler ls;
-  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID) == 0, "init");
+  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID, 1) == 0, "init");
   /* Lights: [0] point, [1] A, [2] B (area lights are added at commit). */
   int ia = -1, ib = -1;
   for (uint32_t i = 0; i < s->nlights; i++)
@@ -806,8 +806,8 @@ static int light_grid_selection(void) {
   valo_error err;
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   light_sampler ls, lp;
-  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID) == 0 && ls.grid_cdf, "grid not built");
-  CHECK(light_sampler_init(&lp, s, LIGHT_SELECT_POWER) == 0 && !lp.grid_cdf, "power selection built a grid");
+  CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID, 1) == 0 && ls.grid_cdf, "grid not built");
+  CHECK(light_sampler_init(&lp, s, LIGHT_SELECT_POWER, 1) == 0 && !lp.grid_cdf, "power selection built a grid");
   uint32_t n = s->nlights;
   double *obs = calloc(n, sizeof *obs), *ex = calloc(n, sizeof *ex);
   int rc = 0;
@@ -1070,6 +1070,86 @@ static int free_flight(void) {
   return rc;
 }
 
+/* Light selection with emitting spheres as units (light.h): 40 small lamps of 20
+ * triangles and one of 80, two lone triangles and a point light; in the grid, by power
+ * alone and for light tracing (light_select_power), at three points: the pmfs sum to 1,
+ * each sphere's lights sum to its light_range_pmf, the light reported is light_select_pmf's,
+ * and the frequencies of the units and of the large sphere's triangles (drawn within its
+ * unit from the number left of the unit's choice) match the pmfs (chi-square); the grid
+ * holds a sum per unit (42), not per light (881). */
+static int light_units(void) {
+  scene *s = scene_new("chi2-units");
+  material m = material_default();
+  m.emission = c3(1, 0.8f, 0.6f);
+  uint32_t mi = scene_add_material(s, &m);
+  m.emission = c3(40, 40, 40);
+  uint32_t hot = scene_add_material(s, &m);
+  valo_error err;
+  uint64_t st = 777;
+  for (int i = 0; i < 40; i++) {
+    float x = 8 * u01(&st), y = 8 * u01(&st), z = 8 * u01(&st), r = 0.05f + 0.2f * u01(&st);
+    CHECK(scene_add_sphere(s, v3(x, y, z), r, 0, 0, 1, i % 3 ? mi : hot, &err) == VALO_OK, "%s", err.message);
+  }
+  CHECK(scene_add_sphere(s, v3(4, 4, 4), 0.7f, 1, 0, 1, mi, &err) == VALO_OK, "%s", err.message);
+  light pt = {0};
+  pt.type = LIGHT_POINT; pt.p = v3(1, 7, 2); pt.L = c3(30, 30, 30);
+  CHECK(scene_add_light(s, &pt) == 0, "light");
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  const sphere_shape *big = &s->spheres[40];
+  CHECK(s->nlights == 40 * 20 + 80 + 1 && big->l1 - big->l0 == 80, "%u lights", s->nlights);
+  int rc = 0;
+  for (int mode = 0; mode < 3 && !rc; mode++) {
+    light_sampler ls;
+    CHECK(light_sampler_init(&ls, s, mode == 0 ? LIGHT_SELECT_GRID : LIGHT_SELECT_POWER, 1) == 0 && ls.unit0 && ls.nu == 42, "%u units", ls.nu);
+    CHECK(mode != 0 || ls.grid_cdf, "no grid");
+    for (int q = 0; q < 3 && !rc; q++) {
+      vec3 p = q == 0 ? v3(4, 5.2f, 4) : q == 1 ? v3(0.5f, 0.5f, 7) : v3(6, 2, 1);
+      double all = 0;
+      for (uint32_t i = 0; i < s->nlights; i++) all += mode == 2 ? 0 : light_select_pmf(&ls, s, i, p);
+      CHECK(mode == 2 || fabs(all - 1) < 1e-4, "pmfs sum to %.6f", all);
+      for (uint32_t g = 0; g < s->nspheres && mode != 2; g++) {
+        double sum = 0;
+        for (uint32_t i = s->spheres[g].l0; i < s->spheres[g].l1; i++) sum += light_select_pmf(&ls, s, i, p);
+        double r = light_range_pmf(&ls, s->spheres[g].l0, s->spheres[g].l1, p);
+        CHECK(fabs(r - sum) < 1e-5 * fmax(r, 1e-3) + 1e-7, "sphere %u: range pmf %.7g, its lights' %.7g", g, r, sum);
+      }
+      long n = nsamples();
+      double *obs = calloc(42 + 80, sizeof *obs), *ex = calloc(42 + 80, sizeof *ex);
+      CHECK(obs && ex, "memory");
+      double pu[42] = {0};
+      light_site at = light_locate(&ls, p);
+      for (long k = 0; k < n; k++) {
+        sampler sm = sampler_make(31 + mode * 7 + q, (uint64_t)k, 0);
+        float pmf;
+        uint32_t li = mode == 2 ? light_select_power(&ls, sampler_1d(&sm), &pmf) : light_select_at(&ls, s, &at, sampler_1d(&sm), &pmf);
+        CHECK(li < s->nlights, "no light");
+        float want = mode == 2 ? pmf : light_select_pmf(&ls, s, li, p);
+        CHECK(pmf == want, "light %u: select says %g, pmf %g", li, pmf, want);
+        obs[ls.unit_of[li]]++;
+        if (li >= big->l0 && li < big->l1) obs[42 + li - big->l0]++;
+      }
+      for (uint32_t u = 0; u < 42; u++) {
+        uint32_t l0 = ls.unit0[u], l1 = ls.unit0[u + 1];
+        for (uint32_t i = l0; i < l1; i++)
+          pu[u] += mode == 2 ? (double)ls.table.bins[u].p * ls.power[i] / ls.upower[u] : light_select_pmf(&ls, s, i, p);
+        ex[u] = n * pu[u];
+      }
+      uint32_t ub = ls.unit_of[big->l0];
+      for (uint32_t i = 0; i < 80; i++) ex[42 + i] = obs[ub] * ls.power[big->l0 + i] / ls.upower[ub];
+      char what[96];
+      snprintf(what, sizeof what, "%s at point %d: units", mode == 0 ? "grid" : mode == 1 ? "power" : "light tracing", q);
+      rc |= chi2_check(what, obs, ex, 42);
+      snprintf(what, sizeof what, "%s at point %d: the large sphere's triangles", mode == 0 ? "grid" : mode == 1 ? "power" : "light tracing", q);
+      rc |= chi2_check(what, obs + 42, ex + 42, 80);
+      free(obs);
+      free(ex);
+    }
+    light_sampler_free(&ls);
+  }
+  scene_free(s);
+  return rc;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"diffuse", diffuse},
                                     {"phong", phong},
@@ -1084,7 +1164,7 @@ int main(int argc, char **argv) {
                                     {"microfacet_furnace", microfacet_furnace}, {"ggx_albedo", ggx_albedo}, {"bsdf_reciprocity", bsdf_reciprocity},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness},
                                     {"sobol_sampler", sobol_sampler},
-                                    {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection},
+                                    {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
                                     {"pixel_filters", pixel_filters}, {"hg_phase", hg_phase}, {"free_flight", free_flight}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

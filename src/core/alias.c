@@ -47,3 +47,15 @@ uint32_t alias_sample(const alias_table *t, float u, float *pmf) {
   if (pmf) *pmf = t->bins[r].p;
   return r;
 }
+
+uint32_t alias_sample_rest(const alias_table *t, float u, float *pmf, float *rest) {
+  double x = (double)u * t->n;
+  uint32_t i = (uint32_t)x;
+  if (i >= t->n) i = t->n - 1;
+  double up = x - i, q = t->bins[i].q;
+  uint32_t r = up < q ? i : t->bins[i].alias;
+  double f = up < q ? up / q : (up - q) / (1 - q);
+  *rest = (float)fmin(fmax(f, 0.0), 0x1.fffffep-1);
+  if (pmf) *pmf = t->bins[r].p;
+  return r;
+}

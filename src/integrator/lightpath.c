@@ -43,7 +43,7 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
   sampler_2d(&smp, &u[0], &u[1]);
   sampler_2d(&smp, &u[2], &u[3]);
   float pmf;
-  uint32_t li = alias_sample(&c->ls.table, ul, &pmf);
+  uint32_t li = light_select_power(&c->ls, ul, &pmf);
   light_emit e;
   if (!(pmf > 0) || !light_sample_emit(s, &s->lights[li], u, &e)) return;
   rgb beta = c3_scale(e.beta, 1 / pmf);

@@ -31,7 +31,7 @@ float light_power(const scene *s, const light *l) {
 typedef struct grid_light { vec3 c; float r, w_far; vec3 n; float d; int local, one_sided; } grid_light;
 
 static int grid_build(light_sampler *ls, const scene *s) {
-  uint32_t n = ls->n;
+  uint32_t n = ls->nu;
   uint64_t budget = LIGHT_GRID_CELLS;
   if (budget * n > (64u << 20)) budget = (64u << 20) / n; /* at most 256 MB of sums */
   if (budget < 8) return 0;
@@ -51,10 +51,19 @@ static int grid_build(light_sampler *ls, const scene *s) {
   if (!gl || !cdf) { free(gl); free(cdf); return -1; }
   float R2 = PI_F * s->radius * s->radius;
   for (uint32_t i = 0; i < n; i++) {
-    const light *l = &s->lights[i];
     grid_light *g = &gl[i];
     memset(g, 0, sizeof *g);
-    float pw = ls->power[i];
+    uint32_t li = ls->unit0 ? ls->unit0[i] : i;
+    const light *l = &s->lights[li];
+    if (ls->unit0 && ls->unit0[i + 1] - li > 1) { /* an emitting sphere */
+      const sphere_shape *sp = &s->spheres[l->sphere - 1];
+      g->c = sp->c;
+      g->r = sp->r;
+      g->w_far = ls->upower[i] / (4 * PI_F);
+      g->local = 1;
+      continue;
+    }
+    float pw = ls->power[li];
     switch (l->type) {
     case LIGHT_AREA: {
       vec3 a = l->v[0], b = l->v[1], c = l->v[2];
@@ -108,9 +117,41 @@ static int grid_build(light_sampler *ls, const scene *s) {
   return 0;
 }
 
-int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode) {
+/* The units of a sampler above the local count with spheres sampled by their cones. */
+static int units_build(light_sampler *ls, const scene *s) {
+  uint32_t n = ls->n, nu = n;
+  for (uint32_t g = 0; g < s->nspheres; g++)
+    if (s->spheres[g].l1 > s->spheres[g].l0) nu -= s->spheres[g].l1 - s->spheres[g].l0 - 1;
+  if (nu == n) return 0;
+  ls->unit0 = malloc((nu + 1) * sizeof *ls->unit0);
+  ls->unit_of = malloc(n * sizeof *ls->unit_of);
+  ls->upower = malloc(nu * sizeof *ls->upower);
+  ls->power_cdf = malloc(n * sizeof *ls->power_cdf);
+  if (!ls->unit0 || !ls->unit_of || !ls->upower || !ls->power_cdf) return -1;
+  uint32_t u = 0;
+  double acc = 0;
+  for (uint32_t i = 0; i < n; u++) {
+    const light *l = &s->lights[i];
+    uint32_t end = i + 1;
+    if (l->type == LIGHT_AREA && l->sphere) end = s->spheres[l->sphere - 1].l1; /* its sphere's lights, in order (scene_commit) */
+    ls->unit0[u] = i;
+    double sum = 0;
+    for (; i < end; i++) {
+      ls->unit_of[i] = u;
+      sum += ls->power[i];
+      ls->power_cdf[i] = acc += ls->power[i];
+    }
+    ls->upower[u] = (float)sum;
+  }
+  ls->unit0[nu] = n;
+  ls->nu = nu;
+  return 0;
+}
+
+int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode, int sphere_cones) {
   memset(ls, 0, sizeof *ls);
   ls->env_index = -1;
+  ls->sphere_cones = sphere_cones;
   if (s->nlights == 0) return 0;
   float *w = malloc(s->nlights * sizeof *w);
   if (!w) return -1;
@@ -119,30 +160,34 @@ int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode
     if (!(w[i] >= 0) || !isfinite(w[i])) w[i] = 0;
     if (s->lights[i].type == LIGHT_ENV) ls->env_index = (int)i;
   }
-  int rc = alias_build(&ls->table, w, s->nlights);
-  if (rc) { ls->table.bins = NULL; ls->table.n = 0; free(w); return 0; } /* all lights black: nothing to sample */
   ls->power = w;
-  ls->n = s->nlights;
+  ls->n = ls->nu = s->nlights;
   ls->local = s->nlights <= LIGHT_LOCAL_MAX;
-  ls->sphere_cones = 1;
-  int spheres = 0;
-  for (uint32_t g = 0; g < s->nspheres; g++) spheres |= s->spheres[g].l1 > s->spheres[g].l0;
-  if (spheres && !ls->local) {
-    if (!(ls->power_cdf = malloc(s->nlights * sizeof *ls->power_cdf))) return -1;
-    double acc = 0;
-    for (uint32_t i = 0; i < s->nlights; i++) ls->power_cdf[i] = acc += alias_pmf(&ls->table, i);
+  if (!ls->local && sphere_cones && units_build(ls, s)) { light_sampler_free(ls); return -1; }
+  int rc = alias_build(&ls->table, ls->unit0 ? ls->upower : w, ls->nu);
+  if (rc) { /* all lights black: nothing to sample */
+    light_sampler_free(ls);
+    return 0;
   }
-  if (!ls->local && mode == LIGHT_SELECT_GRID && grid_build(ls, s)) return -1;
+  if (!ls->local && mode == LIGHT_SELECT_GRID && grid_build(ls, s)) { light_sampler_free(ls); return -1; }
   return 0;
 }
 void light_sampler_free(light_sampler *ls) {
-  alias_free(&ls->table);
+  if (ls->table.bins) alias_free(&ls->table);
+  ls->table.bins = NULL;
+  ls->table.n = 0;
   free(ls->power);
   free(ls->grid_cdf);
   free(ls->power_cdf);
+  free(ls->unit0);
+  free(ls->unit_of);
+  free(ls->upower);
   ls->power_cdf = NULL;
   ls->power = NULL;
   ls->grid_cdf = NULL;
+  ls->unit0 = ls->unit_of = NULL;
+  ls->upower = NULL;
+  ls->n = ls->nu = 0;
 }
 
 /* Can light l send anything to p? Only one-sided area lights can be turned away. */
@@ -152,7 +197,8 @@ static int light_faces(const light *l, vec3 p) {
 }
 
 /* The local selection weights at p (power, 0 for lights facing away) and their sum, in
- * one order, so light_select and light_select_pmf agree to the bit. */
+ * one order, so light_select and light_select_pmf agree to the bit. (The local selection
+ * has no units: it is used only up to LIGHT_LOCAL_MAX lights.) */
 static float facing_weights(const light_sampler *ls, const scene *s, vec3 p, float w[LIGHT_LOCAL_MAX]) {
   float total = 0;
   for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(&s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
@@ -168,10 +214,10 @@ static const float *grid_row(const light_sampler *ls, vec3 p) {
     int i = isfinite(f[a]) ? (int)floorf(fminf(fmaxf(f[a], 0), 1e6f)) : 0;
     c[a] = i >= ls->gdim[a] ? ls->gdim[a] - 1 : i;
   }
-  const float *row = ls->grid_cdf + (((size_t)c[2] * ls->gdim[1] + c[1]) * ls->gdim[0] + c[0]) * ls->n;
-  return row[ls->n - 1] > 0 ? row : NULL;
+  const float *row = ls->grid_cdf + (((size_t)c[2] * ls->gdim[1] + c[1]) * ls->gdim[0] + c[0]) * ls->nu;
+  return row[ls->nu - 1] > 0 ? row : NULL;
 }
-/* The mixture's probability of light i at a point whose cell has running sums row: one
+/* The mixture's probability of unit i at a point whose cell has running sums row: one
  * expression for light_select and light_select_pmf, so they agree to the bit. */
 static inline float grid_mix_pmf(const light_sampler *ls, const float *row, uint32_t i) {
   return LIGHT_GRID_POWER * alias_pmf(&ls->table, i) + (1 - LIGHT_GRID_POWER) * (i ? row[i] - row[i - 1] : row[0]);
@@ -185,30 +231,62 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
   light_site at = light_locate(ls, p);
   return light_select_at(ls, s, &at, u, pmf);
 }
+
+/* The light of unit un picked with probability pu, rest the number left of the unit's
+ * choice: the unit's only light, or one of its lights by power. */
+static uint32_t unit_light(const light_sampler *ls, uint32_t un, float pu, float rest, float *pmf) {
+  uint32_t l0 = ls->unit0[un], l1 = ls->unit0[un + 1];
+  *pmf = pu;
+  if (l1 - l0 == 1) return l0;
+  double base = l0 ? ls->power_cdf[l0 - 1] : 0, target = base + (double)rest * (ls->power_cdf[l1 - 1] - base);
+  uint32_t lo = l0, hi = l1 - 1; /* the first light whose running sum passes the target */
+  while (lo < hi) {
+    uint32_t mid = (lo + hi) / 2;
+    if (ls->power_cdf[mid] > target) hi = mid; else lo = mid + 1;
+  }
+  *pmf = pu * (ls->power[lo] / ls->upower[un]);
+  return lo;
+}
+
+uint32_t light_select_power(const light_sampler *ls, float u, float *pmf) {
+  if (ls->table.n == 0) return UINT32_MAX;
+  if (!ls->unit0) return alias_sample(&ls->table, u, pmf);
+  float pu, rest;
+  uint32_t un = alias_sample_rest(&ls->table, u, &pu, &rest);
+  return unit_light(ls, un, pu, rest, pmf);
+}
+
 uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
   vec3 p = at->p;
   if (ls->grid_cdf) {
     const float *row = at->row;
-    if (!row) return alias_sample(&ls->table, u, pmf);
+    if (!row) return light_select_power(ls, u, pmf);
     uint32_t i;
+    float rest = 0;
     const float a = LIGHT_GRID_POWER;
     if (u < a) {
       float power_pmf; /* not the answer: the mixture's pmf is */
-      i = alias_sample(&ls->table, fminf(u / a, 0x1.fffffep-1f), &power_pmf);
+      float v = fminf(u / a, 0x1.fffffep-1f);
+      i = ls->unit0 ? alias_sample_rest(&ls->table, v, &power_pmf, &rest) : alias_sample(&ls->table, v, &power_pmf);
     } else {
       float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
-      uint32_t lo = 0, hi = ls->n - 1; /* the first i with row[i] > v */
+      uint32_t lo = 0, hi = ls->nu - 1; /* the first i with row[i] > v */
       while (lo < hi) {
         uint32_t mid = (lo + hi) / 2;
         if (row[mid] > v) hi = mid; else lo = mid + 1;
       }
       i = lo;
+      if (ls->unit0) {
+        float below = i ? row[i - 1] : 0;
+        rest = fminf(fmaxf((v - below) / (row[i] - below), 0), 0x1.fffffep-1f);
+      }
     }
-    *pmf = grid_mix_pmf(ls, row, i);
-    return i;
+    float pu = grid_mix_pmf(ls, row, i);
+    if (!ls->unit0) { *pmf = pu; return i; }
+    return unit_light(ls, i, pu, rest, pmf);
   }
-  if (!ls->local) return alias_sample(&ls->table, u, pmf);
+  if (!ls->local) return light_select_power(ls, u, pmf);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   if (!(total > 0)) return UINT32_MAX;
   float target = u * total, acc = 0;
@@ -223,8 +301,19 @@ uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_si
   return last;
 }
 
+/* The probability of unit un at p. */
+static float unit_pmf(const light_sampler *ls, uint32_t un, vec3 p) {
+  const float *row = ls->grid_cdf ? grid_row(ls, p) : NULL;
+  return row ? grid_mix_pmf(ls, row, un) : alias_pmf(&ls->table, un);
+}
+
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
   if (ls->table.n == 0) return 0;
+  if (ls->unit0) {
+    uint32_t un = ls->unit_of[li];
+    float pu = unit_pmf(ls, un, p);
+    return ls->unit0[un + 1] - ls->unit0[un] == 1 ? pu : pu * (ls->power[li] / ls->upower[un]);
+  }
   if (ls->grid_cdf) {
     const float *row = grid_row(ls, p);
     if (!row) return alias_pmf(&ls->table, li);
@@ -236,18 +325,14 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
 }
 
 float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p) {
-  if (ls->table.n == 0 || ls->local || !ls->power_cdf || l1 <= l0) return 0;
-  double power = ls->power_cdf[l1 - 1] - (l0 ? ls->power_cdf[l0 - 1] : 0);
-  const float *row = ls->grid_cdf ? grid_row(ls, p) : NULL;
-  if (!row) return (float)power;
-  /* light_select_at draws from the row's running sums: a range is drawn with exactly the
-   * difference of its ends */
-  float cell = row[l1 - 1] - (l0 ? row[l0 - 1] : 0);
-  return (float)(LIGHT_GRID_POWER * power + (1 - LIGHT_GRID_POWER) * cell);
+  if (ls->table.n == 0 || !ls->unit0 || l1 <= l0 || l1 > ls->n) return 0;
+  uint32_t un = ls->unit_of[l0];
+  if (ls->unit0[un] != l0 || ls->unit0[un + 1] != l1) return 0;
+  return unit_pmf(ls, un, p);
 }
 
 int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k) {
-  if (!ls->sphere_cones || !ls->power_cdf || li >= s->nlights) return 0;
+  if (!ls->sphere_cones || !ls->unit0 || li >= s->nlights) return 0;
   const light *l = &s->lights[li];
   if (l->type != LIGHT_AREA || !l->sphere) return 0;
   const sphere_shape *sp = &s->spheres[l->sphere - 1];

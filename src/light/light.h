@@ -28,16 +28,30 @@
 #define LIGHT_GRID_CELLS 4096
 #define LIGHT_GRID_POWER 0.2f
 typedef enum light_select_mode { LIGHT_SELECT_GRID, LIGHT_SELECT_POWER } light_select_mode;
+/* Above LIGHT_LOCAL_MAX lights, with emitting spheres sampled by their cones, the choice is
+ * made between units: each such sphere's lights are one unit (grid weight: its power over
+ * 4 pi max(d^2, r^2), the irradiance a Lambertian sphere can bring), every other light one
+ * of its own. A unit of several lights then gives one of them by power, from where the
+ * number fell within the unit's share (alias_sample_rest; pbrt's light sampler reuses it
+ * so), and the light's pmf is the unit's times its power share. */
 typedef struct light_sampler {
-  alias_table table; int env_index; float *power; uint32_t n; int local;
-  int sphere_cones;     /* emitting spheres sampled whole (light_sphere_at); set after init */
-  double *power_cdf;    /* running sums of the power pmf, when the scene has emitting spheres */
-  float *grid_cdf;      /* per cell, n running sums normalised to 1 (cells with nothing: all 0) */
+  alias_table table;    /* by power, over the units */
+  int env_index; float *power; uint32_t n; int local;
+  int sphere_cones;     /* emitting spheres sampled whole (light_sphere_at) */
+  uint32_t nu;          /* units (n when each light is its own) */
+  uint32_t *unit0;      /* unit u holds lights [unit0[u], unit0[u + 1]); NULL: each light its own */
+  uint32_t *unit_of;    /* the unit of each light (with unit0) */
+  float *upower;        /* each unit's power (with unit0) */
+  double *power_cdf;    /* running sums of the lights' power (with unit0) */
+  float *grid_cdf;      /* per cell, nu running sums normalised to 1 (cells with nothing: all 0) */
   int gdim[3];
   vec3 glo, ginv;       /* grid origin and cells per unit length */
 } light_sampler;
 
-int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode);
+/* sphere_cones: sample emitting spheres by their cones (light_sphere_at). */
+int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode, int sphere_cones);
+/* A light by power alone, wherever it is received (photon and VPL tracing); *pmf. */
+uint32_t light_select_power(const light_sampler *ls, float u, float *pmf);
 void light_sampler_free(light_sampler *ls);
 /* Picks a light for shading point p with u in [0,1); returns its index and *pmf, or
  * UINT32_MAX when no light can reach p. */
@@ -49,8 +63,8 @@ light_site light_locate(const light_sampler *ls, vec3 p);
 uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf);
 /* The probability light_select picks light li at p. */
 float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p);
-/* The probability light_select picks any of the lights [l0, l1) at p (not in the local
- * mode). */
+/* The probability light_select picks any of the lights [l0, l1) at p, when they are one
+ * unit (an emitting sphere's lights); else 0. */
 float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p);
 
 /* Emitting spheres (scene.spheres whose lights are [l0, l1)) are sampled whole where

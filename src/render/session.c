@@ -75,11 +75,10 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   if (st) goto fail;
   ss->build_seconds = now_seconds() - t0;
   int cones = strcmp(o.sphere_lights, "triangles") != 0;
-  if (light_sampler_init(&ss->ctx.ls, s, strcmp(o.light_sampler, "power") ? LIGHT_SELECT_GRID : LIGHT_SELECT_POWER)) {
+  if (light_sampler_init(&ss->ctx.ls, s, strcmp(o.light_sampler, "power") ? LIGHT_SELECT_GRID : LIGHT_SELECT_POWER, cones)) {
     st = err_set(err, VALO_ERR_NOMEM, "out of memory");
     goto fail;
   }
-  ss->ctx.ls.sphere_cones = cones;
   ss->ctx.s = s;
   ss->ctx.acc = ss->acc;
   ss->ctx.max_depth = o.max_depth;
