@@ -244,7 +244,7 @@ static uint32_t unit_light(const light_sampler *ls, uint32_t un, float pu, float
     uint32_t mid = (lo + hi) / 2;
     if (ls->power_cdf[mid] > target) hi = mid; else lo = mid + 1;
   }
-  *pmf = pu * (ls->power[lo] / ls->upower[un]);
+  *pmf = ls->upower[un] > 0 ? pu * (ls->power[lo] / ls->upower[un]) : 0;
   return lo;
 }
 
@@ -312,7 +312,8 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
   if (ls->unit0) {
     uint32_t un = ls->unit_of[li];
     float pu = unit_pmf(ls, un, p);
-    return ls->unit0[un + 1] - ls->unit0[un] == 1 ? pu : pu * (ls->power[li] / ls->upower[un]);
+    if (ls->unit0[un + 1] - ls->unit0[un] == 1) return pu;
+    return ls->upower[un] > 0 ? pu * (ls->power[li] / ls->upower[un]) : 0;
   }
   if (ls->grid_cdf) {
     const float *row = grid_row(ls, p);
