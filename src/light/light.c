@@ -173,9 +173,7 @@ int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode
   return 0;
 }
 void light_sampler_free(light_sampler *ls) {
-  if (ls->table.bins) alias_free(&ls->table);
-  ls->table.bins = NULL;
-  ls->table.n = 0;
+  alias_free(&ls->table);
   free(ls->power);
   free(ls->grid_cdf);
   free(ls->power_cdf);
@@ -232,6 +230,13 @@ uint32_t light_select(const light_sampler *ls, const scene *s, vec3 p, float u, 
   return light_select_at(ls, s, &at, u, pmf);
 }
 
+/* The probability of light li of unit un, the unit picked with probability pu: one
+ * expression for light_select and light_select_pmf, so they agree to the bit. */
+static inline float unit_share(const light_sampler *ls, uint32_t un, uint32_t li, float pu) {
+  if (ls->unit0[un + 1] - ls->unit0[un] == 1) return pu;
+  return ls->upower[un] > 0 ? pu * (ls->power[li] / ls->upower[un]) : 0;
+}
+
 /* The light of unit un picked with probability pu, rest the number left of the unit's
  * choice: the unit's only light, or one of its lights by power. */
 static uint32_t unit_light(const light_sampler *ls, uint32_t un, float pu, float rest, float *pmf) {
@@ -244,7 +249,7 @@ static uint32_t unit_light(const light_sampler *ls, uint32_t un, float pu, float
     uint32_t mid = (lo + hi) / 2;
     if (ls->power_cdf[mid] > target) hi = mid; else lo = mid + 1;
   }
-  *pmf = ls->upower[un] > 0 ? pu * (ls->power[lo] / ls->upower[un]) : 0;
+  *pmf = unit_share(ls, un, lo, pu);
   return lo;
 }
 
@@ -311,16 +316,9 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
   if (ls->table.n == 0) return 0;
   if (ls->unit0) {
     uint32_t un = ls->unit_of[li];
-    float pu = unit_pmf(ls, un, p);
-    if (ls->unit0[un + 1] - ls->unit0[un] == 1) return pu;
-    return ls->upower[un] > 0 ? pu * (ls->power[li] / ls->upower[un]) : 0;
+    return unit_share(ls, un, li, unit_pmf(ls, un, p));
   }
-  if (ls->grid_cdf) {
-    const float *row = grid_row(ls, p);
-    if (!row) return alias_pmf(&ls->table, li);
-    return grid_mix_pmf(ls, row, li);
-  }
-  if (!ls->local) return alias_pmf(&ls->table, li);
+  if (!ls->local) return unit_pmf(ls, li, p); /* each light its own unit */
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
   return total > 0 ? w[li] / total : 0;
 }

@@ -204,12 +204,8 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   double m[16];
   int has_xf;
   TRY(mi_transform(c, n, "to_world", m, &has_xf));
-  if (c->outer) {
-    /* an instance's shape: the instance's to_world after the shape's own */
-    double a[16];
-    memcpy(a, m, sizeof a);
-    for (int i = 0; i < 4; i++)
-      for (int j = 0; j < 4; j++) m[4 * i + j] = c->outer[4 * i] * a[j] + c->outer[4 * i + 1] * a[4 + j] + c->outer[4 * i + 2] * a[8 + j] + c->outer[4 * i + 3] * a[12 + j];
+  if (c->outer) { /* an instance's shape: the instance's to_world after the shape's own */
+    mi_mat_mul(m, c->outer, m);
     has_xf = 1;
   }
   int flip = 0;
@@ -301,10 +297,7 @@ static valo_status check_group(mctx *c, xml_node *g) {
     if (!strcmp(k->name, "shape")) {
       const char *t = xml_attr_get(k, "type");
       if (t && (!strcmp(t, "shapegroup") || !strcmp(t, "instance"))) return mi_bad(c, k, "a shapegroup cannot hold groups or instances (nor can Mitsuba's)");
-      for (xml_node *e = k->child; e; e = e->next)
-        if (!strcmp(e->name, "emitter") || (!strcmp(e->name, "ref") && mi_find_id(c, xml_attr_get(e, "id")) &&
-                                            !strcmp(mi_find_id(c, xml_attr_get(e, "id"))->name, "emitter")))
-          return mi_bad(c, k, "an emitting shape cannot be instanced (nor can it in Mitsuba)");
+      if (mi_child(c, k, "emitter", 0)) return mi_bad(c, k, "an emitting shape cannot be instanced (nor can it in Mitsuba)");
     } else if (strcmp(k->name, "ref")) {
       return mi_bad(c, k, "a shapegroup holds shapes");
     }

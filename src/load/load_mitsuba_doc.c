@@ -83,7 +83,7 @@ static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
     }
     if (st) {
       size_t ml = strlen(c->err->message);
-      snprintf(c->err->message + ml, sizeof c->err->message - ml, " (the <include> at %s:%d)", n->file ? n->file : c->path, n->line);
+      snprintf(c->err->message + ml, sizeof c->err->message - ml, " (the <include> at %s:%d)", mi_file(c, n), n->line);
       return st;
     }
     set_file(r, path);

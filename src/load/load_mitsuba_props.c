@@ -28,8 +28,10 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) {
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
   if (!n) return err_set(c->err, VALO_ERR_INVALID, "%s: %s", c->path, msg);
-  return err_set(c->err, VALO_ERR_INVALID, "%s:%d: %s: %s", n->file ? n->file : c->path, n->line, label(n, lb, sizeof lb), msg);
+  return err_set(c->err, VALO_ERR_INVALID, "%s:%d: %s: %s", mi_file(c, n), n->line, label(n, lb, sizeof lb), msg);
 }
+
+const char *mi_file(const mctx *c, const xml_node *n) { return n->file ? n->file : c->path; }
 
 const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
   if (!n->file) {
@@ -52,7 +54,7 @@ void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  log_warning("%s:%d: %s: %s", n->file ? n->file : c->path, n->line, label(n, lb, sizeof lb), msg);
+  log_warning("%s:%d: %s: %s", mi_file(c, n), n->line, label(n, lb, sizeof lb), msg);
 }
 
 static xml_node *find_id(xml_node *n, const char *id) {
@@ -189,7 +191,7 @@ valo_status mi_point(mctx *c, xml_node *p, const char *name, vec3 *out) {
   return VALO_OK;
 }
 
-static void mat_mul(double r[16], const double a[16], const double b[16]) {
+void mi_mat_mul(double r[16], const double a[16], const double b[16]) {
   double t[16];
   for (int i = 0; i < 4; i++)
     for (int j = 0; j < 4; j++) t[4 * i + j] = a[4 * i] * b[j] + a[4 * i + 1] * b[4 + j] + a[4 * i + 2] * b[8 + j] + a[4 * i + 3] * b[12 + j];
@@ -272,7 +274,7 @@ valo_status mi_transform(mctx *c, xml_node *p, const char *name, double m[16], i
   for (xml_node *op = k->child; op; op = op->next) {
     double t[16];
     TRY(transform_op(c, op, t));
-    mat_mul(m, t, m); /* each operation applies after the ones before it */
+    mi_mat_mul(m, t, m); /* each operation applies after the ones before it */
   }
   for (int i = 0; i < 16; i++)
     if (!isfinite(m[i])) return mi_bad(c, k, "is not finite");

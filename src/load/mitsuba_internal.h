@@ -32,6 +32,10 @@ valo_status mi_document_prepare(mctx *c);
 /* "file:line: <tag name="..">: what" */
 valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* The file n was read from: the scene file's path, or an included file's. */
+const char *mi_file(const mctx *c, const xml_node *n);
+/* r = a b (4x4, row-major; r may be a or b). */
+void mi_mat_mul(double r[16], const double a[16], const double b[16]);
 /* Where n is, for names of the materials and media made from unnamed elements: "line12",
  * or "part.xml:line12" in an included file (so two files' line 12 are told apart). */
 const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len);
