@@ -1120,11 +1120,22 @@ static int light_units(void) {
       light_site at = light_locate(&ls, p);
       for (long k = 0; k < n; k++) {
         sampler sm = sampler_make(31 + mode * 7 + q, (uint64_t)k, 0);
-        float pmf;
-        uint32_t li = mode == 2 ? light_select_power(&ls, sampler_1d(&sm), &pmf) : light_select_at(&ls, s, &at, sampler_1d(&sm), &pmf);
+        float pmf, u = sampler_1d(&sm);
+        uint32_t li = mode == 2 ? light_select_power(&ls, u, &pmf) : light_select_at(&ls, s, &at, u, &pmf);
         CHECK(li < s->nlights, "no light");
         float want = mode == 2 ? pmf : light_select_pmf(&ls, s, li, p);
         CHECK(pmf == want, "light %u: select says %g, pmf %g", li, pmf, want);
+        if (mode != 2) { /* next-event estimation's choice: the same unit, a sphere whole */
+          light_cone kc, kl;
+          float cpmf;
+          uint32_t lc = light_select_cone(&ls, s, p, u, &cpmf, &kc), un = ls.unit_of[li];
+          if (light_sphere_at(&ls, s, li, p, &kl)) {
+            uint32_t l0 = kl.sp->l0, l1 = kl.sp->l1;
+            CHECK(kc.sp == kl.sp && lc == l0 && cpmf == light_range_pmf(&ls, l0, l1, p) && ls.unit0[un] == l0,
+                  "light %u: the cone's choice is light %u, pmf %g", li, lc, cpmf);
+          } else
+            CHECK(!kc.sp && lc == li && cpmf == pmf, "light %u: the cone's choice is light %u, pmf %g", li, lc, cpmf);
+        }
         obs[ls.unit_of[li]]++;
         if (li >= big->l0 && li < big->l1) obs[42 + li - big->l0]++;
       }

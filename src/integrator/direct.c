@@ -36,7 +36,7 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
 }
 
 /* An emitting sphere's sample: a direction in its cone k, and the first solid surface
- * along it, which must be one of the sphere's triangles. */
+ * along it, which must be one of the sphere's triangles; *pmf is the sphere's. */
 static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, const isect *it, float u1, float u2, thread_stats *ts,
                               float *pmf, light_li *ls) {
   const scene *s = c->s;
@@ -56,17 +56,16 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   ls->L = light_area_radiance(s, &s->lights[lid], hi.ng, v3_neg(wi), hi.u, hi.v);
   ls->pdf = k->pdf;
   ls->visible = 1;
-  *pmf = light_range_pmf(&c->ls, k->sp->l0, k->sp->l1, p);
   return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
 }
 
 uint32_t direct_light_sample(const render_ctx *c, vec3 p, const isect *it, sampler *smp, thread_stats *ts, float *pmf, light_li *ls) {
   float ul = sampler_1d(smp), u1, u2;
   sampler_2d(smp, &u1, &u2);
-  uint32_t li = light_select(&c->ls, c->s, p, ul, pmf);
-  if (li == UINT32_MAX) return UINT32_MAX;
   light_cone k;
-  if (light_sphere_at(&c->ls, c->s, li, p, &k)) return sphere_sample(c, &k, p, it, u1, u2, ts, pmf, ls);
+  uint32_t li = light_select_cone(&c->ls, c->s, p, ul, pmf, &k);
+  if (li == UINT32_MAX) return UINT32_MAX;
+  if (k.sp) return sphere_sample(c, &k, p, it, u1, u2, ts, pmf, ls);
   if (!light_sample(c->s, &c->s->lights[li], p, u1, u2, ls)) return UINT32_MAX;
   ls->visible = 0;
   return li;

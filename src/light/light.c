@@ -261,38 +261,53 @@ uint32_t light_select_power(const light_sampler *ls, float u, float *pmf) {
   return unit_light(ls, un, pu, rest, pmf);
 }
 
+/* The grid's choice at `at` (row not NULL): the unit, its mixture pmf *pu and, with
+ * units, the number left of the choice *rest. */
+static uint32_t grid_select(const light_sampler *ls, const float *row, float u, float *pu, float *rest) {
+  uint32_t i;
+  *rest = 0;
+  const float a = LIGHT_GRID_POWER;
+  if (u < a) {
+    float power_pmf; /* not the answer: the mixture's pmf is */
+    float v = fminf(u / a, 0x1.fffffep-1f);
+    i = ls->unit0 ? alias_sample_rest(&ls->table, v, &power_pmf, rest) : alias_sample(&ls->table, v, &power_pmf);
+  } else {
+    float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
+    uint32_t lo = 0, hi = ls->nu - 1; /* the first i with row[i] > v */
+    while (lo < hi) {
+      uint32_t mid = (lo + hi) / 2;
+      if (row[mid] > v) hi = mid; else lo = mid + 1;
+    }
+    i = lo;
+    if (ls->unit0) {
+      float below = i ? row[i - 1] : 0;
+      *rest = fminf(fmaxf((v - below) / (row[i] - below), 0), 0x1.fffffep-1f);
+    }
+  }
+  *pu = grid_mix_pmf(ls, row, i);
+  return i;
+}
+
+/* The unit picked at `at` (a sampler with units): *pu and *rest as grid_select. */
+static uint32_t unit_select(const light_sampler *ls, const light_site *at, float u, float *pu, float *rest) {
+  if (ls->grid_cdf && at->row) return grid_select(ls, at->row, u, pu, rest);
+  return alias_sample_rest(&ls->table, u, pu, rest);
+}
+
 uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
-  vec3 p = at->p;
+  if (ls->unit0) {
+    float pu, rest;
+    uint32_t un = unit_select(ls, at, u, &pu, &rest);
+    return unit_light(ls, un, pu, rest, pmf);
+  }
   if (ls->grid_cdf) {
-    const float *row = at->row;
-    if (!row) return light_select_power(ls, u, pmf);
-    uint32_t i;
-    float rest = 0;
-    const float a = LIGHT_GRID_POWER;
-    if (u < a) {
-      float power_pmf; /* not the answer: the mixture's pmf is */
-      float v = fminf(u / a, 0x1.fffffep-1f);
-      i = ls->unit0 ? alias_sample_rest(&ls->table, v, &power_pmf, &rest) : alias_sample(&ls->table, v, &power_pmf);
-    } else {
-      float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
-      uint32_t lo = 0, hi = ls->nu - 1; /* the first i with row[i] > v */
-      while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (row[mid] > v) hi = mid; else lo = mid + 1;
-      }
-      i = lo;
-      if (ls->unit0) {
-        float below = i ? row[i - 1] : 0;
-        rest = fminf(fmaxf((v - below) / (row[i] - below), 0), 0x1.fffffep-1f);
-      }
-    }
-    float pu = grid_mix_pmf(ls, row, i);
-    if (!ls->unit0) { *pmf = pu; return i; }
-    return unit_light(ls, i, pu, rest, pmf);
+    if (!at->row) return light_select_power(ls, u, pmf);
+    float rest;
+    return grid_select(ls, at->row, u, pmf, &rest);
   }
   if (!ls->local) return light_select_power(ls, u, pmf);
-  float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, p, w);
+  float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, at->p, w);
   if (!(total > 0)) return UINT32_MAX;
   float target = u * total, acc = 0;
   uint32_t last = UINT32_MAX;
@@ -330,11 +345,8 @@ float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p)
   return unit_pmf(ls, un, p);
 }
 
-int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k) {
-  if (!ls->sphere_cones || !ls->unit0 || li >= s->nlights) return 0;
-  const light *l = &s->lights[li];
-  if (l->type != LIGHT_AREA || !l->sphere) return 0;
-  const sphere_shape *sp = &s->spheres[l->sphere - 1];
+/* The cone of emitting sphere sp from p, when p lies outside it by the margin. */
+static int sphere_cone(const sphere_shape *sp, vec3 p, light_cone *k) {
   vec3 d = v3_sub(sp->c, p);
   float d2 = v3_len2(d), rr = sp->r * (1 + LIGHT_SPHERE_MARGIN);
   if (!(d2 > rr * rr) || !isfinite(d2)) return 0;
@@ -344,6 +356,25 @@ int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p
   k->one_minus_cos = sin2 / (1 + cos_max); /* without cancellation for a small, far sphere */
   k->pdf = 1 / (2 * PI_F * k->one_minus_cos);
   return isfinite(k->pdf) && k->pdf > 0;
+}
+
+int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k) {
+  if (!ls->sphere_cones || !ls->unit0 || li >= s->nlights) return 0;
+  const light *l = &s->lights[li];
+  if (l->type != LIGHT_AREA || !l->sphere) return 0;
+  return sphere_cone(&s->spheres[l->sphere - 1], p, k);
+}
+
+uint32_t light_select_cone(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf, light_cone *k) {
+  k->sp = NULL;
+  if (!ls->unit0 || !ls->sphere_cones) return light_select(ls, s, p, u, pmf);
+  if (ls->table.n == 0) return UINT32_MAX;
+  light_site at = light_locate(ls, p);
+  float pu, rest;
+  uint32_t un = unit_select(ls, &at, u, &pu, &rest), l0 = ls->unit0[un];
+  if (light_sphere_at(ls, s, l0, p, k)) { *pmf = pu; return l0; }
+  k->sp = NULL;
+  return unit_light(ls, un, pu, rest, pmf);
 }
 
 vec3 light_cone_sample(const light_cone *k, float u1, float u2) {

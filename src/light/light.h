@@ -87,6 +87,11 @@ typedef struct light_cone {
 } light_cone;
 /* 1 and *k when light li at p is sampled through its sphere's cone; else 0. */
 int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k);
+/* light_select for next-event estimation: when the light picked is one of an emitting
+ * sphere's that light_sphere_at samples by its cone at p, the light within the sphere is
+ * not drawn: *k is filled, *pmf is the sphere's probability (light_range_pmf's) and the
+ * sphere's first light is returned. Otherwise exactly light_select, with k->sp NULL. */
+uint32_t light_select_cone(const light_sampler *ls, const scene *s, vec3 p, float u, float *pmf, light_cone *k);
 /* A unit direction uniform in the cone (u1 in [0,1) from its axis outwards). */
 vec3 light_cone_sample(const light_cone *k, float u1, float u2);
 
