@@ -8,6 +8,7 @@
  * binomial / exact checks instead. */
 #include "harness.h"
 #include "material/bsdf.h"
+#include "material/plastic.h"
 #include "material/fresnel.h"
 #include "material/medium.h"
 #include "light/light.h"
@@ -138,6 +139,7 @@ typedef struct bsdf_ctx { bsdf b; vec3 wo; } bsdf_ctx;
 static int bsdf_sf(void *c, sampler *s, vec3 *d);
 static int test_bsdf_wo(const char *name, material m, vec3 wo);
 static int test_bsdf(const char *name, material m, float theta_o_deg);
+static double directional_albedo(const material *m, float theta_o_deg, uint64_t seed);
 
 /* Rough conductor (6 tests per distribution, GGX and Beckmann) and rough dielectric
  * seen from outside and inside (4 tests per distribution). */
@@ -159,6 +161,38 @@ static int rough_conductor(void) {
     }
   return rc;
 }
+/* Mitsuba's plastics (material/plastic.h): the sampled directions against the pdf, smooth
+ * (its mirror lobe is the delta share) and rough with either distribution (6 tests); then
+ * a white smooth plastic (kd = ks = 1) reflects all it receives, since the coat passes
+ * diffuse light out as much as in (1 - Fdr(eta) = eta^2 (1 - Fdr(1/eta))), and a white
+ * rough one at most all (single scattering loses some). */
+static int plastic(void) {
+  struct { float rough, th; int beck; } cfg[6] = {{0, 20, 0}, {0, 70, 0}, {0.3f, 30, 1}, {0.3f, 75, 0}, {0.7f, 45, 1}, {0.7f, 80, 0}};
+  int rc = 0;
+  for (int i = 0; i < 6; i++) {
+    material m = material_default();
+    m.type = MAT_PLASTIC; m.ior = 1.49f; m.kd = c3(0.6f, 0.4f, 0.2f); m.ks = c3(1, 1, 1);
+    m.roughness = cfg[i].rough; m.beckmann = cfg[i].beck; m.nonlinear = i & 1;
+    plastic_prepare(&m);
+    char name[96];
+    snprintf(name, sizeof name, "%s plastic roughness %.1f", cfg[i].rough == 0 ? "smooth" : cfg[i].beck ? "Beckmann" : "GGX", cfg[i].rough);
+    rc |= test_bsdf(name, m, cfg[i].th);
+  }
+  float rough[3] = {0, 0.3f, 0.7f}, th[3] = {0, 45, 80};
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      material m = material_default();
+      m.type = MAT_PLASTIC; m.ior = 1.49f; m.kd = c3(1, 1, 1); m.ks = c3(1, 1, 1); m.roughness = rough[i];
+      plastic_prepare(&m);
+      double albedo = directional_albedo(&m, th[j], 29);
+      fprintf(stderr, "white plastic roughness %.1f theta_o %2.0f: albedo %.4f\n", rough[i], th[j], albedo);
+      CHECK(albedo <= 1.0 + 5e-3, "albedo %.4f > 1", albedo);
+      CHECK(rough[i] > 0 || fabs(albedo - 1) < 5e-3, "a white smooth plastic's albedo is %.4f, not 1", albedo);
+      CHECK(albedo > 0.45, "albedo %.4f: implausibly low (single scattering at roughness 0.7 keeps about 0.55)", albedo);
+    }
+  return rc;
+}
+
 static int rough_dielectric(void) {
   material m = material_default();
   m.type = MAT_DIELECTRIC;
@@ -1173,7 +1207,7 @@ int main(int argc, char **argv) {
                                     {"rough_conductor", rough_conductor},
                                     {"rough_dielectric", rough_dielectric},
                                     {"microfacet_furnace", microfacet_furnace}, {"ggx_albedo", ggx_albedo}, {"bsdf_reciprocity", bsdf_reciprocity},
-                                    {"pbr_metallic_roughness", pbr_metallic_roughness},
+                                    {"pbr_metallic_roughness", pbr_metallic_roughness}, {"plastic", plastic},
                                     {"sobol_sampler", sobol_sampler},
                                     {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
                                     {"pixel_filters", pixel_filters}, {"hg_phase", hg_phase}, {"free_flight", free_flight}, {NULL, NULL}};

@@ -5,6 +5,7 @@
 #include "core/error.h"
 #include "core/spectrum.h"
 #include "scene/volume.h"
+#include "material/plastic.h"
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -110,7 +111,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, null)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -119,6 +120,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_thin[] = {"type", "ior", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map",
+                                          "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
@@ -171,6 +174,16 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
+  } else if (!strcmp(type, "plastic")) {
+    TRY(json_check_keys(c, o, where, k_plastic));
+    m->type = MAT_PLASTIC;
+    m->kd = c3(0.5f, 0.5f, 0.5f); m->ks = c3(1, 1, 1);
+    TRY(get_rgb_tex(c, o, "diffuse", where, &m->kd, &m->tex_kd));
+    TRY(json_get_rgb(c, o, "specular", where, &m->ks));
+    double ior = 1.49; /* polypropylene, Mitsuba's default */
+    TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
+    m->ior = (float)ior;
+    TRY(json_get_bool(c, o, "nonlinear", where, &m->nonlinear));
   } else if (!strcmp(type, "conductor")) {
     TRY(json_check_keys(c, o, where, k_conductor));
     m->type = MAT_CONDUCTOR;
@@ -190,7 +203,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "k", where, &m->k));
     TRY(json_get_rgb(c, o, "reflectance", where, &m->tint));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, null)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));
@@ -206,6 +219,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   m->beckmann = dist && !strcmp(dist, "beckmann");
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
+  if (m->type == MAT_PLASTIC) plastic_prepare(m);
   return VALO_OK;
 }
 

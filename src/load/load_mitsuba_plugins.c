@@ -173,17 +173,21 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     TRY(set_color(c, b, "specular_reflectance", m, "reflectance", 1));
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
   } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
-    mi_warn(c, b, "valo has no plastic: approximated by its pbr (glTF) material with the same diffuse colour, a clear coat of "
-                  "index 1.5 and GGX roughness");
-    TYPE("pbr");
+    double in = 1.49, out = 1.000277; /* polypropylene in air, Mitsuba's defaults */
+    TRY(ior_prop(c, b, "int_ior", &in));
+    TRY(ior_prop(c, b, "ext_ior", &out));
+    if (!(in > 0 && out > 0)) return mi_bad(c, b, "indices of refraction must be positive");
+    if (in < out) return mi_bad(c, b, "valo's plastic coat is denser than outside (int_ior >= ext_ior)");
+    TYPE("plastic");
+    cJSON_AddNumberToObject(m, "ior", in / out);
     cJSON *v;
     TRY(mi_color(c, b, "diffuse_reflectance", 0, &v));
-    cJSON_AddItemToObject(m, "base_color", v ? v : cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
-    cJSON_AddNumberToObject(m, "metallic", 0);
+    cJSON_AddItemToObject(m, "diffuse", v ? v : vec3_json(0.5, 0.5, 0.5));
+    TRY(set_color(c, b, "specular_reflectance", m, "specular", 1));
+    int nonlinear = 0;
+    TRY(mi_bool(c, b, "nonlinear", &nonlinear));
+    cJSON_AddBoolToObject(m, "nonlinear", nonlinear);
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
-    else cJSON_AddNumberToObject(m, "roughness", 0);
-    for (const char *const *q = (const char *const[]){"int_ior", "ext_ior", "nonlinear", "specular_reflectance", NULL}; *q; q++)
-      (void)mi_prop(c, b, *q);
   } else if (!strcmp(type, "principled")) {
     mi_warn(c, b, "read as valo's pbr (glTF metallic-roughness) material: base_color, metallic and roughness only");
     TYPE("pbr");

@@ -8,11 +8,13 @@
  * metallic-roughness model (glTF spec, appendix B): mix(dielectric, metal, metallic)
  * where the dielectric is fresnel_mix(F0 = 0.04; Lambertian base colour, GGX specular)
  * and the metal is the GGX specular with Schlick Fresnel of F0 = base colour; lobes
- * chosen by a fixed mixture probability, specular by visible normals. */
+ * chosen by a fixed mixture probability, specular by visible normals; Mitsuba's plastics
+ * (plastic.c). */
 #include "material/bsdf.h"
 #include "material/fresnel.h"
 #include "core/sampling.h"
 #include "material/microfacet.h"
+#include "material/plastic.h"
 
 static float lobe_prob(rgb a, rgb b) {
   float wa = c3_avg(a), wb = c3_avg(b);
@@ -34,6 +36,17 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
   case MAT_THIN_DIELECTRIC: b.type = BSDF_THIN_DIELECTRIC; break;
   case MAT_CONDUCTOR: b.type = BSDF_CONDUCTOR; break;
+  case MAT_PLASTIC: {
+    b.alpha = m->roughness * m->roughness;
+    b.type = b.alpha >= 1e-3f ? BSDF_ROUGH_PLASTIC : BSDF_PLASTIC;
+    b.beckmann = m->beckmann;
+    b.nonlinear = m->nonlinear;
+    float wd = c3_avg(m->kd), ws = c3_avg(m->ks);
+    b.spec_w = wd + ws > 0 ? ws / (wd + ws) : 0.5f;
+    b.coat_ri = m->coat_ri;
+    memcpy(b.coat_t, m->coat_t, sizeof b.coat_t);
+    return b;
+  }
   case MAT_PBR: {
     b.type = BSDF_PBR;
     b.metallic = clampf(m->metallic, 0, 1);
@@ -60,6 +73,7 @@ int bsdf_has_smooth(const bsdf *b) {
   case BSDF_MIRROR: return b->p_first > 0;
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: return 1;
+  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return 1;
   }
   return 0;
 }
@@ -154,6 +168,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   }
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return c3(0, 0, 0);
   case BSDF_PBR: return pbr_eval(b, wo, wi);
+  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return plastic_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->alpha, wo, wi) / (4 * wo.z * wi.z);
@@ -174,6 +189,7 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
     return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * phong_lobe_pdf(phong_cos_alpha(wo, wi), b->exponent);
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_PBR: return pbr_pdf(b, wo, wi);
+  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return plastic_pdf(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float p = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
@@ -263,6 +279,9 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     s->weight = c3_scale(pbr_eval(b, wo, s->wi), s->wi.z / s->pdf);
     return sample_finite(s);
   }
+  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC:
+    if (!plastic_sample(b, wo, ulobe, u1, u2, s)) return 0;
+    return s->delta ? 1 : sample_finite(s);
   case BSDF_ROUGH_CONDUCTOR: {
     if (wo.z <= 0) return 0;
     vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
@@ -306,6 +325,7 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_DIELECTRIC: case MAT_THIN_DIELECTRIC: return c3(1, 1, 1);
   case MAT_CONDUCTOR: return c3_mul(m->tint, fresnel_conductor(fabsf(cos_o), m->eta, m->k));
   case MAT_PBR: return m->kd;
+  case MAT_PLASTIC: return c3_add(m->kd, c3_scale(m->ks, fresnel_dielectric(fabsf(cos_o), m->ior)));
   case MAT_NULL: break;
   }
   return c3(0, 0, 0);

@@ -10,7 +10,8 @@
 
 typedef enum bsdf_type {
   BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR,
-  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR, BSDF_THIN_DIELECTRIC
+  BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR, BSDF_THIN_DIELECTRIC,
+  BSDF_PLASTIC, BSDF_ROUGH_PLASTIC /* material/plastic.h */
 } bsdf_type;
 
 typedef struct bsdf {
@@ -25,6 +26,9 @@ typedef struct bsdf {
   float metallic;     /* BSDF_PBR */
   int beckmann;       /* rough conductor and dielectric: the Beckmann distribution, not GGX */
   int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */
+  int nonlinear;      /* plastics: material.nonlinear */
+  float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */
+  float coat_ri, coat_t[PLASTIC_RES]; /* plastics: the material's coat tables */
 } bsdf;
 
 typedef struct bsdf_sample {

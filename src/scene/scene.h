@@ -17,8 +17,14 @@ typedef enum mat_type {
   MAT_CONDUCTOR,   /* smooth conductor, complex index eta + i k per channel */
   MAT_PBR,         /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
   MAT_NULL,        /* no surface: rays pass straight through (a medium's boundary) */
-  MAT_THIN_DIELECTRIC /* a thin pane of glass, index ior: reflects as both faces do, transmits without bending */
+  MAT_THIN_DIELECTRIC, /* a thin pane of glass, index ior: reflects as both faces do, transmits without bending */
+  MAT_PLASTIC      /* diffuse kd under a dielectric coat of index ior, specular tint ks, smooth or rough
+                      (Mitsuba's plastic / roughplastic; material/plastic.h) */
 } mat_type;
+
+/* MAT_PLASTIC's coat, tabulated by plastic_prepare: its transmittance at cos theta =
+ * i / (PLASTIC_RES - 1), and the reflectance it shows to diffuse light from inside. */
+#define PLASTIC_RES 64
 
 typedef struct material {
   mat_type type;
@@ -45,6 +51,8 @@ typedef struct material {
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
+  int nonlinear;     /* MAT_PLASTIC: the base's internal scattering tints (Mitsuba's nonlinear) */
+  float coat_t[PLASTIC_RES], coat_ri; /* MAT_PLASTIC: filled by plastic_prepare */
   int nk;            /* MAT_CONDUCTOR: 1 + index into scene.nk (eta and k per wavelength,
                         which --spectral evaluates per wavelength), 0 = RGB eta, k only */
   char name[64];
