@@ -463,12 +463,89 @@ static int mesh_cache_places_alike(void) {
   return 0;
 }
 
+/* The texture coordinates of Mitsuba's unit shapes as valo lays them out for a Mitsuba
+ * scene (mitsuba_uv), at points seen from +z, against Mitsuba's own: Mitsuba 3.9.1's
+ * scene.ray_intersect(Ray3f((x, y, 5), (0, 0, -1))).uv of a scene holding the shape alone,
+ * its v turned up (valo's images run up from v = 0, Mitsuba's down). Without mitsuba_uv the
+ * rectangle keeps v up the shape. */
+static int mitsuba_primitive_uv(void) {
+  static const struct { primitive_kind k; float x, y, u, v; } want[] = {
+      {PRIM_RECTANGLE, 0.5f, -0.5f, 0.75f, 0.25f}, {PRIM_RECTANGLE, -0.5f, 0.2f, 0.25f, 0.6f}, {PRIM_RECTANGLE, 0.3f, 0.6f, 0.65f, 0.8f},
+      {PRIM_DISK, 0.5f, -0.5f, 0.707107f, 0.875f},  {PRIM_DISK, -0.5f, 0.2f, 0.538517f, 0.439441f}, {PRIM_DISK, 0.3f, 0.6f, 0.67082f, 0.176208f},
+      {PRIM_CUBE, 0.5f, -0.5f, 0.25f, 0.75f},       {PRIM_CUBE, -0.5f, 0.2f, 0.6f, 0.25f},          {PRIM_CUBE, 0.3f, 0.6f, 0.8f, 0.65f}};
+  for (size_t i = 0; i < sizeof want / sizeof want[0]; i++)
+    for (int mi = 0; mi < 2; mi++) {
+      if (!mi && want[i].k != PRIM_RECTANGLE) continue;
+      scene *s = scene_new("uv");
+      valo_error err;
+      CHECK(scene_add_primitive(s, want[i].k, NULL, 0, mi, 0, &err) == VALO_OK, "%s", err.message);
+      /* the triangle facing +z, highest, under (x, y): barycentric UV there */
+      float best_z = -INFINITY, u = NAN, v = NAN;
+      for (uint32_t t = 0; t < s->ntris; t++) {
+        const uint32_t *ix = &s->idx[3 * t];
+        vec3 a = s->pos[ix[0]], b = s->pos[ix[1]], c = s->pos[ix[2]];
+        float det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+        if (!(det > 1e-9f)) continue; /* facing away from +z, or edge-on */
+        float l1 = ((want[i].x - a.x) * (c.y - a.y) - (c.x - a.x) * (want[i].y - a.y)) / det;
+        float l2 = ((b.x - a.x) * (want[i].y - a.y) - (want[i].x - a.x) * (b.y - a.y)) / det, l0 = 1 - l1 - l2;
+        if (l0 < 0 || l1 < 0 || l2 < 0 || a.z < best_z) continue;
+        best_z = a.z;
+        u = l0 * s->uv[2 * ix[0]] + l1 * s->uv[2 * ix[1]] + l2 * s->uv[2 * ix[2]];
+        v = l0 * s->uv[2 * ix[0] + 1] + l1 * s->uv[2 * ix[1] + 1] + l2 * s->uv[2 * ix[2] + 1];
+      }
+      scene_free(s);
+      CHECK(best_z > -INFINITY, "no face under (%g, %g)", want[i].x, want[i].y);
+      float wu = want[i].u, wv = mi ? 1 - want[i].v : want[i].v;
+      /* the disk's 256 flat segments: its radius within 1e-4, its angle within half a
+       * segment (its centre's angle is the segment's middle) */
+      float tol_v = want[i].k == PRIM_DISK ? 0.5f / 256 : 2e-4f;
+      CHECK(fabsf(u - wu) < 2e-4f && fabsf(v - wv) < tol_v, "shape %d at (%g, %g)%s: uv (%g, %g), Mitsuba's (%g, %g)", (int)want[i].k, want[i].x,
+            want[i].y, mi ? " with mitsuba_uv" : "", u, v, wu, wv);
+    }
+  /* Every corner of the cube, face by face: Mitsuba 3.9.1's cube mesh
+   * (vertex_positions_buffer, vertex_texcoords_buffer), four corners a face. */
+  static const float corners[6][4][5] = {
+      {{1, -1, -1, 0, 1}, {1, -1, 1, 1, 1}, {-1, -1, 1, 1, 0}, {-1, -1, -1, 0, 0}}, {{1, 1, -1, 0, 1}, {-1, 1, -1, 1, 1}, {-1, 1, 1, 1, 0}, {1, 1, 1, 0, 0}},
+      {{1, -1, -1, 0, 1}, {1, 1, -1, 1, 1}, {1, 1, 1, 1, 0}, {1, -1, 1, 0, 0}},     {{1, -1, 1, 0, 1}, {1, 1, 1, 1, 1}, {-1, 1, 1, 1, 0}, {-1, -1, 1, 0, 0}},
+      {{-1, -1, 1, 0, 1}, {-1, 1, 1, 1, 1}, {-1, 1, -1, 1, 0}, {-1, -1, -1, 0, 0}}, {{1, 1, -1, 0, 1}, {1, -1, -1, 1, 1}, {-1, -1, -1, 1, 0}, {-1, 1, -1, 0, 0}}};
+  scene *s = scene_new("cube");
+  valo_error err;
+  CHECK(scene_add_primitive(s, PRIM_CUBE, NULL, 0, 1, 0, &err) == VALO_OK, "%s", err.message);
+  int checked = 0;
+  for (uint32_t t = 0; t < s->ntris; t++) {
+    const uint32_t *ix = &s->idx[3 * t];
+    vec3 n = v3_cross(v3_sub(s->pos[ix[1]], s->pos[ix[0]]), v3_sub(s->pos[ix[2]], s->pos[ix[0]]));
+    for (int k = 0; k < 3; k++) {
+      vec3 q = s->pos[ix[k]];
+      for (int f = 0; f < 6; f++) {
+        /* the face whose corners share the coordinate the triangle's normal points along */
+        const float *c0 = corners[f][0];
+        int axis = fabsf(n.x) > 0.5f ? 0 : fabsf(n.y) > 0.5f ? 1 : 2;
+        float side = axis == 0 ? n.x : axis == 1 ? n.y : n.z, cv = c0[axis];
+        if (cv * side <= 0 || corners[f][1][axis] != cv || corners[f][2][axis] != cv) continue;
+        for (int j = 0; j < 4; j++) {
+          const float *e = corners[f][j];
+          if (e[0] != q.x || e[1] != q.y || e[2] != q.z) continue;
+          float u = s->uv[2 * ix[k]], v = s->uv[2 * ix[k] + 1];
+          CHECK(u == e[3] && v == 1 - e[4], "cube corner (%g, %g, %g) of face %d: uv (%g, %g), Mitsuba's (%g, %g turned up)", q.x, q.y, q.z, f, u, v,
+                e[3], e[4]);
+          checked++;
+        }
+      }
+    }
+  }
+  scene_free(s);
+  CHECK(checked == 36, "%d of the cube's 36 triangle corners found among Mitsuba's", checked);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"mtl_pbr_extension", mtl_pbr_extension}, {"obj_number_forms", obj_number_forms},
                                     {"mtl_before_newmtl", mtl_before_newmtl},
                                     {"obj_mtl_indented", obj_mtl_indented},
                                     {"head_normals_unit", head_normals_unit}, {"transform_order", transform_order},
                                     {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings},
-                                    {"camera_project_inverts_ray", camera_project_inverts_ray}, {"mesh_cache_places_alike", mesh_cache_places_alike}, {NULL, NULL}};
+                                    {"camera_project_inverts_ray", camera_project_inverts_ray}, {"mesh_cache_places_alike", mesh_cache_places_alike},
+                                    {"mitsuba_primitive_uv", mitsuba_primitive_uv}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -252,7 +252,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
-                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", NULL};
+                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
   int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
@@ -325,6 +325,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "face_normals")) return json_bad(c, where, "\"face_normals\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "shape_index")) return json_bad(c, where, "\"shape_index\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "smooth_normals")) return json_bad(c, where, "\"smooth_normals\" is a mesh's");
+  if ((mesh || sphere) && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a rectangle's, cube's or disk's");
   if (sphere && (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "file")))
     return json_bad(c, where, "a sphere is placed by \"center\" and \"radius\" (no \"transform\" or \"file\")");
   if (mesh) {
@@ -367,8 +368,9 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
     if (strcmp(type, prims[k])) continue;
     float xf[12];
     TRY(shape_transform(c, o, where, xf));
-    int flip = 0;
+    int flip = 0, mitsuba_uv = 0;
     TRY(json_get_bool(c, o, "flip_normals", where, &flip));
+    TRY(json_get_bool(c, o, "mitsuba_uv", where, &mitsuba_uv));
     static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "file"};
     for (int j = 0; j < 5; j++)
       if (cJSON_GetObjectItemCaseSensitive(o, own[j])) {
@@ -381,7 +383,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       mat = scene_add_material(c->s, &d);
       if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     }
-    return scene_add_primitive(c->s, (primitive_kind)k, xf, flip, mat, c->err);
+    return scene_add_primitive(c->s, (primitive_kind)k, xf, flip, mitsuba_uv, mat, c->err);
   }
   return json_bad(c, where, "unknown shape type (mesh, sphere, rectangle, cube, disk)");
 }

@@ -254,6 +254,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     cJSON_AddStringToObject(sh, "type", type);
     if (has_xf) TRY(matrix_json(c, m, sh));
     if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
+    cJSON_AddTrueToObject(sh, "mitsuba_uv"); /* its textures where Mitsuba puts them */
   } else {
     return mi_bad(c, n, "valo reads obj, ply, serialized, sphere, rectangle, cube and disk shapes");
   }

@@ -90,12 +90,26 @@ static valo_status add_flat(scene *s, const vec3 *p, const float *uv, uint32_t n
 
 #define DISK_SEGMENTS 256
 
-valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, uint32_t mat, valo_error *err) {
+/* Mitsuba's texture coordinates of a point p on the face of its unit cube facing sgn along
+ * axis, in valo's convention (v up the image: 1 - Mitsuba's v, whose images run down).
+ * Mitsuba lays each face out so: */
+static void cube_uv_mitsuba(int axis, float sgn, vec3 p, float *u, float *v) {
+  float mv;
+  if (axis == 1 && sgn < 0) { *u = (p.z + 1) / 2; mv = (p.x + 1) / 2; }
+  else if (axis == 1) { *u = (1 - p.x) / 2; mv = (1 - p.z) / 2; }
+  else if (axis == 0 && sgn > 0) { *u = (p.y + 1) / 2; mv = (1 - p.z) / 2; }
+  else if (axis == 2 && sgn > 0) { *u = (p.y + 1) / 2; mv = (p.x + 1) / 2; }
+  else if (axis == 0) { *u = (p.y + 1) / 2; mv = (p.z + 1) / 2; }
+  else { *u = (1 - p.y) / 2; mv = (p.x + 1) / 2; }
+  *v = 1 - mv;
+}
+
+valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err) {
   if (kind == PRIM_RECTANGLE) {
     const vec3 p[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1}, uv_mi[8] = {0, 1, 1, 1, 1, 0, 0, 0};
     const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
-    return add_flat(s, p, uv, 4, idx, 2, xf, flip, mat, err);
+    return add_flat(s, p, mitsuba_uv ? uv_mi : uv, 4, idx, 2, xf, flip, mat, err);
   }
   if (kind == PRIM_CUBE) {
     /* Six faces of four vertices, each wound counter-clockwise seen from outside. */
@@ -116,11 +130,33 @@ valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, 
         p[4 * f + k] = v3(c[0], c[1], c[2]);
         uv[8 * f + 2 * k] = 0.5f * (a + 1);
         uv[8 * f + 2 * k + 1] = 0.5f * (b + 1);
+        if (mitsuba_uv) cube_uv_mitsuba(axis, sgn, p[4 * f + k], &uv[8 * f + 2 * k], &uv[8 * f + 2 * k + 1]);
       }
       const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
       for (int k = 0; k < 6; k++) idx[6 * f + k] = 4u * (uint32_t)f + q[k];
     }
     return add_flat(s, p, uv, 24, idx, 12, xf, flip, mat, err);
+  }
+  if (mitsuba_uv) {
+    /* Mitsuba's disk has polar coordinates, (r, phi / 2 pi) with phi from +x towards +y,
+     * in valo's convention (r, 1 - phi / 2 pi): each triangle of the fan has its own
+     * centre, at its middle angle, and the last one closes at phi = 2 pi. */
+    vec3 p[3 * DISK_SEGMENTS];
+    float uv[6 * DISK_SEGMENTS];
+    uint32_t idx[3 * DISK_SEGMENTS];
+    for (int k = 0; k < DISK_SEGMENTS; k++) {
+      double f0 = (double)k / DISK_SEGMENTS, f1 = (double)(k + 1) / DISK_SEGMENTS;
+      p[3 * k] = v3(0, 0, 0);
+      p[3 * k + 1] = v3((float)cos(2 * M_PI * f0), (float)sin(2 * M_PI * f0), 0);
+      p[3 * k + 2] = k + 1 < DISK_SEGMENTS ? v3((float)cos(2 * M_PI * f1), (float)sin(2 * M_PI * f1), 0) : p[1];
+      const float w[3][2] = {{0, (float)(1 - 0.5 * (f0 + f1))}, {1, (float)(1 - f0)}, {1, (float)(1 - f1)}};
+      for (int j = 0; j < 3; j++) {
+        uv[6 * k + 2 * j] = w[j][0];
+        uv[6 * k + 2 * j + 1] = w[j][1];
+        idx[3 * k + j] = 3u * (uint32_t)k + (uint32_t)j;
+      }
+    }
+    return add_flat(s, p, uv, 3 * DISK_SEGMENTS, idx, DISK_SEGMENTS, xf, flip, mat, err);
   }
   /* PRIM_DISK: a fan of DISK_SEGMENTS triangles around the centre (area within 0.01 % of
    * pi); UVs are the unit square's, (x + 1) / 2 and (y + 1) / 2. */

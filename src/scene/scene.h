@@ -252,9 +252,11 @@ valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, in
 /* Mitsuba's unit shapes, flat-shaded: the rectangle [-1, 1]^2 at z = 0 facing +z, the
  * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments);
  * placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps the front side);
- * flip: facing the other way. */
+ * flip: facing the other way. UVs span [0, 1]^2 on each (each face of the cube), or with
+ * mitsuba_uv as Mitsuba lays them out (its cube's faces, its disk's polar (r, phi / 2 pi)),
+ * v turned up to valo's convention, so a Mitsuba scene's textures land where Mitsuba puts them. */
 typedef enum { PRIM_RECTANGLE, PRIM_CUBE, PRIM_DISK } primitive_kind;
-valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, uint32_t mat, valo_error *err);
+valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err);
 /* Conductor presets: 0 on success. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
 #endif
