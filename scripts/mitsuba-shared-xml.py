@@ -20,14 +20,19 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # how), reading its serialized mesh and textures from ../shared.
           "sponza-serialized": ("@tests/data/mitsuba-xml/sponza-serialized.xml", {"resx": "128", "resy": "72"}),
           # instancing and <include>, with the bunny from ../shared
-          "instances": ("@tests/data/mitsuba-xml/instances.xml", {"resx": "160", "resy": "96"})}
+          "instances": ("@tests/data/mitsuba-xml/instances.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's plastic and roughplastic (valo's plastic material)
+          "plastic": ("@tests/data/mitsuba-xml/plastic.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):
     """The scene file of a SCENES entry and its <default> values (a repository file, "@...",
-    is given the shared folder as $shared)."""
+    is given the shared folder as $shared when it uses it)."""
     if path.startswith("@"):
-        return os.path.join(ROOT, path[1:]), dict(defs, shared=os.path.abspath(shared))
+        file = os.path.join(ROOT, path[1:])
+        with open(file) as f:
+            uses = "$shared" in f.read()
+        return file, dict(defs, shared=os.path.abspath(shared)) if uses else dict(defs)
     return os.path.join(shared, "scenes", path), dict(defs)
 
 

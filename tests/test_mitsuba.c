@@ -247,6 +247,12 @@ static int instances_xml(void) {
                              256, 0.02);
 }
 
+/* Mitsuba's plastics (tests/data/mitsuba-xml/plastic.xml): smooth and rough, Beckmann and
+ * GGX, linear and nonlinear, a tinted specular, a bitmap diffuse colour, a denser coat. */
+static int plastic_xml(void) {
+  return against_mitsuba_xml("plastic", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/plastic.xml", "resx=160 resy=96", 256, 0.03);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -332,6 +338,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
