@@ -6,6 +6,7 @@
 #include "harness.h"
 #include "load/load.h"
 #include "load/xml.h"
+#include "scene/scene.h"
 #include "valo/valo.h"
 #include <math.h>
 #include <stdlib.h>
@@ -299,6 +300,48 @@ static int unit_shapes(void) {
   return 0;
 }
 
+/* A mesh's v as Mitsuba reads it: an OBJ's turned over (flip_tex_coords, default true),
+ * which is valo's own reading; a PLY's as it stands, running down the image, so valo turns
+ * it up; an OBJ with flip_tex_coords false likewise. Checked at the quads' corner (-1, -1),
+ * whose file v is 0 (Mitsuba 3.9.1's vertex_texcoords_buffer: 1 for the OBJ, 0 for the PLY). */
+static int mesh_v_as_mitsuba(void) {
+  const char *quad_v = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  const char *quad_p = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\n"
+                       "property float v\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                       "-1 -1 0 0 0\n1 -1 0 1 0\n1 1 0 1 1\n-1 1 0 0 1\n3 0 1 2\n3 0 2 3\n";
+  scratch_file("quad-uv.obj", quad_v);
+  scratch_file("quad-uv.ply", quad_p);
+  const char *obj = "quad-uv.obj", *ply = "quad-uv.ply"; /* beside the scene file */
+  char xml[2048];
+  snprintf(xml, sizeof xml,
+           "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n"
+           "<shape type=\"ply\"><string name=\"filename\" value=\"%s\"/></shape>\n"
+           "<shape type=\"obj\"><string name=\"filename\" value=\"%s\"/><transform name=\"to_world\"><translate x=\"10\"/></transform></shape>\n"
+           "<shape type=\"obj\"><string name=\"filename\" value=\"%s\"/><boolean name=\"flip_tex_coords\" value=\"false\"/>"
+           "<transform name=\"to_world\"><translate x=\"20\"/></transform></shape>\n</scene>\n",
+           ply, obj, obj);
+  const char *path = scratch_file("mesh-uv.xml", xml);
+  scene *s = scene_new(path);
+  valo_error err;
+  valo_options set;
+  valo_options_init(&set);
+  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  const float want[3] = {1, 0, 1}; /* valo's v at the corner: the PLY, the OBJ, the OBJ not flipped */
+  int found[3] = {0, 0, 0};
+  for (uint32_t v = 0; v < s->nverts; v++) {
+    vec3 p = s->pos[v];
+    if (p.y != -1) continue;
+    for (int k = 0; k < 3; k++)
+      if (p.x == -1 + 10 * k) {
+        CHECK(s->uv[2 * v + 1] == want[k], "shape %d: v %g at its corner, Mitsuba's is %g", k, s->uv[2 * v + 1], want[k]);
+        found[k]++;
+      }
+  }
+  scene_free(s);
+  CHECK(found[0] && found[1] && found[2], "corners found: %d %d %d", found[0], found[1], found[2]);
+  return 0;
+}
+
 /* valo convert (valo_scene_convert): the JSON written for an XML scene, in another folder,
  * renders bit for bit as the XML does, its texture and mesh found through absolute names;
  * what is not a Mitsuba scene or not a .json output is refused. */
@@ -494,6 +537,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

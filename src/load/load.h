@@ -27,8 +27,9 @@ valo_status mitsuba_to_json(const char *path, const char *defines, const char *o
  * mesh_flags: LOAD_MESH_CAMERA, use the file's camera (its aspect sets the file's film
  * size); LOAD_MESH_FLAT, shade with the triangles' own normals, not the file's;
  * LOAD_MESH_SMOOTH, a file without normals is shaded with normals computed from its faces
- * (angle-weighted over the vertices its faces share, as Mitsuba does). */
-enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2, LOAD_MESH_SMOOTH = 4 };
+ * (angle-weighted over the vertices its faces share, as Mitsuba does); LOAD_MESH_FLIP_V, the
+ * file's v runs down its images (a PLY in a Mitsuba scene): turned up, v' = 1 - v. */
+enum { LOAD_MESH_CAMERA = 1, LOAD_MESH_FLAT = 2, LOAD_MESH_SMOOTH = 4, LOAD_MESH_FLIP_V = 8 };
 valo_status load_mesh(scene *s, const char *path, const float *xf, uint32_t override_mat, int mesh_flags, valo_options *file,
                       valo_error *err);
 /* load_mesh, with each file's import kept in *cache (made on first use; NULL: none kept)

@@ -218,6 +218,7 @@ typedef struct load_ctx {
   int flat;          /* LOAD_MESH_FLAT: the file's vertex normals are not used */
   int smooth;        /* LOAD_MESH_SMOOTH: normals computed where the file has none */
   valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
+  int flip_v;        /* LOAD_MESH_FLIP_V: v' = 1 - v */
 } load_ctx;
 
 _Static_assert(sizeof(struct aiVector3D) == 3 * sizeof(float), "Assimp's vectors are read as 3 floats");
@@ -256,6 +257,7 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   uint32_t base = s->nverts;
   valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
   free(idx);
+  for (uint32_t v = base; st == VALO_OK && uv && c->flip_v && v < s->nverts; v++) s->uv[2 * (size_t)v + 1] = 1 - s->uv[2 * (size_t)v + 1];
   for (unsigned v = 0; st == VALO_OK && has_tan && v < mesh->mNumVertices; v++) {
     vec3 n = s->nrm[base + v];
     float *tf = &s->tan_file[4 * (size_t)(base + v)];
@@ -264,7 +266,7 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
     vec3 bt = m34_vector(xf, v3(mesh->mBitangents[v].x, mesh->mBitangents[v].y, mesh->mBitangents[v].z));
     if (v3_finite(t) && v3_finite(bt) && v3_len2(t) > 0) {
       tf[0] = t.x; tf[1] = t.y; tf[2] = t.z;
-      tf[3] = v3_dot(v3_cross(n, t), bt) < 0 ? -1.0f : 1.0f;
+      tf[3] = (v3_dot(v3_cross(n, t), bt) < 0) != (c->flip_v != 0) ? -1.0f : 1.0f; /* v turned: dp/dv turns */
     }
   }
   return st;
@@ -474,7 +476,8 @@ static valo_status import_file(const char *path, int mesh_flags, imported *im, v
 static valo_status place(scene *s, imported *im, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
                          valo_error *err) {
   const struct aiScene *ai = im->ai;
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, im->gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file};
+  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, im->gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file,
+                 (mesh_flags & LOAD_MESH_FLIP_V) != 0};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)

@@ -252,7 +252,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
-                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", NULL};
+                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", "flip_v", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
   int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
@@ -326,6 +326,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "shape_index")) return json_bad(c, where, "\"shape_index\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "smooth_normals")) return json_bad(c, where, "\"smooth_normals\" is a mesh's");
   if ((mesh || sphere) && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a rectangle's, cube's or disk's");
+  if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "flip_v")) return json_bad(c, where, "\"flip_v\" is a mesh file's");
   if (sphere && (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "file")))
     return json_bad(c, where, "a sphere is placed by \"center\" and \"radius\" (no \"transform\" or \"file\")");
   if (mesh) {
@@ -334,12 +335,16 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
     TRY(shape_transform(c, o, where, xf));
     char full[2048];
     json_resolve_path(c, file, full, sizeof full);
-    int flat = 0, smooth = 0;
+    int flat = 0, smooth = 0, flip_v = 0;
     TRY(json_get_bool(c, o, "face_normals", where, &flat));
     TRY(json_get_bool(c, o, "smooth_normals", where, &smooth));
+    TRY(json_get_bool(c, o, "flip_v", where, &flip_v));
     int mflags = (flat ? LOAD_MESH_FLAT : 0) | (smooth ? LOAD_MESH_SMOOTH : 0);
     int index = -1;
     TRY(json_get_int(c, o, "shape_index", where, 0, INT_MAX, &index));
+    if (flip_v && str_ends_with(full, ".serialized"))
+      return json_bad(c, where, "\"flip_v\" is not read for a .serialized file (its v is turned up as it is read)");
+    mflags |= flip_v ? LOAD_MESH_FLIP_V : 0;
     if (str_ends_with(full, ".serialized")) return load_serialized(c->s, full, index < 0 ? 0 : index, xf, mat, mflags, c->err);
     if (index >= 0) return json_bad(c, where, "\"shape_index\" picks a shape of a Mitsuba .serialized file");
     int flags = (c->cam_from_file && !c->s->has_camera ? LOAD_MESH_CAMERA : 0) | mflags;

@@ -220,7 +220,11 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     TRY(mi_bool(c, n, "face_normals", &fn));
     if (fn) cJSON_AddTrueToObject(sh, "face_normals");
     else cJSON_AddTrueToObject(sh, "smooth_normals"); /* Mitsuba computes normals a file lacks */
-    (void)mi_prop(c, n, "flip_tex_coords"); /* Mitsuba's default flip undoes OBJ's bottom-up v, as valo reads it */
+    /* Mitsuba turns an OBJ's v over (flip_tex_coords, default true), which undoes OBJ's
+     * bottom-up v as valo reads it; a PLY's it reads as it stands, running down the image. */
+    int turn = 1;
+    if (!strcmp(type, "obj")) TRY(mi_bool(c, n, "flip_tex_coords", &turn));
+    if (!serialized && (!strcmp(type, "ply") || !turn)) cJSON_AddTrueToObject(sh, "flip_v");
     cJSON_AddStringToObject(sh, "file", file);
     int index = 0;
     if (serialized) {
