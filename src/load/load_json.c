@@ -252,7 +252,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
-                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", "flip_v", NULL};
+                                     "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", "flip_v", "uv_frame", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
   int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
@@ -325,7 +325,8 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "face_normals")) return json_bad(c, where, "\"face_normals\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "shape_index")) return json_bad(c, where, "\"shape_index\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "smooth_normals")) return json_bad(c, where, "\"smooth_normals\" is a mesh's");
-  if ((mesh || sphere) && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a rectangle's, cube's or disk's");
+  if (mesh && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a sphere's, rectangle's, cube's or disk's");
+  if (!sphere && cJSON_GetObjectItemCaseSensitive(o, "uv_frame")) return json_bad(c, where, "\"uv_frame\" is a sphere's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "flip_v")) return json_bad(c, where, "\"flip_v\" is a mesh file's");
   if (sphere && (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "file")))
     return json_bad(c, where, "a sphere is placed by \"center\" and \"radius\" (no \"transform\" or \"file\")");
@@ -364,9 +365,23 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       mat = scene_add_material(c->s, &d);
       if (mat == UINT32_MAX) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     }
-    if (material_has_maps(&c->s->mats[mat]))
-      log_warning("%s: %s: a sphere has no texture coordinates, so the maps of material '%s' are ignored", c->s->path, where, c->s->mats[mat].name);
-    return scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err);
+    int mitsuba_uv = 0;
+    TRY(json_get_bool(c, o, "mitsuba_uv", where, &mitsuba_uv));
+    float rot[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const cJSON *fr = cJSON_GetObjectItemCaseSensitive(o, "uv_frame");
+    if (fr) {
+      if (!mitsuba_uv) return json_bad(c, where, "\"uv_frame\" turns Mitsuba's layout (\"mitsuba_uv\": true)");
+      int n = 0;
+      for (const cJSON *e = cJSON_IsArray(fr) ? fr->child : NULL; e; e = e->next, n++)
+        if (n < 9) rot[n] = cJSON_IsNumber(e) ? (float)e->valuedouble : NAN;
+      double off = 0; /* rot^T rot - I */
+      for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++)
+          off += fabs((double)rot[a] * rot[b] + (double)rot[3 + a] * rot[3 + b] + (double)rot[6 + a] * rot[6 + b] - (a == b));
+      if (n != 9 || !(off < 1e-3)) return json_bad(c, where, "\"uv_frame\" must be 9 numbers, a 3x3 rotation (row-major, local to world)");
+    }
+    TRY(scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err));
+    return mitsuba_uv ? scene_sphere_uv(c->s, c->s->nspheres - 1, rot) : VALO_OK;
   }
   static const char *const prims[] = {"rectangle", "cube", "disk"};
   for (int k = 0; k < 3; k++) {

@@ -254,6 +254,13 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     cJSON_AddItemToObject(sh, "center", vec_json(ctr.x, ctr.y, ctr.z));
     TRY(put_num(c, sh, "radius", r));
     if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
+    cJSON_AddTrueToObject(sh, "mitsuba_uv"); /* its textures where Mitsuba puts them */
+    if (has_xf) { /* the turn of its to_world, which places them */
+      double sx = sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
+      const double rot[9] = {m[0] / sx, m[1] / sx, m[2] / sx, m[4] / sx, m[5] / sx, m[6] / sx, m[8] / sx, m[9] / sx, m[10] / sx};
+      cJSON *fr = cJSON_CreateDoubleArray(rot, 9);
+      if (!fr || !cJSON_AddItemToObject(sh, "uv_frame", fr)) { cJSON_Delete(fr); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+    }
   } else if (!strcmp(type, "rectangle") || !strcmp(type, "cube") || !strcmp(type, "disk")) {
     cJSON_AddStringToObject(sh, "type", type);
     if (has_xf) TRY(matrix_json(c, m, sh));

@@ -7,6 +7,46 @@
 #include <math.h>
 #include <stdlib.h>
 
+/* The equirectangular texture coordinates of the point in unit direction d from a sphere's
+ * centre (scene.h, scene_sphere_uv). */
+static void sphere_dir_uv(vec3 d, const float *rot, float *u, float *v, int *pole) {
+  if (rot) { /* Mitsuba's: its local frame's z the pole, phi from its x towards its y */
+    vec3 l = v3(rot[0] * d.x + rot[3] * d.y + rot[6] * d.z, rot[1] * d.x + rot[4] * d.y + rot[7] * d.z,
+                rot[2] * d.x + rot[5] * d.y + rot[8] * d.z);
+    float phi = atan2f(l.y, l.x);
+    *u = (phi < 0 ? phi + 2 * PI_F : phi) / (2 * PI_F);
+    *v = 1 - acosf(clampf(l.z, -1, 1)) / PI_F;
+    *pole = fabsf(l.z) > 1 - 1e-6f;
+  } else { /* valo's: +y the pole, at the image's top */
+    *u = 0.5f + atan2f(d.z, d.x) / (2 * PI_F);
+    *v = 1 - acosf(clampf(d.y, -1, 1)) / PI_F;
+    *pole = fabsf(d.y) > 1 - 1e-6f;
+  }
+}
+
+valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot) {
+  if (g >= s->nspheres) return VALO_ERR_INVALID;
+  const sphere_shape *sp = &s->spheres[g];
+  for (uint32_t t = sp->first; t < sp->end; t++) {
+    const uint32_t *ix = &s->idx[3 * (size_t)t];
+    float u[3], v[3];
+    int pole[3];
+    for (int k = 0; k < 3; k++) sphere_dir_uv(v3_norm(v3_sub(s->pos[ix[k]], sp->c)), rot, &u[k], &v[k], &pole[k]);
+    /* across the seam: the u's kept together (the map repeats); at a pole, u is the mean
+     * of the other two's */
+    float lo = fminf(u[0], fminf(u[1], u[2])), hi = fmaxf(u[0], fmaxf(u[1], u[2]));
+    for (int k = 0; k < 3 && hi - lo > 0.5f; k++)
+      if (u[k] < 0.5f && !pole[k]) u[k] += 1;
+    for (int k = 0; k < 3; k++)
+      if (pole[k]) u[k] = 0.5f * (u[(k + 1) % 3] + u[(k + 2) % 3]);
+    for (int k = 0; k < 3; k++) {
+      s->uv[2 * (size_t)ix[k]] = u[k];
+      s->uv[2 * (size_t)ix[k] + 1] = v[k];
+    }
+  }
+  return VALO_OK;
+}
+
 /* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
  * are not shared between faces (flat arrays stay simple); normals are exact. */
 valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, int smooth, uint32_t mat, valo_error *err) {
@@ -46,8 +86,6 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
       vec3 u = tris[3 * i + kk];
       s->pos[base + k] = v3_add(c, v3_scale(u, r));
       s->nrm[base + k] = flip ? v3_neg(u) : u;
-      s->uv[2 * (base + k)] = 0.5f + atan2f(u.z, u.x) / (2 * PI_F);
-      s->uv[2 * (base + k) + 1] = acosf(clampf(u.y, -1, 1)) / PI_F;
     }
     s->nverts += 3;
     uint32_t ti = s->ntris++;
@@ -56,7 +94,7 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
     s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS);
   }
   free(tris); free(tmp);
-  return VALO_OK;
+  return scene_sphere_uv(s, s->nspheres - 1, NULL);
 }
 
 

@@ -249,6 +249,13 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf, uint32
  * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,
                              int smooth, uint32_t mat, valo_error *err);
+/* Lays out sphere g's texture coordinates as an equirectangular map, a triangle across
+ * the seam keeping its u's together (the map repeats) and a pole vertex taking the mean u
+ * of the other two. rot NULL: valo's own, +y the pole at the image's top, u = 1/2 +
+ * atan2(z, x) / 2 pi (scene_add_sphere makes it so); else Mitsuba's layout in the sphere's
+ * local frame (3x3 row-major, local to world, orthogonal): u = phi / 2 pi from its x towards
+ * its y, v = 1 - theta / pi from its z (turned up to valo's convention). */
+valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot);
 /* Mitsuba's unit shapes, flat-shaded: the rectangle [-1, 1]^2 at z = 0 facing +z, the
  * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments);
  * placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps the front side);
