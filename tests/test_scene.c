@@ -9,6 +9,7 @@
 #include "scene/scene.h"
 #include "scene/camera.h"
 #include "light/light.h"
+#include "material/plastic.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -463,6 +464,33 @@ static int mesh_cache_places_alike(void) {
   return 0;
 }
 
+/* Plastics of one coat (index, roughness, distribution) share its tables: a material that
+ * reuses another's has exactly the tables its own tabulation gives; another roughness has
+ * its own. */
+static int plastic_coats_shared(void) {
+  const char *jp = scratch_file("plastics.json",
+                                "{ \"materials\": {\"a\": {\"type\": \"plastic\", \"diffuse\": [0.8, 0.1, 0.1], \"roughness\": 0.4},\n"
+                                "                \"b\": {\"type\": \"plastic\", \"diffuse\": [0.1, 0.8, 0.1], \"roughness\": 0.4},\n"
+                                "                \"c\": {\"type\": \"plastic\", \"diffuse\": [0.1, 0.1, 0.8], \"roughness\": 0.5}},\n"
+                                "  \"shapes\": [{\"type\": \"sphere\", \"material\": \"a\"}, {\"type\": \"sphere\", \"material\": \"b\", \"center\": [3, 0, 0]},\n"
+                                "             {\"type\": \"sphere\", \"material\": \"c\", \"center\": [6, 0, 0]}] }\n");
+  scene *s = scene_new(jp);
+  valo_error err;
+  CHECK(load_json(s, jp, NULL, &err) == VALO_OK, "%s", err.message);
+  int checked = 0;
+  for (uint32_t i = 0; i < s->nmats; i++) {
+    material own = s->mats[i];
+    if (own.type != MAT_PLASTIC) continue;
+    plastic_prepare(&own);
+    CHECK(!memcmp(own.coat_t, s->mats[i].coat_t, sizeof own.coat_t) && own.coat_ri == s->mats[i].coat_ri, "material %s: its coat's tables differ from its own",
+          s->mats[i].name);
+    checked++;
+  }
+  CHECK(checked == 3, "%d plastics", checked);
+  scene_free(s);
+  return 0;
+}
+
 /* The texture coordinates seen from +z at (x, y): the highest triangle facing +z there,
  * its UVs interpolated; 0 when none is. */
 static int uv_seen_from_z(const scene *s, float x, float y, float *u, float *v) {
@@ -591,6 +619,6 @@ int main(int argc, char **argv) {
                                     {"mtl_meanings", mtl_meanings}, {"gltf_and_ply_load", gltf_and_ply_load}, {"gltf_lights", gltf_lights}, {"ply_data_starting_with_line_feed", ply_data_starting_with_line_feed}, {"fallback_warnings", fallback_warnings},
                                     {"camera_project_inverts_ray", camera_project_inverts_ray}, {"mesh_cache_places_alike", mesh_cache_places_alike},
                                     {"mitsuba_primitive_uv", mitsuba_primitive_uv},
-                                    {"mitsuba_sphere_uv", mitsuba_sphere_uv}, {NULL, NULL}};
+                                    {"mitsuba_sphere_uv", mitsuba_sphere_uv}, {"plastic_coats_shared", plastic_coats_shared}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }
