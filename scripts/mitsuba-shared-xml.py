@@ -22,7 +22,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # instancing and <include>, with the bunny from ../shared
           "instances": ("@tests/data/mitsuba-xml/instances.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's plastic and roughplastic (valo's plastic material)
-          "plastic": ("@tests/data/mitsuba-xml/plastic.xml", {"resx": "160", "resy": "96"})}
+          "plastic": ("@tests/data/mitsuba-xml/plastic.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's mask with a binary opacity bitmap (valo's alpha map)
+          "mask": ("@tests/data/mitsuba-xml/mask.xml", {"resx": "128", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -253,6 +253,13 @@ static int plastic_xml(void) {
   return against_mitsuba_xml("plastic", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/plastic.xml", "resx=160 resy=96", 256, 0.03);
 }
 
+/* Mitsuba's mask (tests/data/mitsuba-xml/mask.xml): a binary opacity bitmap on a rectangle
+ * and on a cube, read as valo's alpha map (a cutout at 0.5; Mitsuba's mask is stochastic,
+ * the same where the map is 0 or 1). */
+static int mask_xml(void) {
+  return against_mitsuba_xml("mask", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/mask.xml", "resx=128 resy=96", 256, 0.03);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -338,6 +345,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -6,6 +6,7 @@
 #include "core/spectrum.h"
 #include "scene/volume.h"
 #include "material/plastic.h"
+#include "image/texture.h"
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -114,15 +115,15 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_thin[] = {"type", "ior", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map",
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff",
                                           "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -207,6 +208,13 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));
+  /* a cutout: the surface is there where the map's alpha channel (its first channel when it
+   * has none) reaches alpha_cutoff */
+  TRY(get_data_map(c, o, "alpha_map", where, "alpha map", &m->tex_alpha));
+  if (m->tex_alpha >= 0) m->alpha_channel = c->s->tex[m->tex_alpha].has_alpha;
+  double cutoff = m->alpha_cutoff;
+  TRY(json_get_num(c, o, "alpha_cutoff", where, 0, 1, &cutoff));
+  m->alpha_cutoff = (float)cutoff;
   double bscale = 1;
   TRY(json_get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
   m->bump_scale = (float)bscale;

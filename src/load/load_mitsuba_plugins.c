@@ -122,6 +122,23 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (st) { cJSON_Delete(file); return st; }
     cJSON_AddItemToObject(m, normal ? "normal_map" : "bump_map", file);
     if (!normal) cJSON_AddNumberToObject(m, "bump_scale", scale);
+  } else if (!strcmp(type, "mask")) {
+    /* Mitsuba's mask lets light through with probability 1 - opacity; valo's alpha map is
+     * a cutout at 0.5, the same where a map is 0 or 1 (leaves, fences). */
+    cJSON *op;
+    TRY(mi_color(c, b, "opacity", 0, &op));
+    if (!op) return mi_bad(c, b, "needs its opacity: Mitsuba's default, 0.5 everywhere, is a half-transparent surface, which valo's cutouts cannot make");
+    if (!cJSON_IsString(op)) {
+      double a = cJSON_GetArrayItem(op, 0)->valuedouble;
+      cJSON_Delete(op);
+      if (a != 1) return mi_bad(c, b, "valo's masks are cutouts: give the opacity as a bitmap, or 1");
+      TRY(wrapped(c, b, m, "masked"));
+    } else {
+      valo_status st = wrapped(c, b, m, "masked");
+      if (st) { cJSON_Delete(op); return st; }
+      cJSON_DeleteItemFromObject(m, "alpha_map");
+      cJSON_AddItemToObject(m, "alpha_map", op);
+    }
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
     cJSON *v;
@@ -208,7 +225,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     TYPE("null");
   } else {
     return mi_bad(c, b, "valo has no such BSDF (diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, "
-                        "plastic, roughplastic, principled, phong, twosided, normalmap, bumpmap, null)");
+                        "plastic, roughplastic, principled, phong, twosided, normalmap, bumpmap, mask, null)");
   }
 #undef TYPE
   mi_warn_unused(c, b);
