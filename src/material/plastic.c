@@ -5,7 +5,7 @@
 #include "core/sampling.h"
 
 #define COAT_N_OUT 32 /* stratified visible-normal samples per axis, per cos theta, from outside */
-#define COAT_N_IN 64  /* from inside, where total internal reflection makes F jump */
+#define COAT_N_IN 32  /* from inside (64 moved the diffuse part against Mitsuba's by 0.06 % at 4x the time) */
 
 static float mf_G1(int beck, float a, vec3 w) { return beck ? 1 / (1 + beckmann_lambda(a, w)) : ggx_G1(a, w); }
 
