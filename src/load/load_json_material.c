@@ -227,7 +227,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   m->beckmann = dist && !strcmp(dist, "beckmann");
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
-  if (m->type == MAT_PLASTIC) { /* a coat already tabulated for the same index and roughness is reused (10-37 ms each) */
+  if (m->type == MAT_PLASTIC) { /* a coat already tabulated for the same index and roughness is reused (15-60 ms each) */
     const material *same = NULL;
     for (uint32_t i = 0; i < c->s->nmats && !same; i++) {
       const material *o2 = &c->s->mats[i];

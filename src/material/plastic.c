@@ -5,7 +5,7 @@
 #include "core/sampling.h"
 
 #define COAT_N_OUT 32 /* stratified visible-normal samples per axis, per cos theta, from outside */
-#define COAT_N_IN 32  /* from inside (64 moved the diffuse part against Mitsuba's by 0.06 % at 4x the time) */
+#define COAT_N_IN 48  /* from inside: r_i within 0.002 of its value at 256 x 256 (roughness 0.1 to 0.9, index 1.49), 1 / (1 - r_i) within 0.43 % */
 
 static float mf_G1(int beck, float a, vec3 w) { return beck ? 1 / (1 + beckmann_lambda(a, w)) : ggx_G1(a, w); }
 
