@@ -238,6 +238,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     double r = 1;
     TRY(mi_point(c, n, "center", &ctr));
     TRY(mi_float(c, n, "radius", &r));
+    double rot[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}; /* the turn of its to_world, which places its textures */
     if (has_xf) {
       /* A sphere moved and scaled evenly stays a sphere; anything else is not read. */
       double sx = sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]), sy = sqrt(m[1] * m[1] + m[5] * m[5] + m[9] * m[9]),
@@ -249,15 +250,15 @@ static valo_status read_shape(mctx *c, xml_node *n) {
       ctr = v3((float)(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]), (float)(m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7]),
                (float)(m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]));
       r *= sx;
+      for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) rot[3 * i + j] = m[4 * i + j] / sx;
     }
     cJSON_AddStringToObject(sh, "type", "sphere");
     cJSON_AddItemToObject(sh, "center", vec_json(ctr.x, ctr.y, ctr.z));
     TRY(put_num(c, sh, "radius", r));
     if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
     cJSON_AddTrueToObject(sh, "mitsuba_uv"); /* its textures where Mitsuba puts them */
-    if (has_xf) { /* the turn of its to_world, which places them */
-      double sx = sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
-      const double rot[9] = {m[0] / sx, m[1] / sx, m[2] / sx, m[4] / sx, m[5] / sx, m[6] / sx, m[8] / sx, m[9] / sx, m[10] / sx};
+    if (has_xf) {
       cJSON *fr = cJSON_CreateDoubleArray(rot, 9);
       if (!fr || !cJSON_AddItemToObject(sh, "uv_frame", fr)) { cJSON_Delete(fr); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
     }
