@@ -66,9 +66,9 @@ static rgb base_albedo(const bsdf *b) {
   return b->nonlinear ? c3(d.r / (1 - d.r * ri), d.g / (1 - d.g * ri), d.b / (1 - d.b * ri)) : c3_scale(d, 1 / (1 - ri));
 }
 
-/* The coat's share of wo's light (F or 1 - T) and the specular lobe's probability. */
-static float spec_prob(const bsdf *b, vec3 wo) {
-  float f = b->type == BSDF_PLASTIC ? fresnel_dielectric(wo.z, b->eta) : 1 - plastic_coat_t(b, wo.z);
+/* The specular lobe's probability; *coat is the coat's share of wo's light (F or 1 - T). */
+static float spec_prob(const bsdf *b, vec3 wo, float *coat) {
+  float f = *coat = b->type == BSDF_PLASTIC ? fresnel_dielectric(wo.z, b->eta) : 1 - plastic_coat_t(b, wo.z);
   float ps = f * b->spec_w, pd = (1 - f) * (1 - b->spec_w);
   return ps + pd > 0 ? ps / (ps + pd) : 0;
 }
@@ -95,7 +95,7 @@ rgb plastic_eval(const bsdf *b, vec3 wo, vec3 wi) {
 
 float plastic_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (wo.z <= 0 || wi.z <= 0) return 0;
-  float ps = spec_prob(b, wo), p = (1 - ps) * cosine_hemisphere_pdf(wi.z);
+  float coat, ps = spec_prob(b, wo, &coat), p = (1 - ps) * cosine_hemisphere_pdf(wi.z);
   if (b->type == BSDF_ROUGH_PLASTIC) {
     vec3 wm = v3_norm(v3_add(wo, wi));
     p += ps * mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
@@ -105,11 +105,11 @@ float plastic_pdf(const bsdf *b, vec3 wo, vec3 wi) {
 
 int plastic_sample(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
   if (wo.z <= 0) return 0;
-  float ps = spec_prob(b, wo);
+  float coat, ps = spec_prob(b, wo, &coat);
   if (ulobe < ps) {
     if (b->type == BSDF_PLASTIC) {
       s->wi = v3(-wo.x, -wo.y, wo.z);
-      s->weight = c3_scale(b->ks, fresnel_dielectric(wo.z, b->eta) / ps);
+      s->weight = c3_scale(b->ks, coat / ps); /* coat = F(cos_o) here */
       s->pdf = 0;
       s->delta = 1;
       return 1;
