@@ -29,9 +29,9 @@ typedef struct bf_job { const scene *s; const ray *rays; hit *hits; int *found; 
 /* The hit filter under test (NULL: none), given to the structure and applied by brute
  * force in the same way: a hit on a flagged triangle counts only if it passes. */
 static const accel_filter *g_filter;
-static int filter_passes(uint32_t t, float b1, float b2) {
+static int filter_passes(uint32_t t, float b1, float b2, const ray *r) {
   const accel_filter *f = g_filter;
-  return !f || !(f->tri_flags[t] & f->flag_bit) || f->pass(f->user, t, b1, b2);
+  return !f || !(f->tri_flags[t] & f->flag_bit) || f->pass(f->user, t, b1, b2, accel_ray_key(r->o, r->d));
 }
 
 static void tri_verts(const scene *s, uint32_t t, float v[9]) {
@@ -51,7 +51,7 @@ static void brute(void *user, int64_t i, int thread) {
     float v[9];
     tri_verts(s, t, v);
     float tt, b1, b2;
-    if (tri_intersect(&sh, v, INFINITY, &tt, &b1, &b2) && filter_passes(t, b1, b2)) {
+    if (tri_intersect(&sh, v, INFINITY, &tt, &b1, &b2) && filter_passes(t, b1, b2, &r)) {
       if (tt < j->occl_tmax[i]) occl = 1;
       if (tt < best) { best = tt; h.t = tt; h.b1 = b1; h.b2 = b2; h.tri = t; found = 1; }
     }
@@ -182,10 +182,13 @@ static int axis_rays_kdtree(void) {
 }
 /* An alpha-like hit filter: on every other triangle (flagged), a pattern of holes that
  * depends on where the triangle is hit (16 x 16 cells of barycentric space, a third of them
- * open), as an alpha texture would. The kd-tree (exactly) and Embree (within tolerance)
- * must find what brute force finds with the same filter, for closest hits and shadows. */
-static int holes(const void *user, uint32_t tri, float b1, float b2) {
+ * open), as an alpha texture would; on every fourth, a coin tossed from the ray's key and
+ * the triangle, as a stochastic opacity of 1/2 is. The kd-tree (exactly) and Embree
+ * (within tolerance) must find what brute force finds with the same filter, for closest
+ * hits and shadows: both backends must hand the filter the key of the query's ray. */
+static int holes(const void *user, uint32_t tri, float b1, float b2, uint64_t key) {
   (void)user;
+  if (tri % 4 == 1) return (rng_mix64(key ^ tri) >> 63) != 0;
   uint32_t h = tri * 2654435761u ^ (uint32_t)(b1 * 16) * 40503u ^ (uint32_t)(b2 * 16) * 9973u;
   h ^= h >> 15;
   return h % 3 != 0;
@@ -500,7 +503,7 @@ static int subtree_tris(const kdtree *kd, uint32_t ni, uint32_t set[5], int *sma
  * the join all run without ../shared: the tree
  * must be byte-identical for 1, 2 and 3 build threads (nodes, groups, ids, alpha lanes),
  * and its closest hits and shadow queries equal brute force on 10 000 rays. */
-static int filter_odd(const void *user, uint32_t tri, float b1, float b2) { (void)user; return tri % 3 != 0 || b1 < 0.5f + 0.3f * b2; }
+static int filter_odd(const void *user, uint32_t tri, float b1, float b2, uint64_t key) { (void)user; (void)key; return tri % 3 != 0 || b1 < 0.5f + 0.3f * b2; }
 static int synthetic_threads(void) {
   enum { SU = 96, SV = 96, SOUP = 3000, PLANAR = 400 };
   uint32_t nt = 2 * SU * SV + SOUP + 2 + PLANAR, nv = (SU + 1) * (SV + 1) + 3 * SOUP + 4 + 3 * PLANAR;
@@ -573,7 +576,7 @@ static int synthetic_threads(void) {
     for (uint32_t q = 0; q < nt; q++) {
       float tv[9], tt, b1, b2;
       for (int k = 0; k < 3; k++) memcpy(&tv[3 * k], &pos[idx[3 * q + k]], sizeof(vec3));
-      if (!tri_intersect(&sh, tv, r.tmax, &tt, &b1, &b2) || !filter_passes(q, b1, b2)) continue;
+      if (!tri_intersect(&sh, tv, r.tmax, &tt, &b1, &b2) || !filter_passes(q, b1, b2, &r)) continue;
       bo |= tt < 1.5f;
       if (!bf || tt < bh.t) { bh.t = tt; bh.tri = q; bf = 1; }
     }

@@ -592,6 +592,71 @@ static int alpha_cutoff(void) {
   return 0;
 }
 
+/* Stochastic opacity ("opacity" < 1): a hit counts with probability opacity, decided per
+ * ray and triangle, so what passes is 1 - opacity in expectation, for camera and shadow
+ * rays alike. Camera rays: a glowing floor (radiance 1) seen through one black veil of
+ * opacity 0.3 on the left (0.7 passes) and two of 0.5 on the right (0.25: the two veils
+ * decide independently; one coin for both would give 0.5). Shadow rays: a floor lit by a
+ * point light above, a black veil of opacity 0.4 between them over the left half and the
+ * camera under the veil: the left half has 0.6 of the mirrored right half's light. Both
+ * backends; the two must agree within noise. */
+static int opacity_stochastic(void) {
+  CHECK(scratch_file("ofloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("oleft1.obj", "v -5 1 -5\nv -5 1 5\nv 0 1 5\nv 0 1 -5\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("oright1.obj", "v 0 1 -5\nv 0 1 5\nv 5 1 5\nv 5 1 -5\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("oright2.obj", "v 0 2 -5\nv 0 2 5\nv 5 2 5\nv 5 2 -5\nf 1 2 3 4\n"), "write");
+  const char *accels[2] = {"kdtree", "embree"};
+  double seen[2][2], shadow[2];
+  for (int a = 0; a < 2; a++) {
+    if (a == 1 && !test_embree()) break;
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0, 6, 0.001], \"look_at\": [0,0,0], \"fov\": 40},\n"
+             "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 64, \"max_depth\": 1, \"accel\": \"%s\"},\n"
+             "  \"materials\": {\"glow\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 1},\n"
+             "                \"v3\": {\"type\": \"diffuse\", \"reflectance\": 0, \"opacity\": 0.3},\n"
+             "                \"v5\": {\"type\": \"diffuse\", \"reflectance\": 0, \"opacity\": 0.5}},\n"
+             "  \"shapes\": [{\"file\": \"ofloor.obj\", \"material\": \"glow\"}, {\"file\": \"oleft1.obj\", \"material\": \"v3\"},\n"
+             "             {\"file\": \"oright1.obj\", \"material\": \"v5\"}, {\"file\": \"oright2.obj\", \"material\": \"v5\"}] }\n",
+             accels[a]);
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "render failed");
+    double sum[2] = {0, 0};
+    int n[2] = {0, 0};
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w; x++) {
+        if (x == w / 2 - 1 || x == w / 2) continue; /* the seam */
+        int right = x >= w / 2;
+        sum[right] += px[3 * (y * w + x) + 1];
+        n[right]++;
+      }
+    free(px);
+    for (int k = 0; k < 2; k++) seen[a][k] = sum[k] / n[k];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0, 0.6, 0.001], \"look_at\": [0,0,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 64, \"max_depth\": 1, \"accel\": \"%s\"},\n"
+             "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5},\n"
+             "                \"v4\": {\"type\": \"diffuse\", \"reflectance\": 0, \"opacity\": 0.4}},\n"
+             "  \"shapes\": [{\"file\": \"ofloor.obj\", \"material\": \"floor\"}, {\"file\": \"oleft1.obj\", \"material\": \"v4\"}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+             accels[a]);
+    px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "render failed");
+    double l = 0, r = 0;
+    for (int y = 0; y < h; y++)
+      for (int x = 0; x < w / 2 - 1; x++) { l += px[3 * (y * w + x) + 1]; r += px[3 * (y * w + (w - 1 - x)) + 1]; }
+    free(px);
+    shadow[a] = l / r;
+    fprintf(stderr, "%s: seen through one veil of 0.3 %.4f (0.7), two of 0.5 %.4f (0.25); light under a veil of 0.4 %.4f (0.6)\n", accels[a],
+            seen[a][0], seen[a][1], shadow[a]);
+    CHECK(fabs(seen[a][0] - 0.7) < 0.015, "%s: %.4f seen through one veil of opacity 0.3, not 0.7", accels[a], seen[a][0]);
+    CHECK(fabs(seen[a][1] - 0.25) < 0.015, "%s: %.4f seen through two veils of 0.5, not 0.25", accels[a], seen[a][1]);
+    CHECK(fabs(shadow[a] - 0.6) < 0.015, "%s: the light under a veil of opacity 0.4 is %.4f of the light beside it, not 0.6", accels[a], shadow[a]);
+  }
+  return 0;
+}
+
 /* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
@@ -777,7 +842,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

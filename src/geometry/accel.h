@@ -6,11 +6,25 @@
 #ifndef VALO_ACCEL_H
 #define VALO_ACCEL_H
 #include "core/vec.h"
+#include "core/rng.h"
 #include "valo/valo.h"
+#include <string.h>
 
 typedef struct ray { vec3 o, d; float tmax; } ray;
 /* b1, b2: barycentric weights of the triangle's second and third vertex. */
 typedef struct hit { float t, b1, b2; uint32_t tri; } hit;
+
+/* A 64-bit hash of a ray's origin and direction bits (core/rng.h's mixer per word). */
+static inline uint64_t accel_ray_key(vec3 o, vec3 d) {
+  const float f[6] = {o.x, o.y, o.z, d.x, d.y, d.z};
+  uint64_t h = 0x9E3779B97F4A7C15ull;
+  for (int i = 0; i < 6; i++) {
+    uint32_t b;
+    memcpy(&b, &f[i], 4);
+    h = rng_mix64(h ^ b ^ ((uint64_t)i << 32));
+  }
+  return h;
+}
 
 typedef struct accel accel;
 typedef struct accel_ops {
@@ -23,11 +37,13 @@ typedef struct accel_ops {
 } accel_ops;
 struct accel { const accel_ops *ops; };
 
-/* An optional hit filter (alpha cutout): for triangles whose tri_flags[t] has flag_bit
- * set, a hit counts only if pass(user, t, b1, b2) returns non-zero — for closest-hit and
- * any-hit queries alike. */
+/* An optional hit filter (alpha cutouts, stochastic opacity): for triangles whose
+ * tri_flags[t] has flag_bit set, a hit counts only if pass(user, t, b1, b2, key) returns
+ * non-zero — for closest-hit and any-hit queries alike. key is accel_ray_key of the
+ * query's ray, the same for both backends, so a random choice made from it and the
+ * triangle is the same each time the ray meets that triangle, on any thread. */
 typedef struct accel_filter {
-  int (*pass)(const void *user, uint32_t tri, float b1, float b2);
+  int (*pass)(const void *user, uint32_t tri, float b1, float b2, uint64_t key);
   const void *user;
   const uint8_t *tri_flags;
   uint8_t flag_bit;

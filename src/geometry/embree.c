@@ -21,7 +21,11 @@ static void em_filter(const struct RTCFilterFunctionNArguments *args) {
     const unsigned *hu = (const unsigned *)args->hit;
     unsigned prim = hu[5 * args->N + i];
     if (!(e->filter.tri_flags[prim] & e->filter.flag_bit)) continue;
-    if (!e->filter.pass(e->filter.user, prim, hf[3 * args->N + i], hf[4 * args->N + i])) args->valid[i] = 0;
+    /* RTCRayN is SoA too: org_x org_y org_z tnear dir_x dir_y dir_z ... */
+    const float *rf = (const float *)args->ray;
+    unsigned n = args->N;
+    uint64_t key = accel_ray_key(v3(rf[i], rf[n + i], rf[2 * n + i]), v3(rf[4 * n + i], rf[5 * n + i], rf[6 * n + i]));
+    if (!e->filter.pass(e->filter.user, prim, hf[3 * args->N + i], hf[4 * args->N + i], key)) args->valid[i] = 0;
   }
 }
 

@@ -227,7 +227,7 @@ static inline __attribute__((always_inline)) int kd_query(const kdtree *kd, cons
           for (int vtx = 0; vtx < 3; vtx++)
             for (int a = 0; a < 3; a++) tv[3 * vtx + a] = g->v[vtx][a][k];
           if (!tri_intersect(&sh, tv, best, &t, &b1, &b2)) continue;
-          if (((kd->gfilt[gi] >> k) & 1) && !kd->filter.pass(kd->filter.user, gid[k], b1, b2)) continue;
+          if (((kd->gfilt[gi] >> k) & 1) && !kd->filter.pass(kd->filter.user, gid[k], b1, b2, accel_ray_key(r->o, r->d))) continue;
           if (mode == KD_TRACE) tr->end_leaf = ni, tr->t = t;
           if (any) return 1;
           best = t;

@@ -30,6 +30,36 @@ static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const 
   return json_bad(c, w, msg);
 }
 
+/* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
+ * pbrt's bitmaps are, unless "opacity_raw"): a hit counts with that probability. */
+static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, material *m) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, "opacity");
+  int raw = 0;
+  TRY(json_get_bool(c, o, "opacity_raw", where, &raw));
+  if (!v) return VALO_OK;
+  char w[300];
+  snprintf(w, sizeof w, "%s.opacity", where);
+  if (m->tex_alpha >= 0) return json_bad(c, w, "give alpha_map (a cutout) or opacity, not both");
+  if (!cJSON_IsString(v)) {
+    double a = 1;
+    TRY(json_get_num(c, o, "opacity", where, 0, 1, &a));
+    m->opacity = (float)a;
+    return VALO_OK;
+  }
+  char full[2048];
+  json_resolve_path(c, v->valuestring, full, sizeof full);
+  valo_error terr;
+  m->tex_alpha = scene_texture_file(c->s, full, !raw, &terr);
+  if (m->tex_alpha < 0) {
+    char msg[sizeof terr.message + 40];
+    snprintf(msg, sizeof msg, "cannot read the opacity map: %s", terr.message);
+    return json_bad(c, w, msg);
+  }
+  m->alpha_channel = c->s->tex[m->tex_alpha].has_alpha;
+  m->alpha_stochastic = 1;
+  return VALO_OK;
+}
+
 static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (v && cJSON_IsString(v)) {
@@ -115,15 +145,15 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff",
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -215,6 +245,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   double cutoff = m->alpha_cutoff;
   TRY(json_get_num(c, o, "alpha_cutoff", where, 0, 1, &cutoff));
   m->alpha_cutoff = (float)cutoff;
+  TRY(get_opacity(c, o, where, m));
   double bscale = 1;
   TRY(json_get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
   m->bump_scale = (float)bscale;
@@ -226,6 +257,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (dist && strcmp(dist, "ggx") && strcmp(dist, "beckmann")) return json_bad(c, where, "distribution must be \"ggx\" or \"beckmann\"");
   m->beckmann = dist && !strcmp(dist, "beckmann");
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
+  /* light sampling would see such a light whole, while rays that meet it see it in part */
+  if ((m->opacity < 1 || m->alpha_stochastic) && !c3_black(m->emission))
+    return json_bad(c, where, "an emitting material cannot have an opacity: give the emission a darker colour instead");
   TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
   if (m->type == MAT_PLASTIC) { /* a coat already tabulated for the same index and roughness is reused (15-60 ms each) */
     const material *same = NULL;

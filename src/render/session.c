@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2) { return scene_alpha_pass(user, tri, b1, b2); }
+static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2, uint64_t key) { return scene_alpha_pass(user, tri, b1, b2, key); }
 
 int session_set_view(session *ss, int f) {
   camera c = ss->opt.frames > 0 ? scene_camera_at(ss->s, &ss->cam_still, (float)f) : ss->cam_still;

@@ -2,6 +2,7 @@
  * automatic camera framing) and conductor presets. */
 #include "scene/scene.h"
 #include "core/error.h"
+#include "core/rng.h"
 #include "scene/envmap.h"
 #include "scene/volume.h"
 #include "image/texture.h"
@@ -75,6 +76,7 @@ material material_default(void) {
   m.tint = c3(1, 1, 1);
   m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = -1;
   m.alpha_cutoff = 0.5f;
+  m.opacity = 1;
   snprintf(m.name, sizeof m.name, "default");
   return m;
 }
@@ -159,13 +161,24 @@ int material_has_maps(const material *m) {
          m->tex_rough >= 0 || m->tex_metal >= 0 || m->tex_mr >= 0;
 }
 
-int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2) {
+int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key) {
   const material *m = &s->mats[s->tri_mat[t]];
-  if (m->tex_alpha < 0) return 1;
-  float u, v, px[4];
-  scene_tri_uv(s, t, b1, b2, &u, &v);
-  texture_lookup(&s->tex[m->tex_alpha], u, v, px);
-  return (m->alpha_channel ? px[3] : px[0]) >= m->alpha_cutoff;
+  float a = m->opacity;
+  if (m->tex_alpha >= 0 && (s->tri_flags[t] & TRI_HAS_UVS)) {
+    float u, v, px[4];
+    scene_tri_uv(s, t, b1, b2, &u, &v);
+    texture_lookup(&s->tex[m->tex_alpha], u, v, px);
+    float x = m->alpha_channel ? px[3] : px[0];
+    if (!m->alpha_stochastic) {
+      if (!(x >= m->alpha_cutoff)) return 0;
+    } else {
+      a *= x;
+    }
+  }
+  if (a >= 1) return 1;
+  if (!(a > 0)) return 0;
+  uint64_t h = rng_mix64(key ^ ((uint64_t)t * 0xD1B54A32D192ED03ull + 0x632BE59BD9B4E019ull));
+  return (float)(h >> 40) * 0x1p-24f < a;
 }
 
 /* Per-vertex tangents: the file's where it gave them (glTF TANGENT), else from UV
@@ -258,7 +271,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
   for (uint32_t t = 0; t < s->ntris; t++) {
     s->tri_light[t] = -1;
     const material *m = &s->mats[s->tri_mat[t]];
-    if (m->tex_alpha >= 0 && (s->tri_flags[t] & TRI_HAS_UVS)) s->tri_flags[t] |= TRI_ALPHA;
+    if ((m->tex_alpha >= 0 && (s->tri_flags[t] & TRI_HAS_UVS)) || m->opacity < 1) s->tri_flags[t] |= TRI_ALPHA;
     if (c3_black(m->emission)) continue;
     light l;
     scene_area_light(s, t, &l);

@@ -42,7 +42,7 @@ typedef struct material {
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
-  int tex_alpha;     /* alpha-cutout texture, -1 = none */
+  int tex_alpha;     /* alpha-cutout texture (opacity map when alpha_stochastic), -1 = none */
   int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
   int tex_ns;        /* Phong exponent map (MTL map_Ns; linear, mean of RGB multiplies exponent), -1 = none */
   int tex_bump;      /* height map for bump mapping (mean of RGB, linear), -1 = none */
@@ -51,6 +51,9 @@ typedef struct material {
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
+  float opacity;     /* a hit counts with probability opacity (times tex_alpha's value when
+                        alpha_stochastic): 1 = opaque, the default */
+  int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
   int nonlinear;     /* MAT_PLASTIC: the base's internal scattering tints (Mitsuba's nonlinear) */
   float coat_t[PLASTIC_RES], coat_ri; /* MAT_PLASTIC: filled by plastic_prepare */
   int nk;            /* MAT_CONDUCTOR: 1 + index into scene.nk (eta and k per wavelength,
@@ -198,8 +201,11 @@ int scene_texture_file(scene *s, const char *path, int srgb, valo_error *err);
 int scene_texture_memory(scene *s, const char *key, const unsigned char *data, size_t len, int srgb);
 /* Surface UV of triangle t at barycentrics (b1, b2). */
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);
-/* Alpha-cutout test: 1 if the hit on triangle t at (b1, b2) counts. */
-int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2);
+/* Alpha test: 1 if the hit on triangle t at (b1, b2) counts. A cutout compares the map
+ * with alpha_cutoff; an opacity a < 1 lets the hit count with probability a, decided by a
+ * hash of key (the ray's, geometry/accel.h) and t: the same ray meets the same answer
+ * each time, two triangles on its way answer independently. */
+int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key);
 /* 1 if the material reads any texture map (which needs texture coordinates). */
 int material_has_maps(const material *m);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
