@@ -23,8 +23,10 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           "instances": ("@tests/data/mitsuba-xml/instances.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's plastic and roughplastic (valo's plastic material)
           "plastic": ("@tests/data/mitsuba-xml/plastic.xml", {"resx": "160", "resy": "96"}),
-          # Mitsuba's mask with a binary opacity bitmap (valo's alpha map)
-          "mask": ("@tests/data/mitsuba-xml/mask.xml", {"resx": "128", "resy": "96"})}
+          # Mitsuba's mask with a binary opacity bitmap (valo's opacity)
+          "mask": ("@tests/data/mitsuba-xml/mask.xml", {"resx": "128", "resy": "96"}),
+          # Mitsuba's mask with fractional opacity: a number and a ramp bitmap (valo's opacity)
+          "opacity": ("@tests/data/mitsuba-xml/opacity.xml", {"resx": "128", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -260,6 +260,12 @@ static int mask_xml(void) {
   return against_mitsuba_xml("mask", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/mask.xml", "resx=128 resy=96", 256, 0.03);
 }
 
+/* Mitsuba's mask with fractional opacity (tests/data/mitsuba-xml/opacity.xml): the default
+ * 0.5 and a ramp bitmap, seen and casting graded shadows; valo's stochastic opacity. */
+static int opacity_xml(void) {
+  return against_mitsuba_xml("opacity", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/opacity.xml", "resx=128 resy=96", 256, 0.03);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -345,6 +351,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -7,6 +7,7 @@
 #include "load/load.h"
 #include "load/xml.h"
 #include "scene/scene.h"
+#include "image/texture.h"
 #include "valo/valo.h"
 #include <math.h>
 #include <stdlib.h>
@@ -345,6 +346,45 @@ static int mesh_v_as_mitsuba(void) {
   return 0;
 }
 
+/* Mitsuba's mask as valo's stochastic opacity: the default 0.5, a number times the default
+ * (a mask inside a mask), and a bitmap
+ * decoded from sRGB unless raw (the ramp's texel 32 holds 130: 0.510 raw, 0.223 decoded). */
+static int mask_opacity(void) {
+  char xml[2048];
+  const char *ramp = VALO_SOURCE_DIR "/tests/data/mitsuba-xml/opacity-ramp.png";
+  snprintf(xml, sizeof xml,
+           "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"mask\"><bsdf type=\"diffuse\"/></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"mask\"><float name=\"opacity\" value=\"0.5\"/><bsdf type=\"mask\">"
+           "<bsdf type=\"diffuse\"/></bsdf></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"mask\"><texture type=\"bitmap\" name=\"opacity\"><string name=\"filename\" value=\"%s\"/>"
+           "<boolean name=\"raw\" value=\"true\"/></texture><bsdf type=\"diffuse\"/></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"mask\"><texture type=\"bitmap\" name=\"opacity\"><string name=\"filename\" value=\"%s\"/>"
+           "</texture><bsdf type=\"diffuse\"/></bsdf></shape>\n</scene>\n",
+           ramp, ramp);
+  const char *path = scratch_file("mask-opacity.xml", xml);
+  scene *s = scene_new(path);
+  valo_error err;
+  valo_options set;
+  valo_options_init(&set);
+  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->ntris == 8, "%u triangles", s->ntris);
+  const material *m[4];
+  for (int k = 0; k < 4; k++) m[k] = &s->mats[s->tri_mat[2 * k]];
+  CHECK(m[0]->opacity == 0.5f && m[0]->tex_alpha < 0, "default mask: opacity %g, map %d", m[0]->opacity, m[0]->tex_alpha);
+  CHECK(m[1]->opacity == 0.25f && m[1]->tex_alpha < 0, "mask of 0.5 around the default: opacity %g, map %d", m[1]->opacity, m[1]->tex_alpha);
+  for (int k = 2; k < 4; k++) {
+    CHECK(m[k]->opacity == 1 && m[k]->tex_alpha >= 0 && m[k]->alpha_stochastic, "bitmap mask %d: opacity %g, map %d, stochastic %d", k,
+          m[k]->opacity, m[k]->tex_alpha, m[k]->alpha_stochastic);
+    float x = s->tex[m[k]->tex_alpha].px[4 * 32], want = k == 2 ? 130 / 255.0f : 0.2232f;
+    CHECK(fabsf(x - want) < 1e-3f, "bitmap mask %s: texel 32 reads %g, not %g", k == 2 ? "raw" : "decoded", x, want);
+  }
+  CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+  for (uint32_t t = 0; t < 8; t++) CHECK(s->tri_flags[t] & TRI_ALPHA, "triangle %u is not alpha-tested", t);
+  scene_free(s);
+  return 0;
+}
+
 /* valo convert (valo_scene_convert): the JSON written for an XML scene, in another folder,
  * renders bit for bit as the XML does, its texture and mesh found through absolute names;
  * what is not a Mitsuba scene or not a .json output is refused. */
@@ -541,6 +581,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

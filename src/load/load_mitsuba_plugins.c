@@ -123,22 +123,31 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     cJSON_AddItemToObject(m, normal ? "normal_map" : "bump_map", file);
     if (!normal) cJSON_AddNumberToObject(m, "bump_scale", scale);
   } else if (!strcmp(type, "mask")) {
-    /* Mitsuba's mask lets light through with probability 1 - opacity; valo's alpha map is
-     * a cutout at 0.5, the same where a map is 0 or 1 (leaves, fences). */
+    /* Mitsuba's mask lets light through with probability 1 - opacity: valo's "opacity",
+     * a number (Mitsuba's default 0.5) or a bitmap, sRGB-decoded unless raw. */
+    xml_node *k = mi_prop(c, b, "opacity");
+    int raw = 0;
+    if (k && !strcmp(k->name, "texture")) TRY(mi_bool(c, k, "raw", &raw));
     cJSON *op;
-    TRY(mi_color(c, b, "opacity", 0, &op));
-    if (!op) return mi_bad(c, b, "needs its opacity: Mitsuba's default, 0.5 everywhere, is a half-transparent surface, which valo's cutouts cannot make");
-    if (!cJSON_IsString(op)) {
-      double a = cJSON_GetArrayItem(op, 0)->valuedouble;
+    TRY(mi_color(c, b, "opacity", MI_RAW, &op));
+    if (!op) op = cJSON_CreateNumber(0.5);
+    else if (!cJSON_IsString(op)) {
+      cJSON *a = cJSON_CreateNumber(cJSON_GetArrayItem(op, 0)->valuedouble);
       cJSON_Delete(op);
-      if (a != 1) return mi_bad(c, b, "valo's masks are cutouts: give the opacity as a bitmap, or 1");
-      TRY(wrapped(c, b, m, "masked"));
-    } else {
-      valo_status st = wrapped(c, b, m, "masked");
-      if (st) { cJSON_Delete(op); return st; }
-      cJSON_DeleteItemFromObject(m, "alpha_map");
-      cJSON_AddItemToObject(m, "alpha_map", op);
+      op = a;
     }
+    if (!op) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    valo_status st = wrapped(c, b, m, "masked");
+    if (st) { cJSON_Delete(op); return st; }
+    cJSON *inner = cJSON_GetObjectItemCaseSensitive(m, "opacity"); /* a mask inside: the two multiply */
+    if (inner && !(cJSON_IsNumber(inner) && cJSON_IsNumber(op))) {
+      cJSON_Delete(op);
+      return mi_bad(c, b, "valo multiplies masks inside masks only when both opacities are numbers");
+    }
+    if (inner) cJSON_SetNumberValue(op, op->valuedouble * inner->valuedouble);
+    cJSON_DeleteItemFromObject(m, "opacity");
+    cJSON_AddItemToObject(m, "opacity", op);
+    if (raw) cJSON_AddTrueToObject(m, "opacity_raw");
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
     cJSON *v;

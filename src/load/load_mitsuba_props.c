@@ -309,7 +309,7 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **ou
     TRY(mi_bool(c, k, "raw", &raw));
     if (strcmp(filter, "bilinear")) mi_warn(c, k, "valo filters textures bilinearly, not \"%s\"", filter);
     if (strcmp(wrap, "repeat")) mi_warn(c, k, "valo repeats textures; wrap_mode \"%s\" is not read", wrap);
-    if (raw) mi_warn(c, k, "raw is not read: valo decodes 8-bit colour textures from sRGB");
+    if (raw && !(how & MI_RAW)) mi_warn(c, k, "raw is not read: valo decodes 8-bit colour textures from sRGB");
     mi_warn_unused(c, k);
     *out = cJSON_CreateString(file);
     return *out ? VALO_OK : err_set(c->err, VALO_ERR_NOMEM, "out of memory");
