@@ -657,6 +657,56 @@ static int opacity_stochastic(void) {
   return 0;
 }
 
+/* glTF alphaMode BLEND: the base colour's alpha (128/255 here) as stochastic opacity, as
+ * Cycles renders a blended material: seen from above, the quad over a floor lit by a point
+ * light gives a·Q + (1 - a)·(1 - a)·F, Q the opaque quad (MASK at cutoff 0.25), F the floor
+ * alone, (1 - a) once for the camera ray through the quad and once for the floor's shadow
+ * ray through it. */
+static int gltf_blend(void) {
+  unsigned char rgba[4 * 4 * 4];
+  for (int i = 0; i < 16; i++) { rgba[4 * i] = 220; rgba[4 * i + 1] = 30; rgba[4 * i + 2] = 30; rgba[4 * i + 3] = 128; }
+  char pngp[1200];
+  snprintf(pngp, sizeof pngp, "%s/quad-texture.png", scratch_dir());
+  CHECK(stbi_write_png(pngp, 4, 4, 4, rgba, 16), "png");
+  unsigned char png[4096];
+  FILE *f = fopen(pngp, "rb");
+  CHECK(f, "png");
+  size_t png_n = fread(png, 1, sizeof png, f);
+  fclose(f);
+  CHECK(scratch_file("bfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  CHECK(write_gltf_quad("blend.glb", png, png_n, ", \"alphaMode\": \"BLEND\"", 1) == 0, "write glb");
+  CHECK(write_gltf_quad("opaque.glb", png, png_n, ", \"alphaMode\": \"MASK\", \"alphaCutoff\": 0.25", 1) == 0, "write glb");
+  const char *quads[3] = {"blend.glb", "opaque.glb", NULL};
+  double c[3][3];
+  for (int k = 0; k < 3; k++) {
+    char json[1024], quad[256] = "";
+    if (quads[k]) snprintf(quad, sizeof quad, ", {\"file\": \"%s\", \"transform\": {\"rotate_x\": -90, \"translate\": [0, 1, 0]}}", quads[k]);
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0, 4, 0.01], \"look_at\": [0,0,0], \"fov\": 20},\n"
+             "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 1024, \"max_depth\": 1},\n"
+             "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
+             "  \"shapes\": [{\"file\": \"bfloor.obj\", \"material\": \"floor\"}%s],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+             quad);
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "render failed");
+    for (int ch = 0; ch < 3; ch++) {
+      c[k][ch] = 0;
+      for (int y = 2; y < 6; y++)
+        for (int x = 2; x < 6; x++) c[k][ch] += px[3 * (y * w + x) + ch] / 16;
+    }
+    free(px);
+  }
+  double a = 128 / 255.0;
+  for (int ch = 0; ch < 3; ch++) {
+    double want = a * c[1][ch] + (1 - a) * (1 - a) * c[2][ch];
+    fprintf(stderr, "channel %d: blend %.4f, a Q + (1-a)^2 F = %.4f (Q %.4f, F %.4f)\n", ch, c[0][ch], want, c[1][ch], c[2][ch]);
+    CHECK(fabs(c[0][ch] - want) < 0.03 * want, "channel %d: BLEND gives %.4f, not %.4f", ch, c[0][ch], want);
+  }
+  return 0;
+}
+
 /* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
@@ -842,7 +892,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -184,7 +184,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   }
   m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
-  /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK/BLEND on the base colour. */
+  /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK on the base colour; BLEND: below. */
   /* glTF 2.0 metallic-roughness (docs/scene-format.md): MAT_PBR with the factors (glTF
    * defaults 1 and 1) times the metallic-roughness texture (G roughness, B metallic),
    * which Assimp 5.2 files under METALNESS or, for older files, UNKNOWN. */
@@ -198,8 +198,15 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
   struct aiString mode;
-  if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) == aiReturn_SUCCESS && strcmp(mode.data, "OPAQUE") &&
-      m->tex_kd >= 0 && s->tex[m->tex_kd].has_alpha) {
+  if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) != aiReturn_SUCCESS || !strcmp(mode.data, "OPAQUE")) return;
+  int kd_alpha = m->tex_kd >= 0 && s->tex[m->tex_kd].has_alpha;
+  if (!strcmp(mode.data, "BLEND") && c3_black(m->emission)) {
+    /* BLEND: the base colour's alpha (factor times texture) as stochastic opacity, the
+     * fraction of light a surface stops, as Cycles renders a blended glTF material */
+    struct aiColor4D bc;
+    if (aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &bc) == aiReturn_SUCCESS && bc.a >= 0 && bc.a < 1) m->opacity = bc.a;
+    if (kd_alpha) { m->tex_alpha = m->tex_kd; m->alpha_channel = 1; m->alpha_stochastic = 1; }
+  } else if (kd_alpha) {
     m->tex_alpha = m->tex_kd;
     m->alpha_channel = 1;
     m->alpha_cutoff = ai_float(am, AI_MATKEY_GLTF_ALPHACUTOFF, 0.5f);
