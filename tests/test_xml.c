@@ -346,6 +346,33 @@ static int mesh_v_as_mitsuba(void) {
   return 0;
 }
 
+/* A file written on one line (as programs write them): each anonymous BSDF and each
+ * emitter stays its own material (they were named by line alone, and the second of a line
+ * took the first's: a green sphere rendered red, a lamp at the first's radiance). */
+static int one_line_materials(void) {
+  const char *xml = "<scene version=\"3.0.0\"><sensor type=\"perspective\"/>"
+                    "<shape type=\"sphere\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.9 0 0\"/></bsdf></shape>"
+                    "<shape type=\"sphere\"><point name=\"center\" value=\"3 0 0\"/><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0 0.9 0\"/></bsdf></shape>"
+                    "<shape type=\"sphere\"><point name=\"center\" value=\"6 0 0\"/><emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/></emitter></shape>"
+                    "<shape type=\"sphere\"><point name=\"center\" value=\"9 0 0\"/><emitter type=\"area\"><rgb name=\"radiance\" value=\"5\"/></emitter></shape>"
+                    "</scene>\n";
+  const char *path = scratch_file("one-line.xml", xml);
+  scene *s = scene_new(path);
+  valo_error err;
+  valo_options set;
+  valo_options_init(&set);
+  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  uint32_t per = s->ntris / 4;
+  CHECK(per > 0 && s->ntris == 4 * per, "%u triangles", s->ntris);
+  const material *m[4];
+  for (int k = 0; k < 4; k++) m[k] = &s->mats[s->tri_mat[k * per]];
+  CHECK(m[0]->kd.r > 0.8f && m[0]->kd.g == 0, "the first sphere is (%g %g %g), not red", m[0]->kd.r, m[0]->kd.g, m[0]->kd.b);
+  CHECK(m[1]->kd.g > 0.8f && m[1]->kd.r == 0, "the second sphere is (%g %g %g), not green", m[1]->kd.r, m[1]->kd.g, m[1]->kd.b);
+  CHECK(m[2]->emission.g == 1 && m[3]->emission.g == 5, "the lamps glow %g and %g, not 1 and 5", m[2]->emission.g, m[3]->emission.g);
+  scene_free(s);
+  return 0;
+}
+
 /* Mitsuba's mask as valo's stochastic opacity: the default 0.5, a number times the default
  * (a mask inside a mask), and a bitmap
  * decoded from sRGB unless raw (the ramp's texel 32 holds 130: 0.510 raw, 0.223 decoded). */
@@ -483,7 +510,7 @@ static int includes(void) {
   size_t got = fread(buf, 1, sizeof buf - 1, f);
   fclose(f);
   buf[got] = 0;
-  CHECK(strstr(buf, "\"bsdf@line2\"") && strstr(buf, "\"bsdf@inc-green.xml:line2\"") && strstr(buf, "0.7, 0.1, 0.1") && strstr(buf, "0.1, 0.7, 0.1"),
+  CHECK(strstr(buf, "\"bsdf@line2:22\"") && strstr(buf, "\"bsdf@inc-green.xml:line2:22\"") && strstr(buf, "0.7, 0.1, 0.1") && strstr(buf, "0.1, 0.7, 0.1"),
         "both files' line-2 BSDFs should be materials: %s", buf);
   for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
     if (bad[i].text) scratch_file(bad[i].inc, bad[i].text);
@@ -581,6 +608,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -260,7 +260,7 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
   if (b) {
     st = translate_bsdf(c, b, m);
     if (id) snprintf(base, sizeof base, "%.60s", id);
-    else snprintf(base, sizeof base, "bsdf@%s", mi_where(c, b, where, sizeof where));
+    else snprintf(base, sizeof base, "bsdf@%s", mi_place(c, b, where, sizeof where));
   } else {
     /* Mitsuba's default BSDF: diffuse, reflectance 0.5 */
     cJSON_AddStringToObject(m, "type", "diffuse");
@@ -278,7 +278,7 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
       cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){0, 0, 0}, 3));
     }
     cJSON_AddItemToObject(m, "emission", cJSON_Duplicate(emit, 1));
-    snprintf(name, n, "%s+area@%s", base, mi_where(c, at, where, sizeof where));
+    snprintf(name, n, "%s+area@%s", base, mi_place(c, at, where, sizeof where));
   } else {
     snprintf(name, n, "%s", base);
   }
@@ -335,7 +335,7 @@ valo_status mi_medium(mctx *c, xml_node *med, char *name, size_t n) {
   const char *id = xml_attr_get(med, "id");
   char where[96];
   if (id) snprintf(name, n, "%.90s", id);
-  else snprintf(name, n, "medium@%s", mi_where(c, med, where, sizeof where));
+  else snprintf(name, n, "medium@%s", mi_place(c, med, where, sizeof where));
   if (cJSON_GetObjectItemCaseSensitive(c->media, name)) return VALO_OK;
   med->used = 1;
   const char *type = xml_attr_get(med, "type");

@@ -47,6 +47,12 @@ const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
   return buf;
 }
 
+const char *mi_place(const mctx *c, const xml_node *n, char *buf, size_t len) {
+  char w[96];
+  snprintf(buf, len, "%s:%d", mi_where(c, n, w, sizeof w), n->col);
+  return buf;
+}
+
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) {
   if (c->quiet) return;
   char msg[600], lb[200];

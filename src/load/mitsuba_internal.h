@@ -39,6 +39,9 @@ void mi_mat_mul(double r[16], const double a[16], const double b[16]);
 /* Where n is, for names of the materials and media made from unnamed elements: "line12",
  * or "part.xml:line12" in an included file (so two files' line 12 are told apart). */
 const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len);
+/* mi_where and the column: a name no other element of the files shares (an anonymous
+ * material's, a medium's). */
+const char *mi_place(const mctx *c, const xml_node *n, char *buf, size_t len);
 /* The node with id (any tag), or NULL. */
 xml_node *mi_find_id(mctx *c, const char *id);
 /* The property child named `name` of plugin p (marked used), following a <ref name=..>

@@ -141,6 +141,7 @@ static valo_status read_element(xml_in *x, xml_node *parent, int depth, xml_node
   int line, col;
   line_col(x, open, &line, &col);
   n->line = line;
+  n->col = col;
   if (!(n->name = read_name(x))) return bad(x, x->p, "expected an element name");
   for (;;) {
     skip_space(x);

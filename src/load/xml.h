@@ -15,7 +15,7 @@ typedef struct xml_node {
   xml_attr *attrs;
   int nattrs;
   struct xml_node *child, *next, *parent; /* children in document order */
-  int line;
+  int line, col; /* where its start tag opens */
   int used; /* set by a reader that took this node's meaning (unused ones are warned about) */
   const char *file; /* the file it was read from, when a reader spliced it in from another
                        (Mitsuba's <include>); NULL: the document's own */
