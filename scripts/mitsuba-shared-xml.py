@@ -26,7 +26,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's mask with a binary opacity bitmap (valo's opacity)
           "mask": ("@tests/data/mitsuba-xml/mask.xml", {"resx": "128", "resy": "96"}),
           # Mitsuba's mask with fractional opacity: a number and a ramp bitmap (valo's opacity)
-          "opacity": ("@tests/data/mitsuba-xml/opacity.xml", {"resx": "128", "resy": "96"})}
+          "opacity": ("@tests/data/mitsuba-xml/opacity.xml", {"resx": "128", "resy": "96"}),
+          # Mitsuba's blendbsdf: a number, the default and a ramp bitmap as weights (valo's blend)
+          "blend": ("@tests/data/mitsuba-xml/blend.xml", {"resx": "128", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

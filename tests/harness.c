@@ -194,6 +194,16 @@ float *render_json_text(const char *json, const valo_options *opt, int *w, int *
   return px;
 }
 
+double render_json_mean_green(const char *json) {
+  int w, h;
+  float *px = render_json_text(json, NULL, &w, &h);
+  if (!px) return -1;
+  double m = 0;
+  for (int i = 0; i < w * h; i++) m += px[3 * i + 1];
+  free(px);
+  return m / ((double)w * h);
+}
+
 /* Compares img to ref: per-channel mean error and worst relative error over lit blocks
  * (block luminance above 5 % of the image's mean luminance). */
 void compare_images(const float *img, const float *ref, int w, int h, int block, cmp_result *r) {

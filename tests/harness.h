@@ -41,6 +41,8 @@ char *read_text_file(const char *path);
  * overrides; returns malloc'd RGB pixels and the size, or NULL (message printed). */
 #include "valo/valo.h"
 float *render_json_text(const char *json, const valo_options *opt, int *w, int *h);
+/* The mean of the green channel of render_json_text's image; -1 when it failed. */
+double render_json_mean_green(const char *json);
 /* Loads the scene file at `path`, creates a render with `opt` (may be NULL) and runs it;
  * returns the finished render and its scene in *scene (destroy both), or NULL with the
  * message printed. */

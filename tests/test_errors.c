@@ -165,6 +165,13 @@ static int bad_mitsuba(void) {
        "mx19.xml:4: <ref id=\"nothing\">", "refers to an id that no element has"},
       {"mx17.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"area\"/>\n</scene>", "mx17.xml:3: <emitter type=\"area\">", "belongs inside the <shape>"},
       {"mx18.xml", "<notascene/>", "mx18.xml:1: <notascene>", "root element of a Mitsuba scene is <scene>"},
+      {"mx20.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"blendbsdf\"><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/>"
+       "</bsdf></shape>\n</scene>", "mx20.xml:3: <bsdf type=\"blendbsdf\">", "needs its weight"},
+      {"mx21.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>"
+       "<bsdf type=\"diffuse\"/></bsdf></shape>\n</scene>", "mx21.xml:3: <bsdf type=\"blendbsdf\">", "needs two BSDFs inside it"},
+      {"mx22.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>"
+       "<bsdf type=\"diffuse\"/><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>"
+       "</bsdf></shape>\n</scene>", "mx22.xml", "a blend material, which a blend cannot hold"},
   };
 #undef SENSOR
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

@@ -266,6 +266,12 @@ static int opacity_xml(void) {
   return against_mitsuba_xml("opacity", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/opacity.xml", "resx=128 resy=96", 256, 0.03);
 }
 
+/* Mitsuba's blendbsdf (tests/data/mitsuba-xml/blend.xml): weights of 0.3, 0.5 and a ramp
+ * bitmap, blending diffuse, rough conductors and a rough plastic; valo's blend. */
+static int blend_xml(void) {
+  return against_mitsuba_xml("blend", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/blend.xml", "resx=128 resy=96", 256, 0.03);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -351,6 +357,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

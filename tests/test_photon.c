@@ -242,6 +242,40 @@ static int photon_threads(void) {
   return 0;
 }
 
+/* A blend of diffuse 0.8 and a mirror at weight 0.5 against the same surface as one
+ * material (mirror of reflectance 0.5 over diffuse 0.4): a spot lights the floor only, and
+ * the camera sees the wall, lit only from the floor (its diffuse part by the global map,
+ * its mirror part by the caustic map). Light paths store photons on a blend whichever
+ * material it picked (stored only on the diffuse pick, the wall was half as bright); vpl,
+ * on the same light paths, keeps its lights where the pick can scatter to the camera. */
+static int photon_blend(void) {
+  CHECK(scratch_file("pb-floor.obj", "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("pb-wall.obj", "v -3 0 -2\nv 3 0 -2\nv 3 3 -2\nv -3 3 -2\nf 1 2 3 4\n"), "write");
+  const char *mats[2] = {"\"d\": {\"type\": \"diffuse\", \"reflectance\": 0.8}, \"m\": {\"type\": \"mirror\"},"
+                         " \"f\": {\"type\": \"blend\", \"weight\": 0.5, \"materials\": [\"d\", \"m\"]}",
+                         "\"f\": {\"type\": \"mirror\", \"reflectance\": 0.5, \"diffuse\": 0.4}"};
+  const char *integ[2] = {"photon", "vpl"};
+  for (int q = 0; q < 2; q++) {
+    double mean[2];
+    for (int k = 0; k < 2; k++) {
+      char json[1400];
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0, 1.2, 3], \"look_at\": [0, 1.2, -2], \"fov\": 20},\n"
+               "  \"film\": {\"width\": 24, \"height\": 24}, \"render\": {\"spp\": 8, \"integrator\": \"%s\"},\n"
+               "  \"materials\": {%s, \"w\": {\"type\": \"diffuse\", \"reflectance\": 0.7}},\n"
+               "  \"shapes\": [{\"file\": \"pb-floor.obj\", \"material\": \"f\"}, {\"file\": \"pb-wall.obj\", \"material\": \"w\"}],\n"
+               "  \"lights\": [{\"type\": \"spot\", \"position\": [0, 1.5, 0], \"look_at\": [0, 0, 0], \"intensity\": 20, \"cone_angle\": 30}] }\n",
+               integ[q], mats[k]);
+      mean[k] = render_json_mean_green(json);
+      CHECK(mean[k] >= 0, "render failed");
+    }
+    fprintf(stderr, "%s: wall lit from the floor: blend %.5f, one material %.5f\n", integ[q], mean[0], mean[1]);
+    CHECK(mean[1] > 0 && fabs(mean[0] / mean[1] - 1) < 0.05, "%s: the wall over a blend is %.5f, over the same surface as one material %.5f", integ[q],
+          mean[0], mean[1]);
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"photon_cornell_reference", photon_cornell_reference},
                                     {"photon_converges", photon_converges},
@@ -249,7 +283,7 @@ int main(int argc, char **argv) {
                                     {"photon_caustic_far", photon_caustic_far},
                                     {"photon_cornell_mirror", photon_cornell_mirror},
                                     {"photon_consistent", photon_consistent},
-                                    {"photon_threads", photon_threads},
+                                    {"photon_threads", photon_threads}, {"photon_blend", photon_blend},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

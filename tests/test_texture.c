@@ -707,6 +707,49 @@ static int gltf_blend(void) {
   return 0;
 }
 
+/* "blend": diffuse 0.2 and 0.8 at weight 0.25 scatter as diffuse 0.35 (a point light over
+ * a floor, direct light: the means agree within noise); the file's mistakes are refused
+ * with the key and the reason. */
+static int blend_mixes(void) {
+  CHECK(scratch_file("mfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  const char *mats[2] = {"\"a\": {\"type\": \"diffuse\", \"reflectance\": 0.2}, \"b\": {\"type\": \"diffuse\", \"reflectance\": 0.8},"
+                         " \"f\": {\"type\": \"blend\", \"weight\": 0.25, \"materials\": [\"a\", \"b\"]}",
+                         "\"f\": {\"type\": \"diffuse\", \"reflectance\": 0.35}"};
+  double mean[2];
+  for (int k = 0; k < 2; k++) {
+    char json[1024];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [0, 2, 0.001], \"look_at\": [0,0,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 256, \"max_depth\": 1},\n"
+             "  \"materials\": {%s},\n  \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+             mats[k]);
+    mean[k] = render_json_mean_green(json);
+    CHECK(mean[k] >= 0, "render failed");
+  }
+  fprintf(stderr, "blend of 0.2 and 0.8 at 0.25: %.5f; diffuse 0.35: %.5f\n", mean[0], mean[1]);
+  CHECK(fabs(mean[0] / mean[1] - 1) < 0.01, "the blend's mean %.5f is not diffuse 0.35's %.5f", mean[0], mean[1]);
+  static const struct { const char *mats, *says; } bad[] = {
+      {"\"f\": {\"type\": \"blend\", \"weight\": 0.5, \"materials\": [\"a\", \"zz\"]}, \"a\": {\"type\": \"diffuse\"}", "no material is named \"zz\""},
+      {"\"f\": {\"type\": \"blend\", \"weight\": 0.5, \"materials\": [\"f\", \"f\"]}", "cannot hold itself"},
+      {"\"f\": {\"type\": \"blend\", \"materials\": [\"a\"]}, \"a\": {\"type\": \"diffuse\"}", "must name two materials"},
+      {"\"f\": {\"type\": \"blend\", \"weight\": 2, \"materials\": [\"a\", \"a\"]}, \"a\": {\"type\": \"diffuse\"}", "out of range"},
+      {"\"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"b\"]}, \"a\": {\"type\": \"diffuse\", \"emission\": 1}, \"b\": {\"type\": \"diffuse\"}",
+       "has its own emission"},
+      {"\"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"b\"]}, \"a\": {\"type\": \"diffuse\"}, \"b\": {\"type\": \"blend\"}", "a blend material"},
+      {"\"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"a\"], \"emission\": 1}, \"a\": {\"type\": \"diffuse\"}", "unknown key"}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char json[1024];
+    snprintf(json, sizeof json, "{ \"materials\": {%s}, \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}] }\n", bad[i].mats);
+    const char *path = scratch_file("bad-blend.json", json);
+    valo_scene *sc = NULL;
+    valo_error err;
+    CHECK(valo_scene_load(path, &sc, &err) != VALO_OK, "case %zu loaded", i);
+    CHECK(strstr(err.message, bad[i].says) && strstr(err.message, "materials.f"), "case %zu: \"%s\" does not say \"%s\"", i, err.message, bad[i].says);
+  }
+  return 0;
+}
+
 /* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
@@ -892,7 +935,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -58,7 +58,9 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
     bsdf b = bsdf_at(s, &it);
     vec3 wo = v3_neg(r.d);
     frame fr = shading_frame(&it, &b, wo);
-    if (bsdf_has_smooth(&b)) {
+    /* a blend's photons are stored whichever material it picked: the camera's pick applies
+     * the BSDF, so the flux stored must not carry this one's */
+    if (bsdf_has_smooth(&b) || (s->mats[s->tri_mat[h.tri]].type == MAT_BLEND && surface_has_smooth(s, h.tri))) {
       lp_vertex v = {&it, &b, &fr, r.d, beta, depth, specular_path};
       void *rec = slot(out, j->rec_size);
       if (rec && j->visit(j->user, &v, rec)) out->n++;

@@ -8,6 +8,7 @@
 
 static int visit(void *user, const lp_vertex *v, void *rec) {
   (void)user;
+  if (!bsdf_has_smooth(v->b)) return 0; /* a blend that picked its delta material: no light to give */
   vpl l;
   memset(&l, 0, sizeof l);
   l.p = v->it->p;

@@ -500,8 +500,8 @@ valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_o
   }
   const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
   if (render) TRY(parse_render(&c, render));
-  uint32_t mfirst = s->nmats;
-  const cJSON *mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
+  uint32_t mfirst = c.mfirst = s->nmats;
+  const cJSON *mats = c.mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
   if (mats) {
     if (!cJSON_IsObject(mats)) { st = json_bad(&c, "materials", "must be an object of named materials"); goto done; }
     for (const cJSON *m = mats->child; m; m = m->next) {

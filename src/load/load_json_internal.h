@@ -12,6 +12,8 @@ typedef struct jctx {
   float cam_fov, cam_height, cam_aperture, cam_focus; /* its overrides (fov, height <= 0: keep
                                                          the file's) */
   mesh_cache *meshes;          /* the mesh files imported so far (load_mesh_cached) */
+  const cJSON *mats;           /* the "materials" object, whose k-th material is mfirst + k */
+  uint32_t mfirst;
 } jctx;
 
 /* The getters: a missing key leaves *out as it is; a present one of the wrong type or

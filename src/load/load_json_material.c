@@ -30,6 +30,19 @@ static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const 
   return json_bad(c, w, msg);
 }
 
+/* The map file named by string v, 8-bit decoded from sRGB unless raw (as Mitsuba's and
+ * pbrt's bitmaps are), as *tex; w: "where.key" for errors. */
+static valo_status get_float_map(jctx *c, const cJSON *v, int raw, const char *w, const char *what, int *tex) {
+  char full[2048];
+  json_resolve_path(c, v->valuestring, full, sizeof full);
+  valo_error terr;
+  *tex = scene_texture_file(c->s, full, !raw, &terr);
+  if (*tex >= 0) return VALO_OK;
+  char msg[sizeof terr.message + 40];
+  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
+  return json_bad(c, w, msg);
+}
+
 /* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
  * pbrt's bitmaps are, unless "opacity_raw"): a hit counts with that probability. */
 static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, material *m) {
@@ -46,15 +59,7 @@ static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, mater
     m->opacity = (float)a;
     return VALO_OK;
   }
-  char full[2048];
-  json_resolve_path(c, v->valuestring, full, sizeof full);
-  valo_error terr;
-  m->tex_alpha = scene_texture_file(c->s, full, !raw, &terr);
-  if (m->tex_alpha < 0) {
-    char msg[sizeof terr.message + 40];
-    snprintf(msg, sizeof msg, "cannot read the opacity map: %s", terr.message);
-    return json_bad(c, w, msg);
-  }
+  TRY(get_float_map(c, v, raw, w, "opacity map", &m->tex_alpha));
   m->alpha_channel = c->s->tex[m->tex_alpha].has_alpha;
   m->alpha_stochastic = 1;
   return VALO_OK;
@@ -136,13 +141,59 @@ static valo_status parse_nk_spectrum(jctx *c, const cJSON *o, const char *where0
   return VALO_OK;
 }
 
+/* "blend": "materials" names two others of the file (not blends, emitters, nor with maps
+ * or opacities of their own: the blend carries those), "weight" the second's share. */
+static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, material *m) {
+  m->type = MAT_BLEND;
+  m->weight = 0.5f;
+  const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "weight");
+  int raw = 0;
+  TRY(json_get_bool(c, o, "weight_raw", where, &raw));
+  char at[300];
+  snprintf(at, sizeof at, "%s.weight", where);
+  if (w && cJSON_IsString(w)) {
+    TRY(get_float_map(c, w, raw, at, "weight map", &m->tex_weight));
+    m->weight = 1;
+  } else {
+    double x = m->weight;
+    TRY(json_get_num(c, o, "weight", where, 0, 1, &x));
+    m->weight = (float)x;
+  }
+  snprintf(at, sizeof at, "%s.materials", where);
+  const cJSON *ms = cJSON_GetObjectItemCaseSensitive(o, "materials");
+  if (!cJSON_IsArray(ms) || cJSON_GetArraySize(ms) != 2) return json_bad(c, at, "must name two materials");
+  for (int k = 0; k < 2; k++) {
+    const char *n = cJSON_GetStringValue(cJSON_GetArrayItem(ms, k));
+    if (!n) return json_bad(c, at, "must name two materials");
+    uint32_t i = 0;
+    const cJSON *e = c->mats ? c->mats->child : NULL;
+    while (e && strcmp(e->string, n)) e = e->next, i++;
+    char msg[200];
+    snprintf(msg, sizeof msg, "no material is named \"%.80s\"", n);
+    if (!e || e == o) return json_bad(c, at, e ? "a blend cannot hold itself" : msg);
+    const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(e, "type"));
+    static const char *const own[] = {"emission", "normal_map", "bump_map", "alpha_map", "opacity", NULL};
+    for (int q = 0; own[q]; q++)
+      if (cJSON_GetObjectItemCaseSensitive(e, own[q])) {
+        snprintf(msg, sizeof msg, "\"%.80s\" has its own %s: give it to the blend", n, own[q]);
+        return json_bad(c, at, msg);
+      }
+    if (t && (!strcmp(t, "blend") || !strcmp(t, "null"))) {
+      snprintf(msg, sizeof msg, "\"%.80s\" is a %s material, which a blend cannot hold", n, t);
+      return json_bad(c, at, msg);
+    }
+    m->blend[k] = (int)(c->mfirst + i);
+  }
+  return VALO_OK;
+}
+
 valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, material *m) {
   char where[256];
   snprintf(where, sizeof where, "materials.%s", name);
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, blend, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -153,6 +204,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_blend[] = {"type", "weight", "weight_raw", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
+                                        "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
@@ -205,6 +258,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
+  } else if (!strcmp(type, "blend")) {
+    TRY(json_check_keys(c, o, where, k_blend));
+    TRY(parse_blend(c, o, where, m));
   } else if (!strcmp(type, "plastic")) {
     TRY(json_check_keys(c, o, where, k_plastic));
     m->type = MAT_PLASTIC;
@@ -234,7 +290,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "k", where, &m->k));
     TRY(json_get_rgb(c, o, "reflectance", where, &m->tint));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, null)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, blend, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));

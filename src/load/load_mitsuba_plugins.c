@@ -148,6 +148,31 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     cJSON_DeleteItemFromObject(m, "opacity");
     cJSON_AddItemToObject(m, "opacity", op);
     if (raw) cJSON_AddTrueToObject(m, "opacity_raw");
+  } else if (!strcmp(type, "blendbsdf")) {
+    /* valo's blend of the two BSDFs inside, each its own material; weight: the second's
+     * share (a number or a bitmap, sRGB-decoded unless raw) */
+    xml_node *in[2] = {mi_child(c, b, "bsdf", 0), mi_child(c, b, "bsdf", 1)};
+    if (!in[0] || !in[1]) return mi_bad(c, b, "needs two BSDFs inside it");
+    xml_node *k = mi_prop(c, b, "weight");
+    int raw = 0;
+    if (k && !strcmp(k->name, "texture")) TRY(mi_bool(c, k, "raw", &raw));
+    cJSON *w, *names = cJSON_AddArrayToObject(m, "materials");
+    if (!names) return NOMEM;
+    for (int i = 0; i < 2; i++) {
+      char name[160];
+      TRY(mi_material(c, in[i], NULL, in[i], name, sizeof name));
+      cJSON_AddItemToArray(names, cJSON_CreateString(name));
+    }
+    TRY(mi_color(c, b, "weight", MI_RAW, &w));
+    if (!w) return mi_bad(c, b, "needs its weight (a number or a bitmap), as Mitsuba does");
+    if (!cJSON_IsString(w)) {
+      double x = cJSON_GetArrayItem(w, 0)->valuedouble;
+      cJSON_Delete(w);
+      w = cJSON_CreateNumber(x);
+    }
+    TYPE("blend");
+    cJSON_AddItemToObject(m, "weight", w);
+    if (raw) cJSON_AddTrueToObject(m, "weight_raw");
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
     cJSON *v;
@@ -234,7 +259,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     TYPE("null");
   } else {
     return mi_bad(c, b, "valo has no such BSDF (diffuse, dielectric, roughdielectric, thindielectric, conductor, roughconductor, "
-                        "plastic, roughplastic, principled, phong, twosided, normalmap, bumpmap, mask, null)");
+                        "plastic, roughplastic, principled, phong, twosided, normalmap, bumpmap, mask, blendbsdf, null)");
   }
 #undef TYPE
   mi_warn_unused(c, b);

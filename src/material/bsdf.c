@@ -31,6 +31,7 @@ bsdf bsdf_from_material(const material *m) {
   switch (m->type) {
   case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
   case MAT_NULL: b.type = BSDF_DIFFUSE; b.kd = c3(0, 0, 0); break; /* path passes it by; nothing else sees it */
+  case MAT_BLEND: b.type = BSDF_DIFFUSE; b.kd = c3(0, 0, 0); break; /* hits see one of its materials (isect_from_hit) */
   case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_MIRROR: b.type = BSDF_MIRROR; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
@@ -326,7 +327,7 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_CONDUCTOR: return c3_mul(m->tint, fresnel_conductor(fabsf(cos_o), m->eta, m->k));
   case MAT_PBR: return m->kd;
   case MAT_PLASTIC: return c3_add(m->kd, c3_scale(m->ks, fresnel_dielectric(fabsf(cos_o), m->ior)));
-  case MAT_NULL: break;
+  case MAT_NULL: case MAT_BLEND: break; /* a blend: hits see one of its materials */
   }
   return c3(0, 0, 0);
 }

@@ -1,6 +1,7 @@
 /* shading.c — see shading.h. */
 #include "material/shading.h"
 #include "image/texture.h"
+#include "core/rng.h"
 #include <math.h>
 
 /* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
@@ -34,8 +35,25 @@ static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   if (v3_len2(nb) > 1e-30f && v3_finite(nb)) it->ns = v3_norm(nb);
 }
 
+/* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
+ * of the ray and the triangle (as stochastic opacity is): over rays the hit scatters as
+ * (1 - w) f0 + w f1. Blends inside blends are chosen in turn (at most 8 deep). */
+static const material *blend_pick(const scene *s, const ray *r, const isect *it) {
+  const material *m = it->m;
+  uint64_t key = accel_ray_key(r->o, r->d) ^ ((uint64_t)it->tri * 0xD1B54A32D192ED03ull);
+  for (int depth = 0; m->type == MAT_BLEND && depth < 8; depth++) {
+    float w = m->weight, px[4];
+    if (m->tex_weight >= 0 && (s->tri_flags[it->tri] & TRI_HAS_UVS)) {
+      texture_lookup(&s->tex[m->tex_weight], it->u, it->v, px);
+      w *= px[0];
+    }
+    key = rng_mix64(key + 0x9E3779B97F4A7C15ull);
+    m = &s->mats[m->blend[(float)(key >> 40) * 0x1p-24f < w]];
+  }
+  return m;
+}
+
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
-  (void)r;
   const uint32_t *ix = &s->idx[3 * h->tri];
   vec3 p0 = s->pos[ix[0]], p1 = s->pos[ix[1]], p2 = s->pos[ix[2]];
   it->p = tri_point(p0, p1, p2, h->b1, h->b2, &it->perr);
@@ -69,6 +87,7 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
     }
   }
   if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
+  if (it->m->type == MAT_BLEND) it->m = blend_pick(s, r, it); /* after the blend's own maps */
 }
 
 bsdf bsdf_at(const scene *s, const isect *it) {
@@ -84,6 +103,15 @@ bsdf bsdf_at(const scene *s, const isect *it) {
   if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
   return bsdf_from_material(&mm);
 }
+
+static int material_has_smooth(const scene *s, const material *m, int depth) {
+  if (m->type != MAT_BLEND) {
+    bsdf b = bsdf_from_material(m);
+    return bsdf_has_smooth(&b);
+  }
+  return depth < 8 && (material_has_smooth(s, &s->mats[m->blend[0]], depth + 1) || material_has_smooth(s, &s->mats[m->blend[1]], depth + 1));
+}
+int surface_has_smooth(const scene *s, uint32_t t) { return material_has_smooth(s, &s->mats[s->tri_mat[t]], 0); }
 
 frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
   vec3 ns = it->ns;

@@ -21,6 +21,9 @@ typedef struct isect {
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
 /* The BSDF at it, with the material's texture maps applied at its UV. */
 bsdf bsdf_at(const scene *s, const isect *it);
+/* 1 when triangle t's surface has a non-delta lobe whichever material a blend on it picks
+ * (light paths store photons there whatever their own pick was). */
+int surface_has_smooth(const scene *s, uint32_t t);
 static inline vec3 offset_origin_isect(const isect *it, vec3 d) { return offset_origin(it->p, it->perr, it->ng, d); }
 /* Shading frame at it for viewer direction wo, faced for opaque BSDFs (geometric normal
  * too); returns the frame and updates it->ng. */

@@ -77,6 +77,7 @@ material material_default(void) {
   m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = -1;
   m.alpha_cutoff = 0.5f;
   m.opacity = 1;
+  m.tex_weight = -1;
   snprintf(m.name, sizeof m.name, "default");
   return m;
 }
@@ -158,7 +159,7 @@ void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, floa
 
 int material_has_maps(const material *m) {
   return m->tex_kd >= 0 || m->tex_ks >= 0 || m->tex_ke >= 0 || m->tex_alpha >= 0 || m->tex_normal >= 0 || m->tex_ns >= 0 || m->tex_bump >= 0 ||
-         m->tex_rough >= 0 || m->tex_metal >= 0 || m->tex_mr >= 0;
+         m->tex_rough >= 0 || m->tex_metal >= 0 || m->tex_mr >= 0 || m->tex_weight >= 0;
 }
 
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key) {

@@ -18,8 +18,10 @@ typedef enum mat_type {
   MAT_PBR,         /* glTF 2.0 metallic-roughness: base colour kd, metallic, roughness */
   MAT_NULL,        /* no surface: rays pass straight through (a medium's boundary) */
   MAT_THIN_DIELECTRIC, /* a thin pane of glass, index ior: reflects as both faces do, transmits without bending */
-  MAT_PLASTIC      /* diffuse kd under a dielectric coat of index ior, specular tint ks, smooth or rough
+  MAT_PLASTIC,     /* diffuse kd under a dielectric coat of index ior, specular tint ks, smooth or rough
                       (Mitsuba's plastic / roughplastic; material/plastic.h) */
+  MAT_BLEND        /* blend[1] with probability weight (times tex_weight), else blend[0], chosen per
+                      hit (Mitsuba's blendbsdf; isect_from_hit resolves it) */
 } mat_type;
 
 /* MAT_PLASTIC's coat, tabulated by plastic_prepare: its transmittance at cos theta =
@@ -54,6 +56,9 @@ typedef struct material {
   float opacity;     /* a hit counts with probability opacity (times tex_alpha's value when
                         alpha_stochastic): 1 = opaque, the default */
   int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
+  int blend[2];      /* MAT_BLEND: the two materials' indices */
+  float weight;      /* MAT_BLEND: blend[1]'s share */
+  int tex_weight;    /* MAT_BLEND: a map multiplying weight (its first channel), -1 = none */
   int nonlinear;     /* MAT_PLASTIC: the base's internal scattering tints (Mitsuba's nonlinear) */
   float coat_t[PLASTIC_RES], coat_ri; /* MAT_PLASTIC: filled by plastic_prepare */
   int nk;            /* MAT_CONDUCTOR: 1 + index into scene.nk (eta and k per wavelength,
