@@ -205,7 +205,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_blend[] = {"type", "weight", "weight_raw", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                        "two_sided", "bump_map", "bump_scale", NULL};
+                                        "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
