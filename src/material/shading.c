@@ -67,8 +67,12 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
     float l2 = v3_len2(n);
     if (l2 > 0 && isfinite(l2)) it->ns = v3_scale(n, 1 / sqrtf(l2));
   }
-  it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
-  it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+  if ((s->tri_flags[h->tri] & TRI_SPHERE) && (material_has_maps(it->m) || it->m->type == MAT_BLEND)) { /* exact on a sphere */
+    scene_tri_uv(s, h->tri, h->b1, h->b2, &it->u, &it->v);
+  } else {
+    it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
+    it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
+  }
   if (it->m->tex_normal >= 0 && s->tan && (s->tri_flags[h->tri] & TRI_HAS_UVS)) {
     /* Tangent-space normal map: n = 2 rgb - 1 in the (T, B, N) frame at the hit. */
     const float *t0 = &s->tan[4 * ix[0]], *t1 = &s->tan[4 * ix[1]], *t2 = &s->tan[4 * ix[2]];

@@ -6,6 +6,7 @@
 #include "core/mat34.h"
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* The equirectangular texture coordinates of the point in unit direction d from a sphere's
  * centre (scene.h, scene_sphere_uv). */
@@ -24,9 +25,18 @@ static void sphere_dir_uv(vec3 d, const float *rot, float *u, float *v, int *pol
   }
 }
 
+void scene_sphere_point_uv(const sphere_shape *sp, vec3 p, float *u, float *v) {
+  int pole;
+  vec3 d = v3_sub(p, sp->c);
+  float l = v3_len(d);
+  sphere_dir_uv(l > 0 ? v3_scale(d, 1 / l) : v3(0, 1, 0), sp->mitsuba_uv ? sp->rot : NULL, u, v, &pole);
+}
+
 valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot) {
   if (g >= s->nspheres) return VALO_ERR_INVALID;
-  const sphere_shape *sp = &s->spheres[g];
+  sphere_shape *sp = &s->spheres[g];
+  sp->mitsuba_uv = rot != NULL;
+  if (rot) memcpy(sp->rot, rot, sizeof sp->rot);
   for (uint32_t t = sp->first; t < sp->end; t++) {
     const uint32_t *ix = &s->idx[3 * (size_t)t];
     float u[3], v[3];
@@ -63,7 +73,7 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
   sphere_shape *sps = realloc(s->spheres, (s->nspheres + 1) * sizeof *sps);
   if (sps) s->spheres = sps;
   if (!sps || !tris || !tmp || scene_reserve(s, nf * 3, nf)) { free(tris); free(tmp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
-  sphere_shape sp = {c, r, s->ntris, s->ntris + nf, flip, 0, 0};
+  sphere_shape sp = {c, r, s->ntris, s->ntris + nf, flip, 0, 0, 0, {0}};
   s->spheres[s->nspheres++] = sp;
   for (int i = 0; i < 20; i++)
     for (int k = 0; k < 3; k++) tris[3 * i + k] = v3_norm(iv[f[i][k]]);
@@ -91,7 +101,7 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
     uint32_t ti = s->ntris++;
     s->idx[3 * ti] = base; s->idx[3 * ti + 1] = base + 1; s->idx[3 * ti + 2] = base + 2;
     s->tri_mat[ti] = mat;
-    s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS);
+    s->tri_flags[ti] = (uint8_t)((smooth ? TRI_HAS_NORMALS : 0) | TRI_HAS_UVS | TRI_SPHERE);
   }
   free(tris); free(tmp);
   return scene_sphere_uv(s, s->nspheres - 1, NULL);

@@ -150,9 +150,26 @@ int scene_texture_memory(scene *s, const char *name, const unsigned char *data, 
   return add_texture(s, &t, key);
 }
 
+/* The sphere whose triangles hold t (their ranges are in order), or NULL. */
+static const sphere_shape *tri_sphere(const scene *s, uint32_t t) {
+  uint32_t lo = 0, hi = s->nspheres;
+  while (lo < hi) {
+    uint32_t mid = lo + (hi - lo) / 2;
+    if (s->spheres[mid].end <= t) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < s->nspheres && s->spheres[lo].first <= t ? &s->spheres[lo] : NULL;
+}
+
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v) {
   const uint32_t *ix = &s->idx[3 * t];
   float b0 = 1 - b1 - b2;
+  const sphere_shape *sp = (s->tri_flags[t] & TRI_SPHERE) ? tri_sphere(s, t) : NULL;
+  if (sp) {
+    vec3 p = v3_add(v3_add(v3_scale(s->pos[ix[0]], b0), v3_scale(s->pos[ix[1]], b1)), v3_scale(s->pos[ix[2]], b2));
+    scene_sphere_point_uv(sp, p, u, v);
+    return;
+  }
   *u = b0 * s->uv[2 * ix[0]] + b1 * s->uv[2 * ix[1]] + b2 * s->uv[2 * ix[2]];
   *v = b0 * s->uv[2 * ix[0] + 1] + b1 * s->uv[2 * ix[1] + 1] + b2 * s->uv[2 * ix[2] + 1];
 }

@@ -109,7 +109,10 @@ typedef struct light {
  * when it emits outwards and each of its triangles is an area light, its lights are
  * [l0, l1), in triangle order, and light sampling may take it whole (light.h); else
  * l0 == l1. */
-typedef struct sphere_shape { vec3 c; float r; uint32_t first, end; int flip; uint32_t l0, l1; } sphere_shape;
+typedef struct sphere_shape {
+  vec3 c; float r; uint32_t first, end; int flip; uint32_t l0, l1;
+  int mitsuba_uv; float rot[9]; /* its texture layout (scene_sphere_uv) */
+} sphere_shape;
 
 typedef struct camera {
   vec3 pos, look_at, up;
@@ -127,7 +130,7 @@ typedef struct camera {
 typedef struct cam_key { float frame; vec3 pos, look_at, up; float fov_deg, ortho_height; } cam_key;
 
 /* Triangle flags. */
-enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4 };
+enum { TRI_HAS_NORMALS = 1, TRI_HAS_UVS = 2, TRI_ALPHA = 4, TRI_SPHERE = 8 /* one of scene.spheres' */ };
 
 /* Proximity-AO settings of one JSON shape (its triangles [first, end)); a negative
  * value (not given) takes the proximity-ao integrator's parameter. */
@@ -204,7 +207,9 @@ material material_default(void);
  * names the file and the map is ignored. */
 int scene_texture_file(scene *s, const char *path, int srgb, valo_error *err);
 int scene_texture_memory(scene *s, const char *key, const unsigned char *data, size_t len, int srgb);
-/* Surface UV of triangle t at barycentrics (b1, b2). */
+/* Surface UV of triangle t at barycentrics (b1, b2): interpolated, or on a sphere's
+ * triangle the sphere's own layout at the point's direction from its centre (exact, so a
+ * texture shows no facets). */
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);
 /* Alpha test: 1 if the hit on triangle t at (b1, b2) counts. A cutout compares the map
  * with alpha_cutoff; an opacity a < 1 lets the hit count with probability a, decided by a
@@ -267,6 +272,8 @@ valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, in
  * local frame (3x3 row-major, local to world, orthogonal): u = phi / 2 pi from its x towards
  * its y, v = 1 - theta / pi from its z (turned up to valo's convention). */
 valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot);
+/* The UV of sphere sp's layout at point p (its direction from the centre). */
+void scene_sphere_point_uv(const sphere_shape *sp, vec3 p, float *u, float *v);
 /* Mitsuba's unit shapes, flat-shaded: the rectangle [-1, 1]^2 at z = 0 facing +z, the
  * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments);
  * placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps the front side);
