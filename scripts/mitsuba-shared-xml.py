@@ -28,7 +28,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's mask with fractional opacity: a number and a ramp bitmap (valo's opacity)
           "opacity": ("@tests/data/mitsuba-xml/opacity.xml", {"resx": "128", "resy": "96"}),
           # Mitsuba's blendbsdf: a number, the default and a ramp bitmap as weights (valo's blend)
-          "blend": ("@tests/data/mitsuba-xml/blend.xml", {"resx": "128", "resy": "96"})}
+          "blend": ("@tests/data/mitsuba-xml/blend.xml", {"resx": "128", "resy": "96"}),
+          # Mitsuba's principled BSDF (valo's principled)
+          "principled": ("@tests/data/mitsuba-xml/principled.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

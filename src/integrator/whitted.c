@@ -25,7 +25,7 @@ static rgb whitted_rec(const render_ctx *c, ray r, sampler *smp, thread_stats *t
   vec3 refr_l = v3(0, 0, 0);
   float eta_scale = 1;
   switch (b.type) {
-  case BSDF_DIFFUSE: case BSDF_PHONG: case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: case BSDF_ROUGH_PLASTIC: break; /* direct light only */
+  case BSDF_DIFFUSE: case BSDF_PHONG: case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: case BSDF_ROUGH_PLASTIC: case BSDF_PRINCIPLED: break; /* direct light only */
   case BSDF_PLASTIC: k_refl = c3_scale(b.ks, fresnel_dielectric(wo_l.z, b.eta)); break; /* its coat's mirror */
   case BSDF_MIRROR: k_refl = b.ks; break;
   case BSDF_CONDUCTOR: k_refl = c3_mul(b.cond_tint, fresnel_conductor(fabsf(wo_l.z), b.cond_eta, b.cond_k)); break;

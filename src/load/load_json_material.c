@@ -8,6 +8,7 @@
 #include "material/plastic.h"
 #include "image/texture.h"
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -141,6 +142,28 @@ static valo_status parse_nk_spectrum(jctx *c, const cJSON *o, const char *where0
   return VALO_OK;
 }
 
+/* "principled": Mitsuba's (material/principled.h); "specular" s, or "ior", sets the index
+ * (eta = 2 / (1 - sqrt(0.08 s)) - 1: 1.5 at the default 0.5). */
+static valo_status parse_principled(jctx *c, const cJSON *o, const char *where, material *m) {
+  m->type = MAT_PRINCIPLED;
+  m->kd = c3(0.5f, 0.5f, 0.5f);
+  m->roughness = 0.5f;
+  TRY(get_rgb_tex(c, o, "base_color", where, &m->kd, &m->tex_kd));
+  static const char *const keys[] = {"metallic", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss"};
+  float *dst[] = {&m->metallic, &m->spec_tint, &m->sheen, &m->sheen_tint, &m->flatness, &m->clearcoat, &m->clearcoat_gloss};
+  for (int k = 0; k < 7; k++) {
+    double x = 0;
+    TRY(json_get_num(c, o, keys[k], where, 0, 1, &x));
+    *dst[k] = (float)x;
+  }
+  double spec = 0.5, ior = 0;
+  TRY(json_get_num(c, o, "specular", where, 0, 1, &spec));
+  TRY(json_get_num(c, o, "ior", where, 1.0001, 10, &ior));
+  if (ior > 0 && cJSON_GetObjectItemCaseSensitive(o, "specular")) return json_bad(c, where, "give \"specular\" or \"ior\", not both");
+  m->ior = ior > 0 ? (float)ior : (float)(2 / (1 - sqrt(0.08 * fmax(spec, 1e-3))) - 1);
+  return VALO_OK;
+}
+
 /* "blend": "materials" names two others of the file (not blends, emitters, nor with maps
  * or opacities of their own: the blend carries those), "weight" the second's share. */
 static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, material *m) {
@@ -193,7 +216,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, blend, null)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -206,6 +229,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
                                           "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_blend[] = {"type", "weight", "weight_raw", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                         "bump_map", "bump_scale", NULL};
+  static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
+                                             "clearcoat", "clearcoat_gloss", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
+                                             "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "bump_map", "bump_scale", NULL};
   if (!strcmp(type, "null")) {
@@ -258,6 +284,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
       m->dispersion = (int)d;
       m->ior = dispersion_ior(d, 589.3f); /* RGB mode renders at the sodium d line */
     }
+  } else if (!strcmp(type, "principled")) {
+    TRY(json_check_keys(c, o, where, k_principled));
+    TRY(parse_principled(c, o, where, m));
   } else if (!strcmp(type, "blend")) {
     TRY(json_check_keys(c, o, where, k_blend));
     TRY(parse_blend(c, o, where, m));
@@ -290,7 +319,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "k", where, &m->k));
     TRY(json_get_rgb(c, o, "reflectance", where, &m->tint));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, blend, null)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));

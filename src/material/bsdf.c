@@ -15,6 +15,7 @@
 #include "core/sampling.h"
 #include "material/microfacet.h"
 #include "material/plastic.h"
+#include "material/principled.h"
 
 static float lobe_prob(rgb a, rgb b) {
   float wa = c3_avg(a), wb = c3_avg(b);
@@ -32,6 +33,15 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
   case MAT_NULL: b.type = BSDF_DIFFUSE; b.kd = c3(0, 0, 0); break; /* path passes it by; nothing else sees it */
   case MAT_BLEND: b.type = BSDF_DIFFUSE; b.kd = c3(0, 0, 0); break; /* hits see one of its materials (isect_from_hit) */
+  case MAT_PRINCIPLED:
+    b.type = BSDF_PRINCIPLED;
+    b.metallic = clampf(m->metallic, 0, 1);
+    b.roughness = clampf(m->roughness, 0, 1);
+    b.alpha = fmaxf(1e-3f, b.roughness * b.roughness);
+    b.spec_tint = m->spec_tint; b.sheen = m->sheen; b.sheen_tint = m->sheen_tint;
+    b.flatness = m->flatness; b.clearcoat = m->clearcoat;
+    b.cc_alpha = 0.1f + (0.001f - 0.1f) * clampf(m->clearcoat_gloss, 0, 1);
+    return b;
   case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_MIRROR: b.type = BSDF_MIRROR; b.p_first = lobe_prob(m->kd, m->ks); break;
   case MAT_DIELECTRIC: b.type = BSDF_DIELECTRIC; break;
@@ -74,7 +84,7 @@ int bsdf_has_smooth(const bsdf *b) {
   case BSDF_MIRROR: return b->p_first > 0;
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_ROUGH_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_PBR: return 1;
-  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return 1;
+  case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: case BSDF_PRINCIPLED: return 1;
   }
   return 0;
 }
@@ -170,6 +180,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return c3(0, 0, 0);
   case BSDF_PBR: return pbr_eval(b, wo, wi);
   case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return plastic_eval(b, wo, wi);
+  case BSDF_PRINCIPLED: return principled_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->alpha, wo, wi) / (4 * wo.z * wi.z);
@@ -191,6 +202,7 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_DIELECTRIC: case BSDF_CONDUCTOR: case BSDF_ROUGH_DIELECTRIC: case BSDF_THIN_DIELECTRIC: return 0;
   case BSDF_PBR: return pbr_pdf(b, wo, wi);
   case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC: return plastic_pdf(b, wo, wi);
+  case BSDF_PRINCIPLED: return principled_pdf(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float p = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
@@ -283,6 +295,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   case BSDF_PLASTIC: case BSDF_ROUGH_PLASTIC:
     if (!plastic_sample(b, wo, ulobe, u1, u2, s)) return 0;
     return s->delta ? 1 : sample_finite(s);
+  case BSDF_PRINCIPLED:
+    return principled_sample(b, wo, ulobe, u1, u2, s) && sample_finite(s);
   case BSDF_ROUGH_CONDUCTOR: {
     if (wo.z <= 0) return 0;
     vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
@@ -327,6 +341,7 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_CONDUCTOR: return c3_mul(m->tint, fresnel_conductor(fabsf(cos_o), m->eta, m->k));
   case MAT_PBR: return m->kd;
   case MAT_PLASTIC: return c3_add(m->kd, c3_scale(m->ks, fresnel_dielectric(fabsf(cos_o), m->ior)));
+  case MAT_PRINCIPLED: return c3_add(c3_scale(m->kd, 1 - m->metallic), c3_scale(c3(1, 1, 1), 0.04f)); /* its diffuse and a dielectric's specular */
   case MAT_NULL: case MAT_BLEND: break; /* a blend: hits see one of its materials */
   }
   return c3(0, 0, 0);

@@ -11,7 +11,8 @@
 typedef enum bsdf_type {
   BSDF_DIFFUSE, BSDF_PHONG, BSDF_MIRROR, BSDF_DIELECTRIC, BSDF_CONDUCTOR,
   BSDF_ROUGH_CONDUCTOR, BSDF_ROUGH_DIELECTRIC, BSDF_PBR, BSDF_THIN_DIELECTRIC,
-  BSDF_PLASTIC, BSDF_ROUGH_PLASTIC /* material/plastic.h */
+  BSDF_PLASTIC, BSDF_ROUGH_PLASTIC, /* material/plastic.h */
+  BSDF_PRINCIPLED /* material/principled.h */
 } bsdf_type;
 
 typedef struct bsdf {
@@ -29,6 +30,7 @@ typedef struct bsdf {
   int nonlinear;      /* plastics: material.nonlinear */
   float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */
   float coat_ri, coat_t[PLASTIC_RES]; /* plastics: the material's coat tables */
+  float roughness, spec_tint, sheen, sheen_tint, flatness, clearcoat, cc_alpha; /* BSDF_PRINCIPLED (kd, metallic, alpha, eta too) */
 } bsdf;
 
 typedef struct bsdf_sample {
