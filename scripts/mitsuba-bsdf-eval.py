@@ -36,7 +36,13 @@ PRINCIPLED = [
     ('sheen-flat', dict(type='principled', base_color=rgb([0.7, 0.4, 0.6]), sheen=0.8, sheen_tint=0.5, flatness=0.6, roughness=0.7)),
     ('clearcoat', dict(type='principled', base_color=rgb([0.2, 0.5, 0.7]), clearcoat=1.0, clearcoat_gloss=0.7, roughness=0.5)),
     ('eta-1.8', dict(type='principled', base_color=rgb([0.3, 0.3, 0.3]), eta=1.8, roughness=0.15)),
+    ('glass-0.3', dict(type='principled', base_color=rgb([0.9, 0.95, 1.0]), spec_trans=1.0, roughness=0.3)),
+    ('half-trans', dict(type='principled', base_color=rgb([0.8, 0.5, 0.3]), spec_trans=0.5, metallic=0.2, roughness=0.5, eta=1.33,
+                        clearcoat=0.5)),
 ]
+# for the transmissive cases, also light below the surface and the viewer inside
+DIRS_T = [(30, 0, 150, 180), (10, 0, 170, 0), (60, 0, 130, 200), (45, 0, 100, 180), (140, 0, 150, 180), (150, 0, 40, 180),
+          (120, 0, 60, 0), (170, 0, 30, 170), (100, 0, 20, 180), (160, 0, 120, 30)]
 DIRS = [(10, 0, 40, 180), (30, 0, 30, 170), (60, 0, 20, 150), (45, 0, 45, 180), (75, 0, 70, 160), (20, 0, 80, 30),
         (5, 0, 5, 90), (50, 0, 52, 178), (85, 0, 60, 180), (0, 0, 88, 0)]
 
@@ -52,7 +58,7 @@ print('# Mitsuba %s, scalar_rgb: name theta_wo phi_wo theta_wi phi_wi %s' %
       (mi.__version__, 'specular(rgb) diffuse(rgb)' if plastic else 'f*cos(rgb)'))
 for name, d in (PLASTIC if plastic else PRINCIPLED):
     b = mi.load_dict(d)
-    for (to, po, ti, pi) in DIRS:
+    for (to, po, ti, pi) in DIRS + (DIRS_T if not plastic and 'spec_trans' in d else []):
         si = mi.SurfaceInteraction3f()
         si.wi = unit(to, po)
         si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))

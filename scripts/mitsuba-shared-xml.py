@@ -30,7 +30,8 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's blendbsdf: a number, the default and a ramp bitmap as weights (valo's blend)
           "blend": ("@tests/data/mitsuba-xml/blend.xml", {"resx": "128", "resy": "96"}),
           # Mitsuba's principled BSDF (valo's principled)
-          "principled": ("@tests/data/mitsuba-xml/principled.xml", {"resx": "160", "resy": "96"})}
+          "principled": ("@tests/data/mitsuba-xml/principled.xml", {"resx": "160", "resy": "96"}),
+          "principled-glass": ("@tests/data/mitsuba-xml/principled-glass.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

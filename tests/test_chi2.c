@@ -193,9 +193,10 @@ static int plastic(void) {
   return rc;
 }
 
-/* Mitsuba's principled: its four lobes' mixture sampled (cosine, GGX visible normals,
- * GTR1 normals) against the pdf it reports, chi-square; at several roughnesses, metallic
- * weights, a clearcoat and a sheen, grazing and not. */
+/* Mitsuba's principled: its lobes' mixture sampled (cosine, GGX visible normals reflected
+ * or refracted, GTR1 normals) against the pdf it reports, chi-square; at several
+ * roughnesses, metallic weights, a clearcoat and a sheen, grazing and not; transmissive
+ * from outside and inside. */
 static int principled(void) {
   struct { float rough, metal, cc, gloss, sheen, th; } cfg[6] = {{0.5f, 0, 0, 0, 0, 30},     {0.2f, 1, 0, 0, 0, 60},
                                                                  {0.6f, 0.5f, 1, 0.7f, 0, 45}, {0.3f, 0, 1, 0.2f, 0.8f, 75},
@@ -210,6 +211,18 @@ static int principled(void) {
     snprintf(name, sizeof name, "principled roughness %.2f metallic %.1f clearcoat %.1f (gloss %.1f) sheen %.1f", cfg[i].rough, cfg[i].metal,
              cfg[i].cc, cfg[i].gloss, cfg[i].sheen);
     rc |= test_bsdf(name, m, cfg[i].th);
+  }
+  /* with its transmission lobe: from outside and from inside */
+  struct { float trans, rough, th; int inside; } tc[4] = {{1, 0.3f, 30, 0}, {0.5f, 0.6f, 60, 0}, {1, 0.3f, 40, 1}, {0.5f, 0.5f, 20, 1}};
+  for (int i = 0; i < 4; i++) {
+    material m = material_default();
+    m.type = MAT_PRINCIPLED; m.ior = 1.5f; m.kd = c3(0.8f, 0.6f, 0.4f); m.spec_trans = tc[i].trans; m.roughness = tc[i].rough;
+    m.clearcoat = 0.5f; m.clearcoat_gloss = 0.5f;
+    float t = tc[i].th * (float)M_PI / 180;
+    char name[128];
+    snprintf(name, sizeof name, "principled spec_trans %.1f roughness %.1f, theta_o %.0f, %s", tc[i].trans, tc[i].rough, tc[i].th,
+             tc[i].inside ? "inside" : "outside");
+    rc |= test_bsdf_wo(name, m, v3(sinf(t), 0, tc[i].inside ? -cosf(t) : cosf(t)));
   }
   return rc;
 }

@@ -240,24 +240,23 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     cJSON_AddBoolToObject(m, "nonlinear", nonlinear);
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
   } else if (!strcmp(type, "principled")) {
-    /* valo's principled: Mitsuba's reflection lobes; transmission and anisotropy not modelled */
+    /* valo's principled: Mitsuba's lobes; anisotropy not modelled */
     TYPE("principled");
     TRY(set_color(c, b, "base_color", m, "base_color", 0));
-    static const char *const keys[] = {"metallic", "roughness", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "specular"};
-    for (int k = 0; k < 9; k++) {
+    static const char *const keys[] = {"metallic", "roughness", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "specular",
+                                       "spec_trans"};
+    for (int k = 0; k < 10; k++) {
       double x = -1;
       TRY(mi_float(c, b, keys[k], &x));
       if (x != -1) cJSON_AddNumberToObject(m, keys[k], x);
     }
-    double eta = 0, st = 0, an = 0;
+    double eta = 0, an = 0;
     TRY(mi_float(c, b, "eta", &eta));
     if (eta > 0) {
       if (cJSON_GetObjectItemCaseSensitive(m, "specular")) return mi_bad(c, b, "give eta or specular, not both (as Mitsuba asks)");
       cJSON_AddNumberToObject(m, "ior", eta);
     }
-    TRY(mi_float(c, b, "spec_trans", &st));
     TRY(mi_float(c, b, "anisotropic", &an));
-    if (st != 0) mi_warn(c, b, "spec_trans is not read: valo's principled has no transmission lobe");
     if (an != 0) mi_warn(c, b, "anisotropic is not read: valo's principled is isotropic");
     double rate;
     static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate", "diffuse_reflectance_sampling_rate"};

@@ -39,7 +39,7 @@ bsdf bsdf_from_material(const material *m) {
     b.roughness = clampf(m->roughness, 0, 1);
     b.alpha = fmaxf(1e-3f, b.roughness * b.roughness);
     b.spec_tint = m->spec_tint; b.sheen = m->sheen; b.sheen_tint = m->sheen_tint;
-    b.flatness = m->flatness; b.clearcoat = m->clearcoat;
+    b.flatness = m->flatness; b.clearcoat = m->clearcoat; b.spec_trans = clampf(m->spec_trans, 0, 1);
     b.cc_alpha = 0.1f + (0.001f - 0.1f) * clampf(m->clearcoat_gloss, 0, 1);
     return b;
   case MAT_PHONG: b.type = BSDF_PHONG; b.p_first = lobe_prob(m->kd, m->ks); break;
@@ -168,6 +168,7 @@ static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
 
 rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_eval(b, wo, wi);
+  if (b->type == BSDF_PRINCIPLED) return principled_eval(b, wo, wi); /* it may transmit */
   if (wo.z <= 0 || wi.z <= 0) return c3(0, 0, 0);
   switch (b->type) {
   case BSDF_DIFFUSE: return c3_scale(b->kd, INV_PI_F);
@@ -193,6 +194,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
 
 float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_pdf(b, wo, wi);
+  if (b->type == BSDF_PRINCIPLED) return principled_pdf(b, wo, wi);
   if (wo.z <= 0 || wi.z <= 0) return 0;
   switch (b->type) {
   case BSDF_DIFFUSE: return cosine_hemisphere_pdf(wi.z);

@@ -30,7 +30,7 @@ typedef struct bsdf {
   int nonlinear;      /* plastics: material.nonlinear */
   float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */
   float coat_ri, coat_t[PLASTIC_RES]; /* plastics: the material's coat tables */
-  float roughness, spec_tint, sheen, sheen_tint, flatness, clearcoat, cc_alpha; /* BSDF_PRINCIPLED (kd, metallic, alpha, eta too) */
+  float roughness, spec_tint, sheen, sheen_tint, flatness, clearcoat, cc_alpha, spec_trans; /* BSDF_PRINCIPLED (kd, metallic, alpha, eta too) */
 } bsdf;
 
 typedef struct bsdf_sample {
@@ -57,6 +57,7 @@ int bsdf_has_smooth(const bsdf *b);
 rgb material_albedo(const material *m, float cos_o);
 /* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
 static inline int bsdf_transmits(const bsdf *b) {
-  return b->type == BSDF_DIELECTRIC || b->type == BSDF_ROUGH_DIELECTRIC || b->type == BSDF_THIN_DIELECTRIC;
+  return b->type == BSDF_DIELECTRIC || b->type == BSDF_ROUGH_DIELECTRIC || b->type == BSDF_THIN_DIELECTRIC ||
+         (b->type == BSDF_PRINCIPLED && b->spec_trans > 0);
 }
 #endif

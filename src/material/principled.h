@@ -1,5 +1,5 @@
 /* principled.h — owns Mitsuba 3's `principled` BSDF in valo's terms (Burley's Disney
- * BRDF as Mitsuba defines it), its reflection lobes: with v the viewer (valo's wo), l the
+ * BSDF as Mitsuba defines it): with v the viewer (valo's wo), l the
  * light (wi), h = normalize(v + l), base colour c, metallic m, spec_tint st and
  *   specular:  F(v.h) D(h) G1(v) G1(l) / (4 cos_v cos_l), GGX of alpha = max(1e-3,
  *              roughness^2), separable Smith G1, F = (1 - m)(1 - st) F_dielectric(eta)
@@ -11,11 +11,17 @@
  *   sheen:     sheen (1 - m) (1 - h.l)^5 lerp(1, c / lum(c), sheen_tint) (no 1/pi, as
  *              Mitsuba's), where the diffuse lobe is;
  *   clearcoat: clearcoat / 4 Schlick(0.04) D_GTR1(h) G1(v) G1(l) of alpha 0.25 (no
- *              1 / (4 cos_v cos_l), as Mitsuba's), GTR1 of alpha lerp(0.1, 0.001, gloss).
+ *              1 / (4 cos_v cos_l), as Mitsuba's), GTR1 of alpha lerp(0.1, 0.001, gloss);
+ *   transmission (weight t = spec_trans): sqrt(c) (1 - m) t times a rough dielectric's
+ *              BTDF (radiance; the same D and separable G); the opaque lobes above are
+ *              weighted by (1 - t) (diffuse) and seen from outside only; from inside the
+ *              surface is a rough dielectric of reflectance (1 - m) t F.
  * eta is the interior / exterior index (JSON "ior"; Mitsuba's `specular` s gives
- * eta = 2 / (1 - sqrt(0.08 s)) - 1). Mitsuba's spec_trans and anisotropic lobes are not
- * modelled. Sampling: a cosine-weighted direction, GGX visible normals or GTR1 normals
- * with probabilities in proportion to (1 - m), 1 and clearcoat / 4, as Mitsuba's. */
+ * eta = 2 / (1 - sqrt(0.08 s)) - 1). Mitsuba's anisotropic lobes are not modelled.
+ * Sampling, as Mitsuba's: a cosine-weighted direction, GTR1 normals or GGX visible
+ * normals with probabilities in proportion to (1 - m)(1 - t), clearcoat / 4 and 1; a
+ * visible normal of Fresnel term F reflects with probability 1 - (1 - m) t (1 - F), else
+ * refracts (from inside: F and 1 - F). */
 #ifndef VALO_PRINCIPLED_H
 #define VALO_PRINCIPLED_H
 #include "material/bsdf.h"

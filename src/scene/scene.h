@@ -20,8 +20,8 @@ typedef enum mat_type {
   MAT_THIN_DIELECTRIC, /* a thin pane of glass, index ior: reflects as both faces do, transmits without bending */
   MAT_PLASTIC,     /* diffuse kd under a dielectric coat of index ior, specular tint ks, smooth or rough
                       (Mitsuba's plastic / roughplastic; material/plastic.h) */
-  MAT_PRINCIPLED,  /* Mitsuba's principled (Disney) BSDF's reflection lobes: base colour kd, metallic,
-                      roughness, ior, and the fields below (material/principled.h) */
+  MAT_PRINCIPLED,  /* Mitsuba's principled (Disney) BSDF: base colour kd, metallic, roughness, ior,
+                      and the fields below (material/principled.h) */
   MAT_BLEND        /* blend[1] with probability weight (times tex_weight), else blend[0], chosen per
                       hit (Mitsuba's blendbsdf; isect_from_hit resolves it) */
 } mat_type;
@@ -58,7 +58,7 @@ typedef struct material {
   float opacity;     /* a hit counts with probability opacity (times tex_alpha's value when
                         alpha_stochastic): 1 = opaque, the default */
   int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
-  float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss; /* MAT_PRINCIPLED */
+  float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, spec_trans; /* MAT_PRINCIPLED */
   int blend[2];      /* MAT_BLEND: the two materials' indices */
   float weight;      /* MAT_BLEND: blend[1]'s share */
   int tex_weight;    /* MAT_BLEND: a map multiplying weight (its first channel), -1 = none */
