@@ -47,13 +47,19 @@ static int run_reference(const char *obj_rel, const char *ref_rel, int spp, int 
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   for (int c = 0; c < 3; c++) CHECK(cr.mean_err[c] < 0.01, "channel %d mean differs by %.3f%%", c, 100 * cr.mean_err[c]);
-  CHECK(cr.lit_blocks > 50, "only %d lit blocks", cr.lit_blocks);
+  int nblocks = 3 * (256 / block) * (256 / block); /* block-channels, as compare_images counts them */
+  CHECK(4 * cr.lit_blocks > 3 * nblocks, "only %d of %d block-channels lit", cr.lit_blocks, nblocks);
   CHECK(cr.worst_block < 0.03, "block (%d,%d) differs by %.2f%%", cr.worst_bx, cr.worst_by, 100 * cr.worst_block);
   return 0;
 }
 
 static int cornell_original(void) { return run_reference("scenes/cornell/CornellBox-Original.obj", "references/cornell-original.exr", 512, 16); }
-static int cornell_mirror(void) { return run_reference("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", 2048, 32); }
+/* The mirror sphere's caustic is the noisiest part: 32x32 blocks need 2048 spp to stay
+ * within 3 % (1.26 %; at 1024 spp one reached 3.10 %), the full form; by default 1024 spp
+ * and 64x64 blocks, whose noise is that of 32x32 ones at 4096. */
+static int cornell_mirror(void) {
+  return run_reference("scenes/cornell/CornellBox-Mirror.obj", "references/cornell-mirror.exr", test_full() ? 2048 : 1024, test_full() ? 32 : 64);
+}
 
 /* veach-mis against the Tungsten render beside it: with its own camera, the
  * four rough plates must show the lights' highlights where Tungsten does. For each plate,
