@@ -13,24 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
- * then multiplies 1. */
-/* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
-static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
-  const char *file = NULL;
-  valo_status st = json_get_str(c, o, key, where, &file);
-  if (st || !file) return st;
-  char full[2048];
-  json_resolve_path(c, file, full, sizeof full);
-  valo_error terr;
-  *tex = scene_texture_file(c->s, full, 0, &terr);
-  if (*tex >= 0) return VALO_OK;
-  char w[300], msg[sizeof terr.message + 200];
-  snprintf(w, sizeof w, "%s.%s", where, key);
-  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
-  return json_bad(c, w, msg);
-}
-
 /* The map file named by string v, 8-bit decoded from sRGB unless raw (as Mitsuba's and
  * pbrt's bitmaps are), as *tex; w: "where.key" for errors. */
 static valo_status get_float_map(jctx *c, const cJSON *v, int raw, const char *w, const char *what, int *tex) {
@@ -39,9 +21,19 @@ static valo_status get_float_map(jctx *c, const cJSON *v, int raw, const char *w
   valo_error terr;
   *tex = scene_texture_file(c->s, full, !raw, &terr);
   if (*tex >= 0) return VALO_OK;
-  char msg[sizeof terr.message + 40];
+  char msg[sizeof terr.message + 80];
   snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
   return json_bad(c, w, msg);
+}
+
+/* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
+static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
+  const char *file = NULL;
+  valo_status st = json_get_str(c, o, key, where, &file);
+  if (st || !file) return st;
+  char w[300];
+  snprintf(w, sizeof w, "%s.%s", where, key);
+  return get_float_map(c, cJSON_GetObjectItemCaseSensitive(o, key), 1, w, what, tex);
 }
 
 /* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
@@ -66,6 +58,8 @@ static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, mater
   return VALO_OK;
 }
 
+/* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
+ * then multiplies 1. */
 static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (v && cJSON_IsString(v)) {
