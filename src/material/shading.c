@@ -48,7 +48,7 @@ static const material *blend_pick(const scene *s, const ray *r, const isect *it)
       w *= px[0];
     }
     key = rng_mix64(key + 0x9E3779B97F4A7C15ull);
-    m = &s->mats[m->blend[(float)(key >> 40) * 0x1p-24f < w]];
+    m = &s->mats[m->blend[rng_to_float((uint32_t)(key >> 32)) < w]];
   }
   return m;
 }

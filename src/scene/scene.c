@@ -196,7 +196,7 @@ int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t ke
   if (a >= 1) return 1;
   if (!(a > 0)) return 0;
   uint64_t h = rng_mix64(key ^ ((uint64_t)t * 0xD1B54A32D192ED03ull + 0x632BE59BD9B4E019ull));
-  return (float)(h >> 40) * 0x1p-24f < a;
+  return rng_to_float((uint32_t)(h >> 32)) < a;
 }
 
 /* Per-vertex tangents: the file's where it gave them (glTF TANGENT), else from UV
