@@ -13,6 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A 10 x 10 floor at y = 0, facing up (its own OBJ). */
+#define FLOOR_OBJ "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"
+
 static float srgb_dec(int b) { float c = b / 255.0f; return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
 
 static int helmet_texels(const char *rel) {
@@ -106,7 +109,7 @@ static double cutout_mean(const char *accel, int alpha, int with_quad) {
            "mtllib leaf%d.mtl\nv -1 1 -1\nv 1 1 -1\nv 1 1 1\nv -1 1 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl leaf\nf 1/1 2/2 3/3 4/4\n", alpha);
   snprintf(name, sizeof name, "leaf%d.obj", alpha);
   scratch_file(name, obj);
-  scratch_file("floor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n");
+  scratch_file("floor.obj", FLOOR_OBJ);
   char json[1024];
   snprintf(json, sizeof json,
            "{ \"camera\": {\"position\": [0,4,0.01], \"look_at\": [0,0,0], \"fov\": 30},\n"
@@ -537,23 +540,31 @@ static int uv_orientation(void) {
   return 0;
 }
 
+/* A 4 x 4 red PNG of alpha 128/255, written to the scratch folder as name and read back
+ * into png (at most cap bytes); its length, 0 on failure. */
+static size_t red_half_alpha_png(const char *name, unsigned char *png, size_t cap) {
+  unsigned char rgba[4 * 4 * 4];
+  for (int i = 0; i < 16; i++) { rgba[4 * i] = 220; rgba[4 * i + 1] = 30; rgba[4 * i + 2] = 30; rgba[4 * i + 3] = 128; }
+  char pngp[1200];
+  snprintf(pngp, sizeof pngp, "%s/%s", scratch_dir(), name);
+  if (!stbi_write_png(pngp, 4, 4, 4, rgba, 16)) return 0;
+  FILE *f = fopen(pngp, "rb");
+  if (!f) return 0;
+  size_t n = fread(png, 1, cap, f);
+  fclose(f);
+  return n;
+}
+
 /* Alpha cutoff: a glTF quad whose base colour has alpha 128/255 = 0.502,
  * alphaMode MASK at cutoffs 0.25, 0.49 (opaque) and 0.51, 0.75 (cut out), 1 unit above a
  * floor under a point light. Camera rays: from above, the centre shows the quad (red) or
  * the floor (grey). Shadow rays: from below the quad's plane, the floor under it is dark
  * or lit. Both on the kd-tree and on Embree. */
 static int alpha_cutoff(void) {
-  unsigned char rgba[4 * 4 * 4];
-  for (int i = 0; i < 16; i++) { rgba[4 * i] = 220; rgba[4 * i + 1] = 30; rgba[4 * i + 2] = 30; rgba[4 * i + 3] = 128; }
-  char pngp[1200];
-  snprintf(pngp, sizeof pngp, "%s/alpha-half.png", scratch_dir());
-  CHECK(stbi_write_png(pngp, 4, 4, 4, rgba, 16), "png");
   unsigned char png[4096];
-  FILE *f = fopen(pngp, "rb");
-  CHECK(f, "png");
-  size_t png_n = fread(png, 1, sizeof png, f);
-  fclose(f);
-  CHECK(scratch_file("afloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  size_t png_n = red_half_alpha_png("alpha-half.png", png, sizeof png);
+  CHECK(png_n > 0, "png");
+  CHECK(scratch_file("afloor.obj", FLOOR_OBJ), "write");
   const double cut[4] = {0.25, 0.49, 0.51, 0.75};
   const char *accels[2] = {"kdtree", "embree"};
   for (int k = 0; k < 4; k++) {
@@ -601,7 +612,7 @@ static int alpha_cutoff(void) {
  * camera under the veil: the left half has 0.6 of the mirrored right half's light. Both
  * backends; the two must agree within noise. */
 static int opacity_stochastic(void) {
-  CHECK(scratch_file("ofloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("ofloor.obj", FLOOR_OBJ), "write");
   CHECK(scratch_file("oleft1.obj", "v -5 1 -5\nv -5 1 5\nv 0 1 5\nv 0 1 -5\nf 1 2 3 4\n"), "write");
   CHECK(scratch_file("oright1.obj", "v 0 1 -5\nv 0 1 5\nv 5 1 5\nv 5 1 -5\nf 1 2 3 4\n"), "write");
   CHECK(scratch_file("oright2.obj", "v 0 2 -5\nv 0 2 5\nv 5 2 5\nv 5 2 -5\nf 1 2 3 4\n"), "write");
@@ -663,17 +674,10 @@ static int opacity_stochastic(void) {
  * alone, (1 - a) once for the camera ray through the quad and once for the floor's shadow
  * ray through it. */
 static int gltf_blend(void) {
-  unsigned char rgba[4 * 4 * 4];
-  for (int i = 0; i < 16; i++) { rgba[4 * i] = 220; rgba[4 * i + 1] = 30; rgba[4 * i + 2] = 30; rgba[4 * i + 3] = 128; }
-  char pngp[1200];
-  snprintf(pngp, sizeof pngp, "%s/quad-texture.png", scratch_dir());
-  CHECK(stbi_write_png(pngp, 4, 4, 4, rgba, 16), "png");
   unsigned char png[4096];
-  FILE *f = fopen(pngp, "rb");
-  CHECK(f, "png");
-  size_t png_n = fread(png, 1, sizeof png, f);
-  fclose(f);
-  CHECK(scratch_file("bfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  size_t png_n = red_half_alpha_png("quad-texture.png", png, sizeof png);
+  CHECK(png_n > 0, "png");
+  CHECK(scratch_file("bfloor.obj", FLOOR_OBJ), "write");
   CHECK(write_gltf_quad("blend.glb", png, png_n, ", \"alphaMode\": \"BLEND\"", 1) == 0, "write glb");
   CHECK(write_gltf_quad("opaque.glb", png, png_n, ", \"alphaMode\": \"MASK\", \"alphaCutoff\": 0.25", 1) == 0, "write glb");
   const char *quads[3] = {"blend.glb", "opaque.glb", NULL};
@@ -711,7 +715,7 @@ static int gltf_blend(void) {
  * a floor, direct light: the means agree within noise); the file's mistakes are refused
  * with the key and the reason. */
 static int blend_mixes(void) {
-  CHECK(scratch_file("mfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"), "write");
+  CHECK(scratch_file("mfloor.obj", FLOOR_OBJ), "write");
   const char *mats[2] = {"\"a\": {\"type\": \"diffuse\", \"reflectance\": 0.2}, \"b\": {\"type\": \"diffuse\", \"reflectance\": 0.8},"
                          " \"f\": {\"type\": \"blend\", \"weight\": 0.25, \"materials\": [\"a\", \"b\"]}",
                          "\"f\": {\"type\": \"diffuse\", \"reflectance\": 0.35}"};

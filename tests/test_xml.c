@@ -304,6 +304,19 @@ static int unit_shapes(void) {
   return 0;
 }
 
+/* The Mitsuba scene file at path, loaded (not committed); NULL, the reason printed, when
+ * it does not load. */
+static scene *mitsuba_scene(const char *path) {
+  scene *s = scene_new(path);
+  valo_error err;
+  valo_options set;
+  valo_options_init(&set);
+  if (load_mitsuba(s, path, NULL, &set, &err) == VALO_OK) return s;
+  fprintf(stderr, "%s\n", err.message);
+  scene_free(s);
+  return NULL;
+}
+
 /* A mesh's v as Mitsuba reads it: an OBJ's turned over (flip_tex_coords, default true),
  * which is valo's own reading; a PLY's as it stands, running down the image, so valo turns
  * it up; an OBJ with flip_tex_coords false likewise. Checked at the quads' corner (-1, -1),
@@ -325,11 +338,8 @@ static int mesh_v_as_mitsuba(void) {
            "<transform name=\"to_world\"><translate x=\"20\"/></transform></shape>\n</scene>\n",
            ply, obj, obj);
   const char *path = scratch_file("mesh-uv.xml", xml);
-  scene *s = scene_new(path);
-  valo_error err;
-  valo_options set;
-  valo_options_init(&set);
-  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  scene *s = mitsuba_scene(path);
+  CHECK(s, "the scene does not load");
   const float want[3] = {1, 0, 1}; /* valo's v at the corner: the PLY, the OBJ, the OBJ not flipped */
   int found[3] = {0, 0, 0};
   for (uint32_t v = 0; v < s->nverts; v++) {
@@ -357,11 +367,8 @@ static int one_line_materials(void) {
                     "<shape type=\"sphere\"><point name=\"center\" value=\"9 0 0\"/><emitter type=\"area\"><rgb name=\"radiance\" value=\"5\"/></emitter></shape>"
                     "</scene>\n";
   const char *path = scratch_file("one-line.xml", xml);
-  scene *s = scene_new(path);
-  valo_error err;
-  valo_options set;
-  valo_options_init(&set);
-  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  scene *s = mitsuba_scene(path);
+  CHECK(s, "the scene does not load");
   uint32_t per = s->ntris / 4;
   CHECK(per > 0 && s->ntris == 4 * per, "%u triangles", s->ntris);
   const material *m[4];
@@ -390,11 +397,8 @@ static int mask_opacity(void) {
            "</texture><bsdf type=\"diffuse\"/></bsdf></shape>\n</scene>\n",
            ramp, ramp);
   const char *path = scratch_file("mask-opacity.xml", xml);
-  scene *s = scene_new(path);
-  valo_error err;
-  valo_options set;
-  valo_options_init(&set);
-  CHECK(load_mitsuba(s, path, NULL, &set, &err) == VALO_OK, "%s", err.message);
+  scene *s = mitsuba_scene(path);
+  CHECK(s, "the scene does not load");
   CHECK(s->ntris == 8, "%u triangles", s->ntris);
   const material *m[4];
   for (int k = 0; k < 4; k++) m[k] = &s->mats[s->tri_mat[2 * k]];
@@ -406,6 +410,7 @@ static int mask_opacity(void) {
     float x = s->tex[m[k]->tex_alpha].px[4 * 32], want = k == 2 ? 130 / 255.0f : 0.2232f;
     CHECK(fabsf(x - want) < 1e-3f, "bitmap mask %s: texel 32 reads %g, not %g", k == 2 ? "raw" : "decoded", x, want);
   }
+  valo_error err;
   CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
   for (uint32_t t = 0; t < 8; t++) CHECK(s->tri_flags[t] & TRI_ALPHA, "triangle %u is not alpha-tested", t);
   scene_free(s);
