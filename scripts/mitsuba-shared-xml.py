@@ -31,7 +31,11 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           "blend": ("@tests/data/mitsuba-xml/blend.xml", {"resx": "128", "resy": "96"}),
           # Mitsuba's principled BSDF (valo's principled)
           "principled": ("@tests/data/mitsuba-xml/principled.xml", {"resx": "160", "resy": "96"}),
-          "principled-glass": ("@tests/data/mitsuba-xml/principled-glass.xml", {"resx": "160", "resy": "96"})}
+          "principled-glass": ("@tests/data/mitsuba-xml/principled-glass.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's checkerboard and bitmap lookups: to_uv, filter_type, wrap_mode, raw
+          "textures": ("@tests/data/mitsuba-xml/textures.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's roughness and metallic textures (valo's roughness_map and metallic_map)
+          "roughness": ("@tests/data/mitsuba-xml/roughness.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -189,7 +189,8 @@ static int from_xml(void) {
  * Mitsuba's render of the same file, tests/data/mitsuba-xml/NAME-mitsuba.exr
  * (scripts/mitsuba-shared-xml.py): means within 1 %, every lit 32x32 block within
  * `block` (relative). */
-static int against_mitsuba_xml(const char *name, const char *path, const char *defines, int spp, double block) {
+/* against_mitsuba_xml with blocks of bs x bs pixels. */
+static int against_mitsuba_xml_blocks(const char *name, const char *path, const char *defines, int spp, int bs, double block) {
   valo_load_options lo;
   valo_load_options_init(&lo);
   snprintf(lo.defines, sizeof lo.defines, "%s", defines);
@@ -212,9 +213,9 @@ static int against_mitsuba_xml(const char *name, const char *path, const char *d
   CHECK(image_read(ref_path, &ref, &err) == VALO_OK, "%s", err.message);
   CHECK(ref.w == st.width && ref.h == st.height, "reference %dx%d, render %dx%d", ref.w, ref.h, st.width, st.height);
   cmp_result cr;
-  compare_images(img, ref.rgb, ref.w, ref.h, 32, &cr);
-  fprintf(stderr, "%s at %d spp (%.1f s): mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit 32x32 blocks %.2f%% at (%d,%d)\n", name, o.spp,
-          st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2], cr.lit_blocks, 100 * cr.worst_block, cr.worst_bx,
+  compare_images(img, ref.rgb, ref.w, ref.h, bs, &cr);
+  fprintf(stderr, "%s at %d spp (%.1f s): mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit %dx%d blocks %.2f%% at (%d,%d)\n", name, o.spp,
+          st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2], cr.lit_blocks, bs, bs, 100 * cr.worst_block, cr.worst_bx,
           cr.worst_by);
   free(img);
   image_free(&ref);
@@ -223,6 +224,10 @@ static int against_mitsuba_xml(const char *name, const char *path, const char *d
   for (int c = 0; c < 3; c++) CHECK(cr.mean_err[c] < 0.01, "channel %d mean differs by %.2f%%", c, 100 * cr.mean_err[c]);
   CHECK(cr.worst_block < block, "block (%d,%d) differs by %.2f%%", cr.worst_bx, cr.worst_by, 100 * cr.worst_block);
   return 0;
+}
+
+static int against_mitsuba_xml(const char *name, const char *path, const char *defines, int spp, double block) {
+  return against_mitsuba_xml_blocks(name, path, defines, spp, 32, block);
 }
 
 static int veach_mis_xml(void) {
@@ -280,6 +285,20 @@ static int principled_xml(void) {
   return rc | against_mitsuba_xml("principled-glass", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/principled-glass.xml", "resx=160 resy=96", 256, 0.03);
 }
 
+/* Mitsuba's texture lookups (tests/data/mitsuba-xml/textures.xml): a checkerboard under a
+ * scaling, turning, moving to_uv, a bitmap looked up nearest, clamped and raw, and
+ * bilinearly and mirrored, and a checkerboard on a sphere. */
+static int textures_xml(void) {
+  return against_mitsuba_xml_blocks("textures", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/textures.xml", "resx=160 resy=96", 256, 8, 0.06);
+}
+
+/* Mitsuba's roughness and metallic textures (tests/data/mitsuba-xml/roughness.xml): alpha
+ * bitmaps on a rough conductor and a rough dielectric, decoded and raw, and principled's
+ * roughness and metallic bitmaps. */
+static int roughness_xml(void) {
+  return against_mitsuba_xml_blocks("roughness", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/roughness.xml", "resx=160 resy=96", 256, 16, 0.06);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -293,6 +312,7 @@ static int plastic_case(const char *name, material *m) {
   m->ks = c3(1, 1, 1);
   m->kd = c3(0.6f, 0.3f, 0.1f);
   m->beckmann = 1;
+  m->smith_separable = 1; /* as the Mitsuba reader sets it */
   if (!strcmp(name, "smooth")) {
   } else if (!strcmp(name, "smooth-nonlinear-1.9")) {
     m->nonlinear = 1; m->ior = (float)(1.9 / 1.000277);
@@ -317,8 +337,9 @@ static vec3 unit_deg(double t, double p) {
 /* Mitsuba's plastic and roughplastic evaluated by Mitsuba itself
  * (tests/data/mitsuba-bsdf/plastic-eval.txt, scripts/mitsuba-bsdf-eval.py plastic) against
  * valo's, the diffuse and the specular component apart, at 50 pairs of directions: the
- * diffuse within 0.6 % (the coat's tables, integrated by each), the specular within 4 %
- * (valo's Smith G is height-correlated, Mitsuba's separable: 3.5 % apart at 85 degrees). */
+ * diffuse within 0.6 % (the coat's tables, integrated by each), the specular within 1 %
+ * (with Mitsuba's separable Smith G, as the reader sets it; the height-correlated G was
+ * 3.5 % apart at 85 degrees). */
 static int plastic_against_mitsuba(void) {
   FILE *f = fopen(VALO_SOURCE_DIR "/tests/data/mitsuba-bsdf/plastic-eval.txt", "r");
   CHECK(f, "cannot open the table");
@@ -344,7 +365,7 @@ static int plastic_against_mitsuba(void) {
       double ed = fabs(vd[k] - md[k]) / fmax(md[k], 1e-3), es = fabs(vs[k] - ms[k]) / fmax(ms[k], 1e-2);
       worst_d = fmax(worst_d, ed);
       worst_s = fmax(worst_s, es);
-      if (ed > 0.006 || es > 0.04) {
+      if (ed > 0.006 || es > 0.01) {
         fprintf(stderr, "%s wo %g/%g wi %g/%g channel %d: diffuse %.6g (Mitsuba %.6g), specular %.6g (Mitsuba %.6g)\n", name, to, po, ti,
                 pi, k, vd[k], md[k], vs[k], ms[k]);
         rc = 1;
@@ -426,6 +447,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -124,7 +124,24 @@ valo_status texture_load_file_as(texture *t, const char *path, int srgb, const c
   return from_8bit(t, img, w, h, n, srgb, path, err);
 }
 
-void texture_free(texture *t) { free(t->px); t->px = NULL; }
+valo_status texture_checkerboard(texture *t, const float c0[3], const float c1[3], valo_error *err) {
+  memset(t, 0, sizeof *t);
+  t->px = malloc(16 * sizeof(float));
+  if (!t->px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  for (int i = 0; i < 4; i++) {
+    const float *c = (i == 0 || i == 3) ? c0 : c1;
+    for (int k = 0; k < 3; k++) t->px[4 * i + k] = c[k];
+    t->px[4 * i + 3] = 1;
+  }
+  t->w = t->h = 2;
+  t->filter = TEX_NEAREST;
+  return VALO_OK;
+}
+
+void texture_free(texture *t) {
+  if (!t->shares_px) free(t->px);
+  t->px = NULL;
+}
 
 static int wrap_coord(int i, int n, tex_wrap m) {
   switch (m) {
@@ -148,7 +165,18 @@ void texture_texel(const texture *t, int x, int y, float out[4]) {
 }
 
 void texture_lookup(const texture *t, float u, float v, float out[4]) {
+  if (t->has_uvm) {
+    float tu = t->uvm[0] * u + t->uvm[1] * v + t->uvm[2];
+    v = t->uvm[3] * u + t->uvm[4] * v + t->uvm[5];
+    u = tu;
+  }
   if (!isfinite(u) || !isfinite(v)) { u = 0; v = 0; }
+  if (t->filter == TEX_NEAREST) {
+    float fx = floorf(u * t->w), fy = floorf((1 - v) * t->h);
+    if (fabsf(fx) > 1e8f || fabsf(fy) > 1e8f) { fx = 0; fy = 0; }
+    texture_texel(t, (int)fx, (int)fy, out);
+    return;
+  }
   /* Texel centres sit at (x + 0.5)/w; v = 0 is the bottom row. */
   float x = u * t->w - 0.5f, y = (1 - v) * t->h - 0.5f;
   float fx0 = floorf(x), fy0 = floorf(y);

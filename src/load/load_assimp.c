@@ -165,6 +165,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   int wrap = 0;
   const mtl_pbr *pb = oc ? obj_check_pbr(oc, m->name) : NULL;
   if (pb && pb->map_pr[0]) m->tex_rough = texture_in(s, dir, pb->map_pr, 0);
+  m->rough_is_alpha = 1;
   if (pb && pb->map_pm[0]) m->tex_metal = texture_in(s, dir, pb->map_pm, 0);
   m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
   if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);

@@ -26,6 +26,9 @@ valo_status json_get_vec(jctx *c, const cJSON *o, const char *key, const char *w
 valo_status json_get_rgb(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out);
 valo_status json_get_str(jctx *c, const cJSON *o, const char *key, const char *where, const char **out);
 valo_status json_get_bool(jctx *c, const cJSON *o, const char *key, const char *where, int *out);
+/* A texture value v at w ("where.key"): a file name or a texture object (load_json_texture.c);
+ * srgb: decode 8-bit images from sRGB unless the object says "raw"; what names it in errors. */
+valo_status json_get_texture(jctx *c, const cJSON *v, int srgb, const char *w, const char *what, int *tex);
 void json_resolve_path(const jctx *c, const char *rel, char *out, size_t n);
 void json_line_col(const char *text, const char *at, int *line, int *col);
 /* Materials (load_json_material.c): the material object `o` named `name`. */

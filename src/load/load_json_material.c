@@ -13,27 +13,19 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The map file named by string v, 8-bit decoded from sRGB unless raw (as Mitsuba's and
- * pbrt's bitmaps are), as *tex; w: "where.key" for errors. */
+/* The map v (a file name or a texture object), 8-bit decoded from sRGB unless raw (as
+ * Mitsuba's and pbrt's bitmaps are), as *tex; w: "where.key" for errors. */
 static valo_status get_float_map(jctx *c, const cJSON *v, int raw, const char *w, const char *what, int *tex) {
-  char full[2048];
-  json_resolve_path(c, v->valuestring, full, sizeof full);
-  valo_error terr;
-  *tex = scene_texture_file(c->s, full, !raw, &terr);
-  if (*tex >= 0) return VALO_OK;
-  char msg[sizeof terr.message + 80];
-  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
-  return json_bad(c, w, msg);
+  return json_get_texture(c, v, !raw, w, what, tex);
 }
 
 /* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
 static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
-  const char *file = NULL;
-  valo_status st = json_get_str(c, o, key, where, &file);
-  if (st || !file) return st;
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (!v) return VALO_OK;
   char w[300];
   snprintf(w, sizeof w, "%s.%s", where, key);
-  return get_float_map(c, cJSON_GetObjectItemCaseSensitive(o, key), 1, w, what, tex);
+  return get_float_map(c, v, 1, w, what, tex);
 }
 
 /* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
@@ -46,7 +38,7 @@ static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, mater
   char w[300];
   snprintf(w, sizeof w, "%s.opacity", where);
   if (m->tex_alpha >= 0) return json_bad(c, w, "give alpha_map (a cutout) or opacity, not both");
-  if (!cJSON_IsString(v)) {
+  if (!cJSON_IsString(v) && !cJSON_IsObject(v)) {
     double a = 1;
     TRY(json_get_num(c, o, "opacity", where, 0, 1, &a));
     m->opacity = (float)a;
@@ -58,30 +50,14 @@ static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, mater
   return VALO_OK;
 }
 
-/* A colour parameter may be a texture file name (sRGB-decoded colour map); the colour
- * then multiplies 1. */
+/* A colour parameter may be a texture (a file name or a texture object: a colour map,
+ * sRGB-decoded unless it says "raw"); the colour then multiplies 1. */
 static valo_status get_rgb_tex(jctx *c, const cJSON *o, const char *key, const char *where, rgb *out, int *tex) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-  if (v && cJSON_IsString(v)) {
-    char full[2048];
-    json_resolve_path(c, v->valuestring, full, sizeof full);
-    FILE *f = fopen(full, "rb");
-    if (!f) {
-      char w[300];
-      snprintf(w, sizeof w, "%s.%s", where, key);
-      char msg[2200];
-      snprintf(msg, sizeof msg, "cannot open texture %s: %s", full, strerror(errno));
-      return json_bad(c, w, msg);
-    }
-    fclose(f);
-    valo_error terr;
-    *tex = scene_texture_file(c->s, full, 1, &terr);
-    if (*tex < 0) {
-      char w[300], msg[sizeof terr.message + 40];
-      snprintf(w, sizeof w, "%s.%s", where, key);
-      snprintf(msg, sizeof msg, "texture could not be decoded: %s", terr.message);
-      return json_bad(c, w, msg);
-    }
+  if (cJSON_IsString(v) || cJSON_IsObject(v)) {
+    char w[300];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    TRY(json_get_texture(c, v, 1, w, "texture", tex));
     *out = c3(1, 1, 1);
     return VALO_OK;
   }
@@ -168,7 +144,7 @@ static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, mater
   TRY(json_get_bool(c, o, "weight_raw", where, &raw));
   char at[300];
   snprintf(at, sizeof at, "%s.weight", where);
-  if (w && cJSON_IsString(w)) {
+  if (cJSON_IsString(w) || cJSON_IsObject(w)) {
     TRY(get_float_map(c, w, raw, at, "weight map", &m->tex_weight));
     m->weight = 1;
   } else {
@@ -216,18 +192,18 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                          "emission", "two_sided", "bump_map", "bump_scale", NULL};
+                                          "emission", "two_sided", "bump_map", "bump_scale", "smith", NULL};
   static const char *const k_blend[] = {"type", "weight", "weight_raw", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                         "bump_map", "bump_scale", NULL};
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                             "emission", "two_sided", "bump_map", "bump_scale", NULL};
+                                             "emission", "two_sided", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
-                                      "two_sided", "bump_map", "bump_scale", NULL};
+                                      "two_sided", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
     static const char *const k_null[] = {"type", NULL};
@@ -331,10 +307,19 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   double rough = m->roughness;
   TRY(json_get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;
+  /* maps (linear unless they say otherwise) multiplying roughness (or alpha, its square)
+   * and metallic by their value, the mean of their channels */
+  TRY(get_data_map(c, o, "roughness_map", where, "roughness map", &m->tex_rough));
+  TRY(json_get_bool(c, o, "roughness_map_is_alpha", where, &m->rough_is_alpha));
+  TRY(get_data_map(c, o, "metallic_map", where, "metallic map", &m->tex_metal));
   const char *dist = NULL;
   TRY(json_get_str(c, o, "distribution", where, &dist));
   if (dist && strcmp(dist, "ggx") && strcmp(dist, "beckmann")) return json_bad(c, where, "distribution must be \"ggx\" or \"beckmann\"");
   m->beckmann = dist && !strcmp(dist, "beckmann");
+  const char *smith = NULL;
+  TRY(json_get_str(c, o, "smith", where, &smith));
+  if (smith && strcmp(smith, "correlated") && strcmp(smith, "separable")) return json_bad(c, where, "smith must be \"correlated\" or \"separable\"");
+  m->smith_separable = smith && !strcmp(smith, "separable");
   TRY(get_rgb_tex(c, o, "emission", where, &m->emission, &m->tex_ke));
   /* light sampling would see such a light whole, while rays that meet it see it in part */
   if ((m->opacity < 1 || m->alpha_stochastic) && !c3_black(m->emission))

@@ -468,17 +468,13 @@ valo_status mitsuba_to_json(const char *path, const char *defines, const char *o
     free(real);
   }
   /* Every value that names a file: shapes' "file", media's and the environment's "file",
-   * and a material's string values other than its type and named choices. */
-  static const char *const names[] = {"type", "preset", "distribution", "dispersion", NULL};
+   * and a material's texture objects' "file". */
   for (cJSON *sh = c.shapes ? c.shapes->child : NULL; !st && sh; sh = sh->next) st = absolute(cJSON_GetObjectItemCaseSensitive(sh, "file"), dir, err);
   for (cJSON *m = c.media ? c.media->child : NULL; !st && m; m = m->next) st = absolute(cJSON_GetObjectItemCaseSensitive(m, "file"), dir, err);
   if (!st) st = absolute(cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(c.out, "environment"), "file"), dir, err);
   for (cJSON *m = c.materials ? c.materials->child : NULL; !st && m; m = m->next)
-    for (cJSON *k = m->child; !st && k; k = k->next) {
-      int named = 0;
-      for (int i = 0; names[i]; i++) named |= !strcmp(k->string, names[i]);
-      if (!named) st = absolute(k, dir, err);
-    }
+    for (cJSON *k = m->child; !st && k; k = k->next)
+      if (cJSON_IsObject(k)) st = absolute(cJSON_GetObjectItemCaseSensitive(k, "file"), dir, err);
   char *text = st ? NULL : cJSON_Print(c.out);
   if (!st && !text) st = err_set(err, VALO_ERR_NOMEM, "out of memory");
   if (!st) {

@@ -41,14 +41,28 @@ static valo_status ior_prop(mctx *c, xml_node *b, const char *name, double *v) {
 
 static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m) {
   double a = def_alpha, au = -1, av = -1;
-  TRY(mi_float(c, b, "alpha", &a));
+  for (const char *const *n = (const char *const[]){"alpha_u", "alpha_v", NULL}; *n; n++)
+    if (mi_prop(c, b, *n) && !strcmp(mi_prop(c, b, *n)->name, "texture")) return mi_bad(c, b, "valo's microfacets are isotropic: %s cannot be a texture", *n);
+  xml_node *ak = mi_prop(c, b, "alpha");
+  if (ak && !strcmp(ak->name, "texture")) {
+    /* valo's roughness 1 with a map multiplying alpha: alpha = the texture's value */
+    const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
+    if (t && !strcmp(t, "plastic")) return mi_bad(c, ak, "valo's plastic tabulates its coat for one roughness: an alpha texture is not read");
+    cJSON *amap;
+    TRY(mi_color(c, b, "alpha", 0, &amap));
+    cJSON_AddItemToObject(m, "roughness_map", amap);
+    if (!cJSON_AddTrueToObject(m, "roughness_map_is_alpha")) return NOMEM;
+    a = 1;
+  } else {
+    TRY(mi_float(c, b, "alpha", &a));
+  }
   TRY(mi_float(c, b, "alpha_u", &au));
   TRY(mi_float(c, b, "alpha_v", &av));
   if (au >= 0 || av >= 0) {
     if (au != av) return mi_bad(c, b, "valo's microfacets are isotropic: alpha_u and alpha_v must be equal");
+    if (cJSON_GetObjectItemCaseSensitive(m, "roughness_map")) return mi_bad(c, b, "an alpha texture and alpha_u, alpha_v: give one or the other");
     a = au;
   }
-  if (mi_prop(c, b, "alpha") && !strcmp(mi_prop(c, b, "alpha")->name, "texture")) return mi_bad(c, b, "a roughness texture is not read");
   if (!(a >= 0 && a <= 1)) return mi_bad(c, b, "alpha must be in [0, 1]");
   const char *dist = "beckmann";
   TRY(mi_string(c, b, "distribution", &dist));
@@ -56,8 +70,8 @@ static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m
   const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
   if (t && !strcmp(t, "pbr")) {
     if (strcmp(dist, "ggx")) mi_warn(c, b, "rendered with GGX (valo's pbr material): this %s distribution of the same alpha is not", dist);
-  } else if (!cJSON_AddStringToObject(m, "distribution", dist)) {
-    return NOMEM;
+  } else if (!cJSON_AddStringToObject(m, "distribution", dist) || !cJSON_AddStringToObject(m, "smith", "separable")) {
+    return NOMEM; /* Mitsuba's Smith G is the separable one */
   }
   (void)mi_prop(c, b, "sample_visible"); /* the sampling strategy changes the noise, not the image */
   if (!cJSON_AddNumberToObject(m, "roughness", sqrt(a))) return NOMEM; /* valo's alpha = roughness^2 */
@@ -114,7 +128,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
       /* an unnamed texture child: name it for the reader */
       return mi_bad(c, tex, "give the map texture a name (name=\"%s\")", normal ? "normalmap" : "bumpmap");
     }
-    if (!cJSON_IsString(file)) { cJSON_Delete(file); return mi_bad(c, tex, "must be a bitmap texture (a file)"); }
+    if (!cJSON_IsObject(file)) { cJSON_Delete(file); return mi_bad(c, tex, "must be a texture"); }
     double scale = 1;
     valo_status st = VALO_OK;
     if (!normal) st = mi_float(c, b, "scale", &scale);
@@ -124,14 +138,11 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (!normal) cJSON_AddNumberToObject(m, "bump_scale", scale);
   } else if (!strcmp(type, "mask")) {
     /* Mitsuba's mask lets light through with probability 1 - opacity: valo's "opacity",
-     * a number (Mitsuba's default 0.5) or a bitmap, sRGB-decoded unless raw. */
-    xml_node *k = mi_prop(c, b, "opacity");
-    int raw = 0;
-    if (k && !strcmp(k->name, "texture")) TRY(mi_bool(c, k, "raw", &raw));
+     * a number (Mitsuba's default 0.5) or a texture (a bitmap sRGB-decoded unless raw). */
     cJSON *op;
-    TRY(mi_color(c, b, "opacity", MI_RAW, &op));
+    TRY(mi_color(c, b, "opacity", 0, &op));
     if (!op) op = cJSON_CreateNumber(0.5);
-    else if (!cJSON_IsString(op)) {
+    else if (cJSON_IsArray(op)) {
       cJSON *a = cJSON_CreateNumber(cJSON_GetArrayItem(op, 0)->valuedouble);
       cJSON_Delete(op);
       op = a;
@@ -147,15 +158,11 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (inner) cJSON_SetNumberValue(op, op->valuedouble * inner->valuedouble);
     cJSON_DeleteItemFromObject(m, "opacity");
     cJSON_AddItemToObject(m, "opacity", op);
-    if (raw) cJSON_AddTrueToObject(m, "opacity_raw");
   } else if (!strcmp(type, "blendbsdf")) {
     /* valo's blend of the two BSDFs inside, each its own material; weight: the second's
-     * share (a number or a bitmap, sRGB-decoded unless raw) */
+     * share (a number or a texture: a bitmap sRGB-decoded unless raw) */
     xml_node *in[2] = {mi_child(c, b, "bsdf", 0), mi_child(c, b, "bsdf", 1)};
     if (!in[0] || !in[1]) return mi_bad(c, b, "needs two BSDFs inside it");
-    xml_node *k = mi_prop(c, b, "weight");
-    int raw = 0;
-    if (k && !strcmp(k->name, "texture")) TRY(mi_bool(c, k, "raw", &raw));
     cJSON *w, *names = cJSON_AddArrayToObject(m, "materials");
     if (!names) return NOMEM;
     for (int i = 0; i < 2; i++) {
@@ -163,16 +170,15 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
       TRY(mi_material(c, in[i], NULL, in[i], name, sizeof name));
       cJSON_AddItemToArray(names, cJSON_CreateString(name));
     }
-    TRY(mi_color(c, b, "weight", MI_RAW, &w));
-    if (!w) return mi_bad(c, b, "needs its weight (a number or a bitmap), as Mitsuba does");
-    if (!cJSON_IsString(w)) {
+    TRY(mi_color(c, b, "weight", 0, &w));
+    if (!w) return mi_bad(c, b, "needs its weight (a number or a texture), as Mitsuba does");
+    if (cJSON_IsArray(w)) {
       double x = cJSON_GetArrayItem(w, 0)->valuedouble;
       cJSON_Delete(w);
       w = cJSON_CreateNumber(x);
     }
     TYPE("blend");
     cJSON_AddItemToObject(m, "weight", w);
-    if (raw) cJSON_AddTrueToObject(m, "weight_raw");
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
     cJSON *v;
@@ -247,7 +253,17 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
                                        "spec_trans"};
     for (int k = 0; k < 10; k++) {
       double x = -1;
-      TRY(mi_float(c, b, keys[k], &x));
+      xml_node *tk = mi_prop(c, b, keys[k]);
+      if (tk && !strcmp(tk->name, "texture")) {
+        /* valo's principled reads maps for roughness and metallic: the value 1 times the map */
+        if (k > 1) return mi_bad(c, tk, "valo reads textures for principled's roughness and metallic, not for %s", keys[k]);
+        cJSON *map;
+        TRY(mi_color(c, b, keys[k], 0, &map));
+        cJSON_AddItemToObject(m, k ? "roughness_map" : "metallic_map", map);
+        x = 1;
+      } else {
+        TRY(mi_float(c, b, keys[k], &x));
+      }
       if (x != -1) cJSON_AddNumberToObject(m, keys[k], x);
     }
     double eta = 0, an = 0;

@@ -294,6 +294,52 @@ static cJSON *rgb_json(double r, double g, double b) {
   return cJSON_CreateDoubleArray(v, 3);
 }
 
+/* A <texture> as a valo texture object (docs/scene-format.md, "Textures"): a bitmap's file,
+ * raw, wrap and filter, or a checkerboard's colours; to_uv as "uv_matrix", turned into
+ * valo's texture coordinates (v up where Mitsuba's runs down: F A F with F(u, v) = (u, 1 - v)). */
+static valo_status mi_texture(mctx *c, xml_node *k, cJSON **out) {
+  const char *type = xml_attr_get(k, "type");
+  cJSON *o = cJSON_CreateObject();
+  if (!o) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  valo_status st = VALO_OK;
+  if (type && !strcmp(type, "bitmap")) {
+    const char *file = NULL, *filter = "bilinear", *wrap = "repeat";
+    int raw = 0;
+    if (!(st = mi_string(c, k, "filename", &file)) && !file) st = mi_bad(c, k, "a bitmap needs <string name=\"filename\">");
+    if (!st) st = mi_string(c, k, "filter_type", &filter);
+    if (!st) st = mi_string(c, k, "wrap_mode", &wrap);
+    if (!st) st = mi_bool(c, k, "raw", &raw);
+    if (!st && strcmp(filter, "bilinear") && strcmp(filter, "nearest")) st = mi_bad(c, k, "filter_type must be bilinear or nearest");
+    if (!st && strcmp(wrap, "repeat") && strcmp(wrap, "mirror") && strcmp(wrap, "clamp")) st = mi_bad(c, k, "wrap_mode must be repeat, mirror or clamp");
+    if (!st && !(cJSON_AddStringToObject(o, "file", file) && cJSON_AddBoolToObject(o, "raw", raw) && cJSON_AddStringToObject(o, "filter", filter) &&
+                 cJSON_AddStringToObject(o, "wrap", wrap)))
+      st = err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  } else if (type && !strcmp(type, "checkerboard")) {
+    cJSON *c0 = NULL, *c1 = NULL;
+    if (!cJSON_AddStringToObject(o, "type", "checkerboard")) st = err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    if (!st) st = mi_color(c, k, "color0", MI_RGB_ONLY, &c0);
+    if (!st) st = mi_color(c, k, "color1", MI_RGB_ONLY, &c1);
+    if (c0) cJSON_AddItemToObject(o, "color0", c0);
+    if (c1) cJSON_AddItemToObject(o, "color1", c1);
+  } else {
+    st = mi_bad(c, k, "valo reads \"bitmap\" and \"checkerboard\" textures");
+  }
+  double m[16];
+  int given = 0;
+  if (!st) st = mi_transform(c, k, "to_uv", m, &given);
+  if (!st && given) {
+    double a = m[0], b = m[1], cc = m[3], d = m[4], e = m[5], f = m[7];
+    double uvm[6] = {a, -b, b + cc, -d, e, 1 - e - f};
+    cJSON *arr = cJSON_CreateDoubleArray(uvm, 6);
+    if (!arr) st = err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    else cJSON_AddItemToObject(o, "uv_matrix", arr);
+  }
+  if (st) { cJSON_Delete(o); return st; }
+  mi_warn_unused(c, k);
+  *out = o;
+  return VALO_OK;
+}
+
 valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out) {
   *out = NULL;
   int rgb_only = how & MI_RGB_ONLY;
@@ -301,24 +347,8 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **ou
   if (!k) return VALO_OK;
   if (!strcmp(k->name, "ref")) return mi_bad(c, k, "refers to an id that no element has");
   if (!strcmp(k->name, "texture")) {
-    const char *type = xml_attr_get(k, "type");
     if (rgb_only) return mi_bad(c, k, "valo reads a constant colour here, not a texture");
-    if (!type || strcmp(type, "bitmap")) return mi_bad(c, k, "valo reads only \"bitmap\" textures");
-    const char *file = NULL;
-    TRY(mi_string(c, k, "filename", &file));
-    if (!file) return mi_bad(c, k, "a bitmap needs <string name=\"filename\">");
-    /* valo looks textures up bilinearly, repeating, and decodes 8-bit colour from sRGB. */
-    const char *filter = "bilinear", *wrap = "repeat";
-    int raw = 0;
-    TRY(mi_string(c, k, "filter_type", &filter));
-    TRY(mi_string(c, k, "wrap_mode", &wrap));
-    TRY(mi_bool(c, k, "raw", &raw));
-    if (strcmp(filter, "bilinear")) mi_warn(c, k, "valo filters textures bilinearly, not \"%s\"", filter);
-    if (strcmp(wrap, "repeat")) mi_warn(c, k, "valo repeats textures; wrap_mode \"%s\" is not read", wrap);
-    if (raw && !(how & MI_RAW)) mi_warn(c, k, "raw is not read: valo decodes 8-bit colour textures from sRGB");
-    mi_warn_unused(c, k);
-    *out = cJSON_CreateString(file);
-    return *out ? VALO_OK : err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    return mi_texture(c, k, out);
   }
   double v[3];
   const char *val = xml_attr_get(k, "value");

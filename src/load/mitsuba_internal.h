@@ -55,12 +55,12 @@ valo_status mi_string(mctx *c, xml_node *p, const char *name, const char **out);
 valo_status mi_point(mctx *c, xml_node *p, const char *name, vec3 *out);
 /* A 4x4 transform (row-major) from a <transform name=..> child; identity when absent. */
 valo_status mi_transform(mctx *c, xml_node *p, const char *name, double m[16], int *given);
-/* A colour property as valo JSON: [r, g, b], or a bitmap texture's file name; *out
- * stays NULL when absent. how: MI_RGB_ONLY, a texture is an error; MI_EMITTER, an
- * emitter's colour, where Mitsuba reads a one-value <spectrum> as that much of the
- * equal-energy spectrum (a pinkish white in sRGB's D65 terms), not as grey; MI_RAW, the
- * caller reads a bitmap's `raw` itself (no warning that valo does not). */
-enum { MI_RGB_ONLY = 1, MI_EMITTER = 2, MI_RAW = 4 };
+/* A colour property as valo JSON: [r, g, b], or a texture object (a bitmap or a
+ * checkerboard, with Mitsuba's raw, wrap_mode, filter_type and to_uv); *out stays NULL
+ * when absent. how: MI_RGB_ONLY, a texture is an error; MI_EMITTER, an emitter's colour,
+ * where Mitsuba reads a one-value <spectrum> as that much of the equal-energy spectrum
+ * (a pinkish white in sRGB's D65 terms), not as grey. */
+enum { MI_RGB_ONLY = 1, MI_EMITTER = 2 };
 valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out);
 /* Parses up to n numbers separated by commas and/or spaces; returns how many. */
 int mi_numbers(const char *s, double *v, int n);

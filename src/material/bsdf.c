@@ -28,6 +28,7 @@ bsdf bsdf_from_material(const material *m) {
   b.kd = m->kd; b.ks = m->ks; b.exponent = m->exponent; b.eta = m->ior;
   b.cond_eta = m->eta; b.cond_k = m->k; b.cond_tint = m->tint;
   b.beckmann = m->beckmann && m->type != MAT_PBR;
+  b.separable = m->smith_separable && m->type != MAT_PBR;
   b.p_first = 1;
   switch (m->type) {
   case MAT_DIFFUSE: b.type = BSDF_DIFFUSE; break;
@@ -134,7 +135,7 @@ static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
   float etap;
   if (!rd_half(b, wo, wi, &wm, &etap)) return c3(0, 0, 0);
   float F = fresnel_dielectric(v3_dot(wo, wm), b->eta);
-  float D = mf_D(b->beckmann, b->alpha, wm), G = mf_G(b->beckmann, b->alpha, wo, wi);
+  float D = mf_D(b->beckmann, b->alpha, wm), G = mf_G(b->beckmann, b->separable, b->alpha, wo, wi);
   float v;
   if (etap == 1) v = D * G * F / fabsf(4 * wi.z * wo.z);
   else {
@@ -184,7 +185,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_PRINCIPLED: return principled_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
-    float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->alpha, wo, wi) / (4 * wo.z * wi.z);
+    float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->separable, b->alpha, wo, wi) / (4 * wo.z * wi.z);
     rgb F = conductor_F(b, fabsf(v3_dot(wo, wm)));
     return c3_scale(F, dg);
   }

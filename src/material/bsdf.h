@@ -26,6 +26,7 @@ typedef struct bsdf {
   float alpha;        /* GGX roughness (rough types) */
   float metallic;     /* BSDF_PBR */
   int beckmann;       /* rough conductor and dielectric: the Beckmann distribution, not GGX */
+  int separable;      /* rough conductor, dielectric, plastic: Smith's separable G (Mitsuba's), not the height-correlated one */
   int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */
   int nonlinear;      /* plastics: material.nonlinear */
   float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */

@@ -12,8 +12,9 @@
  *   inverted by safeguarded Newton steps in erf(x) from a fitted first guess (Jakob 2014,
  *   "An improved visible normal sampling routine for the Beckmann distribution"), the
  *   other slope is a unit Gaussian (erf(y) uniform).
- * Both use the height-correlated G = 1 / (1 + Lambda(wo) + Lambda(wi)). The mf_ functions
- * choose by `beck`. */
+ * Both use the height-correlated G = 1 / (1 + Lambda(wo) + Lambda(wi)), or on request the
+ * separable G1(wo) G1(wi) = 1 / ((1 + Lambda(wo)) (1 + Lambda(wi))) that Mitsuba uses. The
+ * mf_ functions choose by `beck` (and mf_G by `sep`). */
 #ifndef VALO_MICROFACET_H
 #define VALO_MICROFACET_H
 #include "core/vec.h"
@@ -130,7 +131,11 @@ static inline float beckmann_D_visible(float a, vec3 w, vec3 wm) {
 }
 
 static inline float mf_D(int beck, float a, vec3 wm) { return beck ? beckmann_D(a, wm) : ggx_D(a, wm); }
-static inline float mf_G(int beck, float a, vec3 wo, vec3 wi) {
+static inline float mf_G(int beck, int sep, float a, vec3 wo, vec3 wi) {
+  if (sep) {
+    float lo = beck ? beckmann_lambda(a, wo) : ggx_lambda(a, wo), li = beck ? beckmann_lambda(a, wi) : ggx_lambda(a, wi);
+    return 1 / ((1 + lo) * (1 + li));
+  }
   return beck ? 1 / (1 + beckmann_lambda(a, wo) + beckmann_lambda(a, wi)) : ggx_G(a, wo, wi);
 }
 /* The density of sampled normal wm (for direction w). */

@@ -87,7 +87,7 @@ rgb plastic_eval(const bsdf *b, vec3 wo, vec3 wi) {
   if (b->type == BSDF_ROUGH_PLASTIC) {
     vec3 wm = v3_norm(v3_add(wo, wi));
     float s = fresnel_dielectric(v3_dot(wo, wm), b->eta) * mf_D(b->beckmann, b->alpha, wm) *
-              mf_G(b->beckmann, b->alpha, wo, wi) / (4 * wo.z * wi.z);
+              mf_G(b->beckmann, b->separable, b->alpha, wo, wi) / (4 * wo.z * wi.z);
     f = c3_add(f, c3_scale(b->ks, s));
   }
   return f;

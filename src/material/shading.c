@@ -9,7 +9,8 @@
  * dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is the new shading
  * normal. dp/du and dp/dv are the triangle's own UV derivatives, made orthogonal to n so
  * that a flat height map leaves n unchanged; d_u and d_v are central differences over
- * half a texel of the bilinearly filtered map, so the slope of a linear ramp is exact. */
+ * half a texel of the filtered map (after its map of the texture coordinates, if any),
+ * so the slope of a bilinear linear ramp is exact. */
 static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   const texture *tx = &s->tex[it->m->tex_bump];
   vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
@@ -24,6 +25,11 @@ static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
   dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
   float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
+  if (tx->has_uvm) { /* half a texel after the map of the texture coordinates */
+    float su = fmaxf(fabsf(tx->uvm[0]) * tx->w, fabsf(tx->uvm[3]) * tx->h), sv = fmaxf(fabsf(tx->uvm[1]) * tx->w, fabsf(tx->uvm[4]) * tx->h);
+    if (su > 1e-6f) hu = 0.5f / su;
+    if (sv > 1e-6f) hv = 0.5f / sv;
+  }
   texture_lookup(tx, it->u + hu, it->v, px); a = px[0] + px[1] + px[2];
   texture_lookup(tx, it->u - hu, it->v, px); b = px[0] + px[1] + px[2];
   float d_u = it->m->bump_scale * (a - b) / (3 * 2 * hu);
@@ -103,7 +109,11 @@ bsdf bsdf_at(const scene *s, const isect *it) {
   if (m->tex_ks >= 0) { texture_lookup(&s->tex[m->tex_ks], it->u, it->v, px); mm.ks = c3_mul(mm.ks, c3(px[0], px[1], px[2])); }
   if (m->tex_ns >= 0) { texture_lookup(&s->tex[m->tex_ns], it->u, it->v, px); mm.exponent *= (px[0] + px[1] + px[2]) / 3; }
   if (m->tex_mr >= 0) { texture_lookup(&s->tex[m->tex_mr], it->u, it->v, px); mm.roughness *= px[1]; mm.metallic *= px[2]; }
-  if (m->tex_rough >= 0) { texture_lookup(&s->tex[m->tex_rough], it->u, it->v, px); mm.roughness *= sqrtf(fmaxf((px[0] + px[1] + px[2]) / 3, 0)); }
+  if (m->tex_rough >= 0) {
+    texture_lookup(&s->tex[m->tex_rough], it->u, it->v, px);
+    float r = fmaxf((px[0] + px[1] + px[2]) / 3, 0);
+    mm.roughness *= m->rough_is_alpha ? sqrtf(r) : r;
+  }
   if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
   return bsdf_from_material(&mm);
 }

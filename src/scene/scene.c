@@ -150,6 +150,35 @@ int scene_texture_memory(scene *s, const char *name, const unsigned char *data, 
   return add_texture(s, &t, key);
 }
 
+int scene_texture_sampled(scene *s, int base, const tex_sampling *smp) {
+  if (base < 0) return base;
+  const texture *b = &s->tex[base];
+  if (b->wrap == smp->wrap && b->filter == smp->filter && b->has_uvm == smp->has_uvm && (!smp->has_uvm || !memcmp(b->uvm, smp->uvm, sizeof b->uvm)))
+    return base;
+  char key[600];
+  int n = snprintf(key, sizeof key, "%s|w%d|f%d", b->key, (int)smp->wrap, (int)smp->filter);
+  for (int k = 0; smp->has_uvm && k < 6 && n > 0 && n < (int)sizeof key; k++) n += snprintf(key + n, sizeof key - n, "|%a", smp->uvm[k]);
+  int i = find_texture(s, key);
+  if (i >= 0) return i;
+  texture t = *b;
+  t.wrap = smp->wrap;
+  t.filter = smp->filter;
+  t.has_uvm = smp->has_uvm;
+  memcpy(t.uvm, smp->uvm, sizeof t.uvm);
+  t.shares_px = 1;
+  return add_texture(s, &t, key);
+}
+
+int scene_texture_checkerboard(scene *s, const float c0[3], const float c1[3], valo_error *err) {
+  char key[600];
+  snprintf(key, sizeof key, "checkerboard|%a,%a,%a|%a,%a,%a", c0[0], c0[1], c0[2], c1[0], c1[1], c1[2]);
+  int i = find_texture(s, key);
+  if (i >= 0) return i;
+  texture t;
+  if (texture_checkerboard(&t, c0, c1, err)) return -1;
+  return add_texture(s, &t, key);
+}
+
 /* The sphere whose triangles hold t (their ranges are in order), or NULL. */
 static const sphere_shape *tri_sphere(const scene *s, uint32_t t) {
   uint32_t lo = 0, hi = s->nspheres;

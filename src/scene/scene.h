@@ -30,6 +30,7 @@ typedef enum mat_type {
  * i / (PLASTIC_RES - 1), and the reflectance it shows to diffuse light from inside. */
 #define PLASTIC_RES 64
 
+struct tex_sampling; /* image/texture.h */
 typedef struct material {
   mat_type type;
   rgb kd, ks;
@@ -40,6 +41,7 @@ typedef struct material {
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
   float metallic;    /* MAT_PBR: 0 dielectric .. 1 metal */
   int beckmann;      /* conductor/dielectric roughness: Beckmann's distribution (JSON "distribution"), else GGX */
+  int smith_separable; /* conductor/dielectric/plastic roughness: Smith's separable G (JSON "smith"), else height-correlated */
   int metal_flat;    /* MAT_PBR: metal reflectance kd at every angle, no Schlick term (MTL PBR extension) */
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
@@ -50,8 +52,10 @@ typedef struct material {
   int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
   int tex_ns;        /* Phong exponent map (MTL map_Ns; linear, mean of RGB multiplies exponent), -1 = none */
   int tex_bump;      /* height map for bump mapping (mean of RGB, linear), -1 = none */
-  int tex_rough;     /* MTL map_Pr: multiplies alpha (mean of RGB, linear), so roughness by its root; -1 = none */
-  int tex_metal;     /* MTL map_Pm: multiplies metallic (mean of RGB, linear), -1 = none */
+  int tex_rough;     /* multiplies roughness by its value (mean of RGB, linear), or alpha when
+                        rough_is_alpha (MTL map_Pr, Mitsuba's alpha textures); -1 = none */
+  int rough_is_alpha;
+  int tex_metal;     /* multiplies metallic (mean of RGB, linear; MTL map_Pm), -1 = none */
   float bump_scale;  /* displacement in scene units = bump_scale * height */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
@@ -210,6 +214,11 @@ material material_default(void);
  * names the file and the map is ignored. */
 int scene_texture_file(scene *s, const char *path, int srgb, valo_error *err);
 int scene_texture_memory(scene *s, const char *key, const unsigned char *data, size_t len, int srgb);
+/* Texture base sampled as smp says: base itself when it already is, else (found or added)
+ * a texture sharing base's pixels. base < 0 is returned as is. */
+int scene_texture_sampled(scene *s, int base, const struct tex_sampling *smp);
+/* Mitsuba's checkerboard (texture_checkerboard), found or added; -1 when out of memory. */
+int scene_texture_checkerboard(scene *s, const float c0[3], const float c1[3], valo_error *err);
 /* Surface UV of triangle t at barycentrics (b1, b2): interpolated, or on a sphere's
  * triangle the sphere's own layout at the point's direction from its centre (exact, so a
  * texture shows no facets). */
