@@ -35,7 +35,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's checkerboard and bitmap lookups: to_uv, filter_type, wrap_mode, raw
           "textures": ("@tests/data/mitsuba-xml/textures.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's roughness and metallic textures (valo's roughness_map and metallic_map)
-          "roughness": ("@tests/data/mitsuba-xml/roughness.xml", {"resx": "160", "resy": "96"})}
+          "roughness": ("@tests/data/mitsuba-xml/roughness.xml", {"resx": "160", "resy": "96"}),
+          # an environment map turned any way (valo's environment "matrix")
+          "env-turned": ("@tests/data/mitsuba-xml/env-turned.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -726,9 +726,11 @@ static int light_sampling(void) {
   }
   c.l.type = LIGHT_ENV;
   rc |= run_chi2("constant environment", &c, light_sf, light_pf);
-  /* An equirectangular map with a bright spot, a dark hole and a gradient, upright and
-   * turned by 30 degrees. */
-  for (int rot = 0; rot < 2; rot++) {
+  /* An equirectangular map with a bright spot, a dark hole and a gradient, upright,
+   * turned by 30 degrees about y, turned any way (+y to +z, then 40 degrees about z: a
+   * frame), and so with Mitsuba's rows (which move lookups, not sampling: every direction
+   * keeps a density, envmap_init's floor). */
+  for (int rot = 0; rot < 4; rot++) {
     int w = 64, h = 32;
     float *px = malloc(sizeof(float) * w * h * 3);
     for (int y = 0; y < h; y++)
@@ -740,8 +742,16 @@ static int light_sampling(void) {
           px[3 * (y * w + x) + k] = v * (k + 1) / 3.0f;
         }
     s->env_map = calloc(1, sizeof(envmap));
-    CHECK(envmap_init(s->env_map, w, h, px, 1.0f, rot ? 30.0f : 0.0f) == 0, "envmap init");
-    rc |= run_chi2(rot ? "environment map, rotated 30 deg" : "environment map", &c, light_sf, light_pf);
+    CHECK(envmap_init(s->env_map, w, h, px, 1.0f, rot == 1 ? 30.0f : 0.0f) == 0, "envmap init");
+    if (rot >= 2) {
+      double ca = cos(40 * M_PI / 180), sa = sin(40 * M_PI / 180);
+      const double fr[9] = {ca, 0, sa, sa, 0, -ca, 0, 1, 0}; /* Rz(40) Rx(90) */
+      CHECK(envmap_set_frame(s->env_map, fr) == 0, "frame refused");
+      s->env_map->mitsuba_rows = rot == 3;
+    }
+    static const char *const names[4] = {"environment map", "environment map, rotated 30 deg", "environment map, turned by a frame",
+                                         "environment map, turned by a frame, Mitsuba's rows"};
+    rc |= run_chi2(names[rot], &c, light_sf, light_pf);
     envmap_free(s->env_map);
     free(s->env_map);
     s->env_map = NULL;

@@ -120,6 +120,18 @@ static int wrong_type(void) {
   p = write_file("type8.json", "{ \"environment\": {\"type\": \"cube\", \"faces\": [\"n1.png\", \"n2.png\", \"n3.png\", \"n4.png\", \"n5.png\", \"n6.png\"]} }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("n1.png"); NO_SANITIZER();
+  static const struct { const char *name, *extra, *says; } envm[] = {
+      {"envm1.json", "\"matrix\": [1, 0, 0, 0, 2, 0, 0, 0, 1]", "orthonormal"},
+      {"envm2.json", "\"matrix\": [1, 0, 0, 0, 1, 0, 0, 0, 1], \"rotation\": 10", "not both"},
+      {"envm3.json", "\"matrix\": [1, 0, 0, 0, 1, 0, 0, 0]", "9 numbers"}};
+  for (size_t k = 0; k < sizeof envm / sizeof envm[0]; k++) {
+    char js[600];
+    snprintf(js, sizeof js, "{ \"environment\": {\"type\": \"map\", \"file\": \"%s\", %s} }\n", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/env-marks.exr",
+             envm[k].extra);
+    p = write_file(envm[k].name, js);
+    EXPECT_FAIL(1, "render", p);
+    SAID(envm[k].name); SAID("environment"); SAID(envm[k].says); NO_SANITIZER();
+  }
   p = write_file("type4.json", "{ \"shapes\": [{\"type\": \"sphere\", \"material\": \"nope\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("shapes[0]"); SAID("\"nope\""); NO_SANITIZER();
@@ -142,7 +154,7 @@ static int bad_mitsuba(void) {
       {"mx5.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.1, 700:0.9\"/></bsdf></shape>\n</scene>",
        "mx5.xml:3: <spectrum name=\"reflectance\">", "give wavelength-dependent colours as <rgb>"},
       {"mx6.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>\n"
-       "<transform name=\"to_world\"><rotate x=\"1\" angle=\"90\"/></transform></emitter>\n</scene>", "mx6.xml:3: <emitter type=\"envmap\">", "only about +y"},
+       "<transform name=\"to_world\"><matrix value=\"1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1\"/></transform></emitter>\n</scene>", "mx6.xml:3: <emitter type=\"envmap\">", "not shear it"},
       {"mx7.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>"
        "<float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n</scene>", "mx7.xml:3", "isotropic"},
       {"mx8.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"1\"/>"

@@ -4,7 +4,6 @@
  * file and the JSON path; syntax errors give line:column. */
 #include "load/load_json_internal.h"
 #include "core/error.h"
-#include "scene/envmap.h"
 #include "core/spectrum.h"
 #include "core/options.h"
 #include "core/strutil.h"
@@ -546,52 +545,7 @@ valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_o
     if (at) at[1] = -1;
   }
   const cJSON *env = cJSON_GetObjectItemCaseSensitive(root, "environment");
-  if (env) {
-    const char *type = "constant";
-    TRY(json_get_str(&c, env, "type", "environment", &type));
-    if (!strcmp(type, "constant")) {
-      static const char *const ek[] = {"type", "radiance", NULL};
-      TRY(json_check_keys(&c, env, "environment", ek));
-      s->env_radiance = c3(1, 1, 1);
-      TRY(json_get_rgb(&c, env, "radiance", "environment", &s->env_radiance));
-    } else if (!strcmp(type, "map")) {
-      static const char *const ek[] = {"type", "file", "scale", "rotation", NULL};
-      TRY(json_check_keys(&c, env, "environment", ek));
-      const char *file = NULL;
-      double scale = 1, rot = 0;
-      TRY(json_get_str(&c, env, "file", "environment", &file));
-      if (!file) { st = json_bad(&c, "environment", "a map needs \"file\" (an equirectangular .exr, .hdr or .pfm)"); goto done; }
-      TRY(json_get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
-      TRY(json_get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
-      char full[2048];
-      json_resolve_path(&c, file, full, sizeof full);
-      TRY(envmap_create(full, (float)scale, (float)rot, &s->env_map, err));
-    } else if (!strcmp(type, "cube")) {
-      static const char *const ek[] = {"type", "faces", "scale", "rotation", NULL};
-      TRY(json_check_keys(&c, env, "environment", ek));
-      const cJSON *faces = cJSON_GetObjectItemCaseSensitive(env, "faces");
-      if (!cJSON_IsArray(faces) || cJSON_GetArraySize(faces) != 6) {
-        st = json_bad(&c, "environment.faces", "must be an array of six image files: +x, -x, +y, -y, +z, -z");
-        goto done;
-      }
-      char full[6][2048];
-      const char *paths[6];
-      int i = 0;
-      for (const cJSON *fe = faces->child; fe; fe = fe->next, i++) {
-        if (!cJSON_IsString(fe)) { st = json_bad(&c, "environment.faces", "must hold file names (strings)"); goto done; }
-        json_resolve_path(&c, fe->valuestring, full[i], sizeof full[i]);
-        paths[i] = full[i];
-      }
-      double scale = 1, rot = 0;
-      TRY(json_get_num(&c, env, "scale", "environment", 0, 1e9, &scale));
-      TRY(json_get_num(&c, env, "rotation", "environment", -1e6, 1e6, &rot));
-      TRY(envmap_create_cube(paths, (float)scale, (float)rot, &s->env_map, err));
-    } else {
-      st = json_bad(&c, "environment.type", "unknown environment type (constant, map, cube)");
-      goto done;
-    }
-    s->has_env = 1;
-  }
+  if (env) TRY(json_parse_environment(&c, env));
 done:
   mesh_cache_free(c.meshes);
   return st;

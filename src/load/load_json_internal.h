@@ -35,6 +35,8 @@ void json_line_col(const char *text, const char *at, int *line, int *col);
 valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, material *m);
 /* The top-level "media" object: adds each named medium to the scene. */
 valo_status json_parse_media(jctx *c, const cJSON *o);
+/* The "environment" object (load_json_env.c). */
+valo_status json_parse_environment(jctx *c, const cJSON *env);
 /* The medium named by key `key` of o (a string naming one of "media"): *med stays as it
  * is when the key is absent. */
 valo_status json_get_medium(jctx *c, const cJSON *o, const char *key, const char *where, int32_t *med);

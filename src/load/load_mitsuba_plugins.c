@@ -486,19 +486,40 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
       TRY(mi_float(c, e, "scale", &scale));
       if (!file) return mi_bad(c, e, "needs <string name=\"filename\">");
       /* Mitsuba's map has u = 0 at -z, valo's centre looks down -z: a turn of theta about
-       * +y there is theta - 180 degrees here. Other turns are not read. */
-      double ang = 180;
+       * +y there is theta - 180 degrees here; any other turn (a z-up world's, say) is the
+       * frame M diag(-1, 1, -1), M the to_world's 3x3 part with its columns made unit
+       * (Mitsuba normalises the direction it turns back). */
+      double ang = 180, fr[9];
+      int general = 0;
       if (has_xf) {
-        double sy = m[5], off = fabs(m[1]) + fabs(m[4]) + fabs(m[6]) + fabs(m[9]) + fabs(m[3]) + fabs(m[7]) + fabs(m[11]);
-        if (fabs(sy - 1) > 1e-4 || off > 1e-4 || fabs(m[0] - m[10]) > 1e-4 || fabs(m[2] + m[8]) > 1e-4 ||
-            fabs(m[0] * m[0] + m[2] * m[2] - 1) > 1e-4)
-          return mi_bad(c, e, "valo turns environment maps only about +y (a y-up world): this to_world does more");
-        ang = atan2(m[2], m[0]) * 180 / M_PI;
+        double off = fabs(m[1]) + fabs(m[4]) + fabs(m[6]) + fabs(m[9]);
+        double len[3];
+        for (int j = 0; j < 3; j++) len[j] = sqrt(m[j] * m[j] + m[4 + j] * m[4 + j] + m[8 + j] * m[8 + j]);
+        if (!(len[0] > 0 && len[1] > 0 && len[2] > 0)) return mi_bad(c, e, "to_world flattens the environment");
+        if (off < 1e-4 && fabs(m[5] - 1) < 1e-4 && fabs(m[0] - m[10]) < 1e-4 && fabs(m[2] + m[8]) < 1e-4 && fabs(m[0] * m[0] + m[2] * m[2] - 1) < 1e-4) {
+          ang = atan2(m[2], m[0]) * 180 / M_PI;
+        } else {
+          for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) fr[3 * i + j] = m[4 * i + j] / len[j] * (j == 1 ? 1 : -1);
+          for (int i = 0; i < 3; i++)
+            for (int j = 0; j < i; j++)
+              if (fabs(fr[i] * fr[j] + fr[3 + i] * fr[3 + j] + fr[6 + i] * fr[6 + j]) > 1e-3)
+                return mi_bad(c, e, "to_world may turn the environment (or mirror it), not shear it");
+          general = 1;
+        }
       }
       cJSON_AddStringToObject(env, "type", "map");
       cJSON_AddStringToObject(env, "file", file);
       cJSON_AddNumberToObject(env, "scale", scale);
-      cJSON_AddNumberToObject(env, "rotation", ang - 180);
+      cJSON_AddTrueToObject(env, "mitsuba_rows"); /* its rows where Mitsuba looks them up */
+
+      if (general) {
+        cJSON *fm = cJSON_CreateDoubleArray(fr, 9);
+        if (!fm) return NOMEM;
+        cJSON_AddItemToObject(env, "matrix", fm);
+      } else {
+        cJSON_AddNumberToObject(env, "rotation", ang - 180);
+      }
     }
     mi_warn_unused(c, e);
     return VALO_OK;

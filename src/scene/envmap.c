@@ -6,11 +6,30 @@
 #include <stdlib.h>
 #include <string.h>
 
-static vec3 to_map(const envmap *e, vec3 d) { /* world -> map frame: rotate by -rotation about y */
+static vec3 to_map(const envmap *e, vec3 d) { /* world -> map frame: rotate by -rotation about y, or by the frame's transpose */
+  if (e->has_frame) {
+    const float *f = e->frame;
+    return v3(f[0] * d.x + f[3] * d.y + f[6] * d.z, f[1] * d.x + f[4] * d.y + f[7] * d.z, f[2] * d.x + f[5] * d.y + f[8] * d.z);
+  }
   return v3(e->rot_cos * d.x - e->rot_sin * d.z, d.y, e->rot_sin * d.x + e->rot_cos * d.z);
 }
 static vec3 from_map(const envmap *e, vec3 d) {
+  if (e->has_frame) {
+    const float *f = e->frame;
+    return v3(f[0] * d.x + f[1] * d.y + f[2] * d.z, f[3] * d.x + f[4] * d.y + f[5] * d.z, f[6] * d.x + f[7] * d.y + f[8] * d.z);
+  }
   return v3(e->rot_cos * d.x + e->rot_sin * d.z, d.y, -e->rot_sin * d.x + e->rot_cos * d.z);
+}
+
+int envmap_set_frame(envmap *e, const double m[9]) {
+  for (int i = 0; i < 3; i++)
+    for (int j = 0; j < 3; j++) {
+      double dot = m[i] * m[j] + m[3 + i] * m[3 + j] + m[6 + i] * m[6 + j]; /* columns i and j */
+      if (!isfinite(dot) || fabs(dot - (i == j)) > 1e-3) return -1;
+    }
+  for (int k = 0; k < 9; k++) e->frame[k] = (float)m[k];
+  e->has_frame = 1;
+  return 0;
 }
 static void dir_to_uv(vec3 d, float *u, float *v) {
   float phi = atan2f(d.x, -d.z);
@@ -34,7 +53,8 @@ static rgb texel(const envmap *e, int x, int y) {
 }
 
 static rgb lookup(const envmap *e, float u, float v) {
-  float x = u * e->w - 0.5f, y = v * e->h - 0.5f;
+  /* texel centres at ((x + 0.5)/w, (y + 0.5)/h); Mitsuba's rows at v = y/(h - 1) */
+  float x = u * e->w - 0.5f, y = e->mitsuba_rows ? v * (e->h - 1) : v * e->h - 0.5f;
   int x0 = (int)floorf(x), y0 = (int)floorf(y);
   float fx = x - x0, fy = y - y0;
   rgb a = texel(e, x0, y0), b = texel(e, x0 + 1, y0), c = texel(e, x0, y0 + 1), d = texel(e, x0 + 1, y0 + 1);

@@ -4,7 +4,8 @@
  * density is non-zero wherever the looked-up radiance is), and the matching solid-angle
  * density pdf(w) = pdf(u,v) / (2 pi^2 sin theta) (pbrt-v3 §14.2.4).
  * Convention: y is up; direction -z maps to the image centre (u = 0.5); the top row is
- * straight up. `rotation` turns the map about +y (degrees).
+ * straight up. `rotation` turns the map about +y (degrees); envmap_set_frame turns it any
+ * way (an orthonormal matrix from the map's frame to the world's).
  * Cube maps (six face images) are resampled into an equirectangular map at load time
  * (envmap_load_cube), so they share the lookup, sampling and MIS code. Face convention:
  * the OpenGL/DirectX cube-map layout of a left-handed world, as skybox packs are made
@@ -23,6 +24,10 @@ typedef struct envmap {
   float *rgb;        /* w*h*3, linear */
   float scale;
   float rot_cos, rot_sin;
+  int has_frame;     /* 1: frame (row-major) turns map directions into world ones, not rotation */
+  int mitsuba_rows;  /* 1: row y is looked up at v = y/(h - 1), as Mitsuba's envmap does, not (y + 1/2)/h
+                        (the sampling's 3x3 footprints still cover every row a lookup reads) */
+  float frame[9];
   distrib2d dist;
   rgb average;       /* mean radiance over the sphere (for light selection) */
 } envmap;
@@ -34,6 +39,9 @@ valo_status envmap_load(envmap *e, const char *path, float scale, float rotation
  * square and of one size. */
 valo_status envmap_load_cube(envmap *e, const char *const faces[6], float scale, float rotation_deg, valo_error *err);
 void envmap_free(envmap *e);
+/* Map directions become world ones by m (row-major, orthonormal within 1e-3: a turn or a
+ * mirror), in place of the rotation; -1 (nothing set) when m is not orthonormal. */
+int envmap_set_frame(envmap *e, const double m[9]);
 /* The same as heap objects the scene owns: *out is a new map (NULL on error);
  * envmap_destroy frees one (NULL is fine). */
 valo_status envmap_create(const char *path, float scale, float rotation_deg, envmap **out, valo_error *err);
