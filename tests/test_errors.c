@@ -151,8 +151,8 @@ static int bad_mitsuba(void) {
       {"mx3.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"hair\"/></shape>\n</scene>", "mx3.xml:3: <bsdf type=\"hair\">",
        "valo has no such BSDF"},
       {"mx4.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"$kind\"/>\n</scene>", "mx4.xml:3", "$kind has no <default"},
-      {"mx5.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"400:0.1, 700:0.9\"/></bsdf></shape>\n</scene>",
-       "mx5.xml:3: <spectrum name=\"reflectance\">", "give wavelength-dependent colours as <rgb>"},
+      {"mx5.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"diffuse\"><spectrum name=\"reflectance\" value=\"700:0.1, 400:0.9\"/></bsdf></shape>\n</scene>",
+       "mx5.xml:3: <spectrum name=\"reflectance\">", "increasing wavelengths"},
       {"mx6.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>\n"
        "<transform name=\"to_world\"><matrix value=\"1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1\"/></transform></emitter>\n</scene>", "mx6.xml:3: <emitter type=\"envmap\">", "not shear it"},
       {"mx7.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>"

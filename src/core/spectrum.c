@@ -153,6 +153,36 @@ rgb tab_to_rgb(const float *nm, const float *v, int n) {
   return c3(c[0], c[1], c[2]);
 }
 
+/* CIE standard illuminant D65 (CIE 15), every 10 nm from 360 to 830 nm; the CIE's 1 nm
+ * values lie on the straight lines between these. */
+static const float D65_10NM[48] = {46.6383f, 52.0891f, 49.9755f, 54.6482f, 82.7549f, 91.486f, 93.4318f, 86.6823f, 104.865f, 117.008f,
+                                   117.812f, 114.861f, 115.923f, 108.811f, 109.354f, 107.802f, 104.79f, 107.689f, 104.405f, 104.046f,
+                                   100.0f, 96.3342f, 95.788f, 88.6856f, 90.0062f, 89.5991f, 87.6987f, 83.2886f, 83.6992f, 80.0268f,
+                                   80.2146f, 82.2778f, 78.2842f, 69.7213f, 71.6091f, 74.349f, 61.604f, 69.8856f, 75.087f, 63.5927f,
+                                   46.4182f, 66.8054f, 63.3828f, 64.304f, 59.4519f, 51.959f, 57.4406f, 60.3125f};
+static float d65(float l) {
+  float t = (l - 360) / 10;
+  if (t <= 0) return D65_10NM[0];
+  if (t >= 47) return D65_10NM[47];
+  int i = (int)t;
+  return D65_10NM[i] + (t - i) * (D65_10NM[i + 1] - D65_10NM[i]);
+}
+
+rgb spectrum_list_to_rgb(const float *nm, const float *v, int n, int emitter) {
+  double X = 0, Y = 0, Z = 0, norm = 0;
+  for (float l = 360.25f; l < 830; l += 0.5f) {
+    float x, y, z, w = emitter ? 1 : d65(l);
+    cie_xyz(l, &x, &y, &z);
+    norm += (double)y * w;
+    if (l < nm[0] || l > nm[n - 1]) continue;
+    float f = tab_eval(nm, v, n, l) * w;
+    X += (double)x * f; Y += (double)y * f; Z += (double)z * f;
+  }
+  float c[3];
+  for (int i = 0; i < 3; i++) c[i] = (float)((XYZ_TO_SRGB[i][0] * X + XYZ_TO_SRGB[i][1] * Y + XYZ_TO_SRGB[i][2] * Z) / norm);
+  return c3(c[0], c[1], c[2]);
+}
+
 int dispersion_parse(const char *name, dispersion *d) {
   static const struct { const char *n; dispersion d; } t[] = {
       {"fused_silica", DISP_FUSED_SILICA}, {"sapphire", DISP_SAPPHIRE}, {"water", DISP_WATER}, {"cauchy_glass", DISP_CAUCHY_GLASS},

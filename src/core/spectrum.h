@@ -37,6 +37,12 @@ float tab_eval(const float *nm, const float *v, int n, float lambda);
  * balanced so that a constant c reads (c, c, c)): how RGB mode takes a tabulated
  * conductor index. */
 rgb tab_to_rgb(const float *nm, const float *v, int n);
+/* Linear sRGB of a spectrum listed at n >= 1 increasing wavelengths (linear between them,
+ * 0 outside) as Mitsuba's RGB modes read one: CIE 1931 over [360, 830] nm; a reflectance
+ * seen under D65 and divided by D65's Y (a constant 1 reads about (1, 1, 1)), an emitter's
+ * (emitter != 0) divided by the equal-energy spectrum's Y (a constant 1 reads about
+ * (1.2048, 0.9483, 0.9088)). */
+rgb spectrum_list_to_rgb(const float *nm, const float *v, int n, int emitter);
 
 /* Dispersion (digest 000, thesis table 2.1): index of refraction at wavelength lambda. */
 typedef enum dispersion { DISP_NONE, DISP_FUSED_SILICA, DISP_SAPPHIRE, DISP_WATER, DISP_CAUCHY_GLASS, DISP_DENSE_FLINT } dispersion;

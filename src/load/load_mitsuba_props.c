@@ -5,6 +5,7 @@
 #include "load/mitsuba_internal.h"
 #include "load/load_json_internal.h"
 #include "core/error.h"
+#include "core/spectrum.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -294,6 +295,55 @@ static cJSON *rgb_json(double r, double g, double b) {
   return cJSON_CreateDoubleArray(v, 3);
 }
 
+/* A <spectrum> of wavelength:value pairs ("400:0.2, 500:0.8") or a file of "wavelength
+ * value" lines (# comments), in linear sRGB as Mitsuba's RGB modes read it
+ * (spectrum_list_to_rgb). */
+#define MI_SPECTRUM_MAX 4096
+static valo_status mi_spectrum_list(mctx *c, xml_node *k, int emitter, rgb *out) {
+  const char *val = xml_attr_get(k, "value"), *file = xml_attr_get(k, "filename");
+  if (val && file) return mi_bad(c, k, "give value or filename, not both");
+  char *text = NULL;
+  if (file) {
+    const char *slash = strrchr(c->path, '/');
+    int dl = file[0] == '/' || !slash ? 0 : (int)(slash - c->path + 1);
+    char path[4096];
+    snprintf(path, sizeof path, "%.*s%s", dl, c->path, file);
+    size_t tl;
+    valo_error e2;
+    if (scene_text_read(path, &text, &tl, &e2)) return mi_bad(c, k, "%s", e2.message);
+    for (char *p = text; *p; p++) /* comments end at the line's end */
+      if (*p == '#') while (*p && *p != '\n') *p++ = ' ';
+  }
+  float *nm = malloc(2 * MI_SPECTRUM_MAX * sizeof(float));
+  if (!nm) { free(text); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+  float *v = nm + MI_SPECTRUM_MAX;
+  int n = 0;
+  const char *p = file ? text : val, *bad = NULL;
+  while (!bad) {
+    while (*p && (isspace((unsigned char)*p) || *p == ',')) p++;
+    if (!*p) break;
+    char *e;
+    errno = 0;
+    double l = strtod(p, &e);
+    if (e == p) { bad = "is not a list of wavelength:value pairs"; break; }
+    p = e;
+    while (*p == ' ' || *p == '\t') p++;
+    if (!file && *p++ != ':') { bad = "is not a list of wavelength:value pairs"; break; }
+    double x = strtod(p, &e);
+    if (e == p || errno) { bad = "is not a list of wavelength:value pairs"; break; }
+    p = e;
+    if (n == MI_SPECTRUM_MAX) { bad = "has more than 4096 wavelengths"; break; }
+    if (!(l >= 100 && l <= 20000) || (n && !(l > nm[n - 1])) || !isfinite(x)) { bad = "needs increasing wavelengths in nm (100 to 20000) and finite values"; break; }
+    nm[n] = (float)l; v[n] = (float)x; n++;
+  }
+  if (!bad && n == 0) bad = "lists no wavelengths";
+  if (!bad) *out = spectrum_list_to_rgb(nm, v, n, emitter);
+  free(nm);
+  free(text);
+  if (bad) return file ? mi_bad(c, k, "%s %s", file, bad) : mi_bad(c, k, "%s", bad);
+  return VALO_OK;
+}
+
 /* A <texture> as a valo texture object (docs/scene-format.md, "Textures"): a bitmap's file,
  * raw, wrap and filter, or a checkerboard's colours; to_uv as "uv_matrix", turned into
  * valo's texture coordinates (v up where Mitsuba's runs down: F A F with F(u, v) = (u, 1 - v)). */
@@ -368,8 +418,12 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **ou
       else if (n != 3) return mi_bad(c, k, "value must hold three numbers (or one)");
     }
     if (!strcmp(k->name, "srgb")) for (int i = 0; i < 3; i++) v[i] = srgb_to_linear(v[i]);
+  } else if (!strcmp(k->name, "spectrum") && (xml_attr_get(k, "filename") || (val && strchr(val, ':')))) {
+    rgb col;
+    TRY(mi_spectrum_list(c, k, how & MI_EMITTER, &col));
+    v[0] = col.r; v[1] = col.g; v[2] = col.b;
   } else if (!strcmp(k->name, "spectrum")) {
-    if (!val || strchr(val, ':')) return mi_bad(c, k, "valo reads a spectrum given as one value; give wavelength-dependent colours as <rgb>");
+    if (!val) return mi_bad(c, k, "needs a value (one number, or wavelength:value pairs) or a filename");
     if (mi_numbers(val, v, 1) != 1) return mi_bad(c, k, "value must be a number");
     v[1] = v[2] = v[0];
     /* The equal-energy spectrum's XYZ (1, 1, 1) in linear sRGB (Mitsuba 3 reads
