@@ -37,7 +37,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's roughness and metallic textures (valo's roughness_map and metallic_map)
           "roughness": ("@tests/data/mitsuba-xml/roughness.xml", {"resx": "160", "resy": "96"}),
           # an environment map turned any way (valo's environment "matrix")
-          "env-turned": ("@tests/data/mitsuba-xml/env-turned.xml", {"resx": "160", "resy": "96"})}
+          "env-turned": ("@tests/data/mitsuba-xml/env-turned.xml", {"resx": "160", "resy": "96"}),
+          # a lamp whose radiance is a bitmap, on a shape without a BSDF (black in Mitsuba)
+          "lamp-texture": ("@tests/data/mitsuba-xml/lamp-texture.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

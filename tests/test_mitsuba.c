@@ -306,6 +306,14 @@ static int env_turned_xml(void) {
   return against_mitsuba_xml_blocks("env-turned", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/env-turned.xml", "resx=160 resy=96", 256, 16, 0.02);
 }
 
+/* A lamp whose radiance is a bitmap, looked up nearest and tiled by to_uv, on a rectangle
+ * without a BSDF (tests/data/mitsuba-xml/lamp-texture.xml): Mitsuba makes such a lamp
+ * black, so it does not reflect the floor's light (read as diffuse 0.5, the lamp seen
+ * directly was 0.8 % too bright and the floor 1.5-4 %). */
+static int lamp_texture_xml(void) {
+  return against_mitsuba_xml_blocks("lamp-texture", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/lamp-texture.xml", "resx=160 resy=96", 256, 16, 0.03);
+}
+
 static int env_spheres(void) {
   if (!shared_file("scenes/envmaps/royal_esplanade_1k.hdr")) return TEST_SKIP; /* the scene reads it from ../shared */
   return against_mitsuba("env-spheres", 256, 32, 0);
@@ -454,6 +462,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

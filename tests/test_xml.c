@@ -134,7 +134,7 @@ static int xml_equals_json(void) {
            "   \"metal\": {\"type\": \"conductor\", \"eta\": [0.2, 0.9, 1.1], \"k\": [3.9, 2.4, 2.1], \"reflectance\": [0.8, 0.8, 0.8],\n"
            "             \"roughness\": 0.3, \"distribution\": \"beckmann\"},\n"
            "   \"glass\": {\"type\": \"dielectric\", \"ior\": %.17g},\n"
-           "   \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"emission\": 8}},\n"
+           "   \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 8}},\n"
            " \"shapes\": [{\"type\": \"rectangle\", \"transform\": {\"scale\": 4, \"rotate_x\": -90}, \"material\": \"white\"},\n"
            "   {\"type\": \"cube\", \"transform\": {\"scale\": 0.5, \"rotate_y\": 30, \"translate\": [-1, 0.5, 0]}, \"material\": \"metal\"},\n"
            "   {\"type\": \"sphere\", \"center\": [1, 0.6, 0], \"radius\": 0.6, \"material\": \"glass\"},\n"

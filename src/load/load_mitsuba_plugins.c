@@ -316,10 +316,11 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
     if (id) snprintf(base, sizeof base, "%.60s", id);
     else snprintf(base, sizeof base, "bsdf@%s", mi_place(c, b, where, sizeof where));
   } else {
-    /* Mitsuba's default BSDF: diffuse, reflectance 0.5 */
+    /* Mitsuba's default BSDF: diffuse, reflectance 0.5, or 0 on a shape that emits */
+    double r = emit ? 0 : 0.5;
     cJSON_AddStringToObject(m, "type", "diffuse");
-    cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
-    snprintf(base, sizeof base, "mitsuba-default");
+    cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){r, r, r}, 3));
+    snprintf(base, sizeof base, emit ? "mitsuba-default-black" : "mitsuba-default");
   }
   if (st) { cJSON_Delete(m); return st; }
   if (emit) {
