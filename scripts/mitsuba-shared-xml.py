@@ -39,7 +39,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # an environment map turned any way (valo's environment "matrix")
           "env-turned": ("@tests/data/mitsuba-xml/env-turned.xml", {"resx": "160", "resy": "96"}),
           # a lamp whose radiance is a bitmap, on a shape without a BSDF (black in Mitsuba)
-          "lamp-texture": ("@tests/data/mitsuba-xml/lamp-texture.xml", {"resx": "160", "resy": "96"})}
+          "lamp-texture": ("@tests/data/mitsuba-xml/lamp-texture.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's twosided of two BSDFs (valo's sided material)
+          "sided": ("@tests/data/mitsuba-xml/sided.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

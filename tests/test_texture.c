@@ -754,6 +754,44 @@ static int blend_mixes(void) {
   return 0;
 }
 
+/* "sided" (Mitsuba's twosided of two BSDFs): a floor of diffuse 0.2 in front (its
+ * winding's normal is +y) and 0.8 behind, seen and lit from above, then from below,
+ * renders as diffuse 0.2, then 0.8, bit for bit (the same hits pick one material); a
+ * sided material holding a blend, and a weight, are refused. */
+static int sided_material(void) {
+  CHECK(scratch_file("mfloor.obj", FLOOR_OBJ), "write");
+  double mean[2][2];
+  for (int side = 0; side < 2; side++)
+    for (int k = 0; k < 2; k++) {
+      const char *mat = k ? (side ? "\"f\": {\"type\": \"diffuse\", \"reflectance\": 0.8}" : "\"f\": {\"type\": \"diffuse\", \"reflectance\": 0.2}")
+                          : "\"a\": {\"type\": \"diffuse\", \"reflectance\": 0.2}, \"b\": {\"type\": \"diffuse\", \"reflectance\": 0.8},"
+                            " \"f\": {\"type\": \"sided\", \"materials\": [\"a\", \"b\"]}";
+      char json[1024];
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0, %d, 0.001], \"look_at\": [0,0,0], \"fov\": 60},\n"
+               "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16, \"max_depth\": 1},\n"
+               "  \"materials\": {%s},\n  \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}],\n"
+               "  \"lights\": [{\"type\": \"point\", \"position\": [0,%d,0], \"intensity\": 10}] }\n",
+               side ? -2 : 2, mat, side ? -3 : 3);
+      mean[side][k] = render_json_mean_green(json);
+      CHECK(mean[side][k] > 0, "render failed");
+    }
+  fprintf(stderr, "sided from the front %.6f (diffuse 0.2: %.6f), from the back %.6f (diffuse 0.8: %.6f)\n", mean[0][0], mean[0][1], mean[1][0], mean[1][1]);
+  CHECK(mean[0][0] == mean[0][1] && mean[1][0] == mean[1][1], "the sided floor is not its front's material above and its back's below");
+  static const struct { const char *mats, *says; } bad[] = {
+      {"\"f\": {\"type\": \"sided\", \"materials\": [\"a\", \"b\"], \"weight\": 0.5}, \"a\": {\"type\": \"diffuse\"}, \"b\": {\"type\": \"diffuse\"}", "unknown key \"weight\""},
+      {"\"f\": {\"type\": \"sided\", \"materials\": [\"a\", \"b\"]}, \"a\": {\"type\": \"diffuse\"}, \"b\": {\"type\": \"blend\"}", "a blend material"}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char json[1024];
+    snprintf(json, sizeof json, "{ \"materials\": {%s}, \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}] }\n", bad[i].mats);
+    valo_scene *sc = NULL;
+    valo_error err;
+    CHECK(valo_scene_load(scratch_file("bad-sided.json", json), &sc, &err) != VALO_OK, "case %zu loaded", i);
+    CHECK(strstr(err.message, bad[i].says) && strstr(err.message, "materials.f"), "case %zu: \"%s\" does not say \"%s\"", i, err.message, bad[i].says);
+  }
+  return 0;
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1080,7 +1118,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"roughness_maps", roughness_maps},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"roughness_maps", roughness_maps},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -135,10 +135,12 @@ static valo_status parse_principled(jctx *c, const cJSON *o, const char *where, 
 }
 
 /* "blend": "materials" names two others of the file (not blends, emitters, nor with maps
- * or opacities of their own: the blend carries those), "weight" the second's share. */
-static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, material *m) {
+ * or opacities of their own: the blend carries those), "weight" the second's share;
+ * "sided" (by_side): the first seen from the front, the second from the back. */
+static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, int by_side, material *m) {
   m->type = MAT_BLEND;
   m->weight = 0.5f;
+  m->blend_by_side = by_side;
   const cJSON *w = cJSON_GetObjectItemCaseSensitive(o, "weight");
   int raw = 0;
   TRY(json_get_bool(c, o, "weight_raw", where, &raw));
@@ -171,7 +173,7 @@ static valo_status parse_blend(jctx *c, const cJSON *o, const char *where, mater
         snprintf(msg, sizeof msg, "\"%.80s\" has its own %s: give it to the blend", n, own[q]);
         return json_bad(c, at, msg);
       }
-    if (t && (!strcmp(t, "blend") || !strcmp(t, "null"))) {
+    if (t && (!strcmp(t, "blend") || !strcmp(t, "sided") || !strcmp(t, "null"))) {
       snprintf(msg, sizeof msg, "\"%.80s\" is a %s material, which a blend cannot hold", n, t);
       return json_bad(c, at, msg);
     }
@@ -186,7 +188,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!cJSON_IsObject(o)) return json_bad(c, where, "must be an object");
   const char *type = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
-  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, null)");
+  if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, sided, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", NULL};
@@ -197,7 +199,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "bump_map", "bump_scale", "smith", NULL};
-  static const char *const k_blend[] = {"type", "weight", "weight_raw", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
+  /* (a sided material takes the same keys but type, weight and weight_raw) */
+  static const char *const k_blend[] = {"weight", "weight_raw", "type", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                         "bump_map", "bump_scale", NULL};
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
@@ -257,9 +260,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   } else if (!strcmp(type, "principled")) {
     TRY(json_check_keys(c, o, where, k_principled));
     TRY(parse_principled(c, o, where, m));
-  } else if (!strcmp(type, "blend")) {
-    TRY(json_check_keys(c, o, where, k_blend));
-    TRY(parse_blend(c, o, where, m));
+  } else if (!strcmp(type, "blend") || !strcmp(type, "sided")) {
+    TRY(json_check_keys(c, o, where, type[0] == 'b' ? k_blend : k_blend + 2));
+    TRY(parse_blend(c, o, where, type[0] == 's', m));
   } else if (!strcmp(type, "plastic")) {
     TRY(json_check_keys(c, o, where, k_plastic));
     m->type = MAT_PLASTIC;
@@ -289,7 +292,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "k", where, &m->k));
     TRY(json_get_rgb(c, o, "reflectance", where, &m->tint));
   } else {
-    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, null)");
+    return json_bad(c, where, "unknown material type (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, sided, null)");
   }
   TRY(get_data_map(c, o, "normal_map", where, "normal map", &m->tex_normal));
   TRY(get_data_map(c, o, "bump_map", where, "bump (height) map", &m->tex_bump));

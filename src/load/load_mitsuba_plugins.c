@@ -111,9 +111,19 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
   if (!type) return mi_bad(c, b, "needs a type");
   b->used = 1;
 #define TYPE(t) cJSON_AddStringToObject(m, "type", t)
-  if (!strcmp(type, "twosided")) {
+  if (!strcmp(type, "twosided") && mi_child(c, b, "bsdf", 1)) {
+    /* two BSDFs: valo's sided material of the two, the first seen from the front */
+    xml_node *in[2] = {mi_child(c, b, "bsdf", 0), mi_child(c, b, "bsdf", 1)};
+    cJSON *names = cJSON_AddArrayToObject(m, "materials");
+    if (!names) return NOMEM;
+    for (int i = 0; i < 2; i++) {
+      char name[160];
+      TRY(mi_material(c, in[i], NULL, in[i], name, sizeof name));
+      cJSON_AddItemToArray(names, cJSON_CreateString(name));
+    }
+    TYPE("sided");
+  } else if (!strcmp(type, "twosided")) {
     /* valo's surfaces scatter from both sides already. */
-    if (mi_child(c, b, "bsdf", 1)) mi_warn(c, b, "valo uses the first BSDF on both sides");
     TRY(wrapped(c, b, m, "front"));
   } else if (!strcmp(type, "normalmap") || !strcmp(type, "bumpmap")) {
     int normal = type[0] == 'n';

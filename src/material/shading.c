@@ -48,6 +48,10 @@ static const material *blend_pick(const scene *s, const ray *r, const isect *it)
   const material *m = it->m;
   uint64_t key = accel_ray_key(r->o, r->d) ^ ((uint64_t)it->tri * 0xD1B54A32D192ED03ull);
   for (int depth = 0; m->type == MAT_BLEND && depth < 8; depth++) {
+    if (m->blend_by_side) {
+      m = &s->mats[m->blend[v3_dot(r->d, it->ng) > 0]];
+      continue;
+    }
     float w = m->weight, px[4];
     if (m->tex_weight >= 0 && (s->tri_flags[it->tri] & TRI_HAS_UVS)) {
       texture_lookup(&s->tex[m->tex_weight], it->u, it->v, px);

@@ -64,6 +64,8 @@ typedef struct material {
   int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
   float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, spec_trans; /* MAT_PRINCIPLED */
   int blend[2];      /* MAT_BLEND: the two materials' indices */
+  int blend_by_side; /* MAT_BLEND: blend[0] seen from the front (the winding's normal side), blend[1] from the back
+                        (JSON "sided", Mitsuba's twosided of two BSDFs), not by weight */
   float weight;      /* MAT_BLEND: blend[1]'s share */
   int tex_weight;    /* MAT_BLEND: a map multiplying weight (its first channel), -1 = none */
   int nonlinear;     /* MAT_PLASTIC: the base's internal scattering tints (Mitsuba's nonlinear) */
