@@ -22,8 +22,7 @@ static valo_status image_file(jctx *c, const char *name, int srgb, const char *w
   valo_error terr;
   *tex = scene_texture_file(c->s, full, srgb, &terr);
   if (*tex >= 0) return VALO_OK;
-  if (terr.status == VALO_ERR_NOMEM) return err_set(c->err, VALO_ERR_NOMEM, "%s", terr.message);
-  snprintf(msg, sizeof msg, "cannot read the %s: %s", what, terr.message);
+  snprintf(msg, sizeof msg, "the %s could not be decoded: %s", what, terr.message);
   return json_bad(c, w, msg);
 }
 
