@@ -6,7 +6,7 @@
 #      test except the long `reference` and `slow` ones;
 #   4. with CI=true (or --fuzz): the libFuzzer harnesses built with clang 14 under
 #      ASan+UBSan in build-fuzz/, each fuzzed from a fixed seed for a fixed number of
-#      runs (about 45 s each; at most VALO_FUZZ_SECONDS, default 60).
+#      runs (25-45 s each on a quiet machine; at most VALO_FUZZ_SECONDS, default 45).
 # VALO_TEST_FULL=1 runs the statistical tests in their full (10x larger) form.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,7 +35,7 @@ if [ "$fuzz" = 1 ]; then
   fi
   rm -rf build-fuzz/fuzz-corpus # the same start as any other run of this commit (configure makes it anew)
   CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVALO_WERROR=ON -DVALO_SANITIZE=ON -DVALO_FUZZ=ON \
-    -DVALO_FUZZ_SECONDS="${VALO_FUZZ_SECONDS:-60}"
+    -DVALO_FUZZ_SECONDS="${VALO_FUZZ_SECONDS:-45}"
   cmake --build build-fuzz -j"$jobs" --target fuzzers
   (cd build-fuzz && UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j"$jobs" -L fuzz)
 fi
