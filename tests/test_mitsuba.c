@@ -169,12 +169,14 @@ static int gaussian_filter(void) {
 /* The same scenes read from Mitsuba's own XML files (tests/data/materials/NAME.xml, written
  * by scripts/mitsuba-materials.py from the scene Mitsuba rendered; its --check-xml renders
  * them in Mitsuba against the EXRs: within 0.15 %, 0.44 % for absorbing-glass's fireflies):
- * valo's .xml reader must give the same images, by the same measure. */
+ * valo's .xml reader must give the same images, by the same measure. Six run at fewer
+ * samples than their JSON twins (it is the reader that is tested here): at each count the
+ * worst block is within 2.1 % (2026-12-06; Sobol counts stay powers of two, 768 gave 3.8 %). */
 static int from_xml(void) {
   static const struct { const char *name; int spp, block; } t[] = {
-      {"gold-rough", 512, 16}, {"copper-smooth", 1024, 16}, {"glass-rough", 1536, 16}, {"glass-smooth", 1024, 32}, {"thin-glass", 1024, 32},
+      {"gold-rough", 512, 16}, {"copper-smooth", 1024, 16}, {"glass-rough", 1024, 16}, {"glass-smooth", 512, 32}, {"thin-glass", 256, 32},
       {"pbr-metal", 512, 16}, {"spot-light", 256, 16}, {"sun-light", 256, 16}, {"ortho-camera", 256, 16}, {"ortho-gaussian", 256, 16},
-      {"textured-quad", 64, 16}, {"smoke-ball", 512, 16}, {"cloud-grid", 512, 16}, {"absorbing-glass", 1536, 32}};
+      {"textured-quad", 64, 16}, {"smoke-ball", 256, 16}, {"cloud-grid", 256, 16}, {"absorbing-glass", 512, 32}};
   int rc = 0;
   for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) rc |= against_ext(t[i].name, "xml", t[i].spp, t[i].block, 0, NULL, -1);
   return rc;

@@ -415,6 +415,30 @@ static int moving_camera_temporal(void) {
   return 0;
 }
 
+/* The code paths of the test above in a form cheap enough for the sanitizer build (which
+ * skips the rate tests, labelled slow): both integrators with temporal reuse along 6
+ * frames of the camera path, 1 sample per pixel; every kept frame finite and lit, and
+ * the last two different (the camera moved). */
+static int moving_camera_sequences(void) {
+  const char *integ[2] = {"restir-di", "restir-gi"};
+  for (int k = 0; k < 2; k++) {
+    frame_log l;
+    if (run_sequence(integ[k], "temporal=1", -1, 1, 6, &l)) return 1;
+    double sum = 0;
+    int bad = 0;
+    for (int f = 0; f < 4; f++)
+      for (size_t i = 0; i < (size_t)W * H * 3; i++) {
+        if (!isfinite(l.frames[f][i]) || l.frames[f][i] < 0) bad++;
+        sum += l.frames[f][i];
+      }
+    int same = !memcmp(l.frames[2], l.frames[3], (size_t)W * H * 3 * sizeof(float));
+    free_log(&l);
+    CHECK(!bad && sum > 0, "%s: %d bad values, sum %g", integ[k], bad, sum);
+    CHECK(!same, "%s: the last two frames are the same image", integ[k]);
+  }
+  return 0;
+}
+
 /* The room with a still camera (its keyframes removed), for reuse tests. */
 static const char *still_room(void) {
   char json[1024];
@@ -572,7 +596,7 @@ int main(int argc, char **argv) {
                                     {"jacobian_solid_angle", jacobian_solid_angle},
                                     {"jacobian_makes_reuse_unbiased", jacobian_makes_reuse_unbiased},
                                     {"keyframes_interpolate", keyframes_interpolate},
-                                    {"moving_camera_temporal", moving_camera_temporal},
+                                    {"moving_camera_temporal", moving_camera_temporal}, {"moving_camera_sequences", moving_camera_sequences},
                                     {"di_reuse_lowers_error", di_reuse_lowers_error},
                                     {"gi_reuse_lowers_error", gi_reuse_lowers_error},
                                     {"reuse_rejects_other_surfaces", reuse_rejects_other_surfaces},
