@@ -63,13 +63,9 @@ static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
     if (strchr(f, '$')) return mi_bad(c, n, "a $parameter in an included file's name is not read");
     if (depth >= MI_INCLUDE_DEPTH) return mi_bad(c, n, "includes nested more than %d deep (does a file include itself?)", MI_INCLUDE_DEPTH);
     if (c->nincluded >= MI_INCLUDE_FILES) return mi_bad(c, n, "more than %d files included", MI_INCLUDE_FILES);
-    const char *slash = strrchr(c->path, '/');
-    int dl = f[0] == '/' || !slash ? 0 : (int)(slash - c->path + 1);
-    size_t len = (size_t)dl + strlen(f) + 1;
-    char *path = malloc(len), **inc = realloc(c->included, (size_t)(c->nincluded + 1) * sizeof *inc);
+    char *path = mi_resolve(c, f), **inc = realloc(c->included, (size_t)(c->nincluded + 1) * sizeof *inc);
     if (inc) c->included = inc;
     if (!path || !inc) { free(path); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
-    snprintf(path, len, "%.*s%s", dl, c->path, f);
     c->included[c->nincluded++] = path;
     struct stat sb;
     if (stat(path, &sb) == 0 && !S_ISREG(sb.st_mode)) return mi_bad(c, n, "%s is not a file", path);

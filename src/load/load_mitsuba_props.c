@@ -34,6 +34,19 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) {
 
 const char *mi_file(const mctx *c, const xml_node *n) { return n->file ? n->file : c->path; }
 
+/* the length of the main file's folder, its slash included (0 for a bare name) */
+static size_t mi_dir_len(const mctx *c) {
+  const char *slash = strrchr(c->path, '/');
+  return slash ? (size_t)(slash - c->path + 1) : 0;
+}
+
+char *mi_resolve(const mctx *c, const char *name) {
+  size_t dl = name[0] == '/' ? 0 : mi_dir_len(c), len = dl + strlen(name) + 1;
+  char *path = malloc(len);
+  if (path) snprintf(path, len, "%.*s%s", (int)dl, c->path, name);
+  return path;
+}
+
 const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
   if (!n->file) {
     snprintf(buf, len, "line%d", n->line);
@@ -41,8 +54,7 @@ const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {
   }
   /* the included file's name as its <include> gave it: the main file's folder is where
    * every relative name starts (expand_includes) */
-  const char *slash = strrchr(c->path, '/');
-  size_t dl = slash ? (size_t)(slash - c->path + 1) : 0;
+  size_t dl = mi_dir_len(c);
   const char *f = !strncmp(n->file, c->path, dl) ? n->file + dl : n->file;
   snprintf(buf, len, "%.60s:line%d", f, n->line);
   return buf;
@@ -304,13 +316,13 @@ static valo_status mi_spectrum_list(mctx *c, xml_node *k, int emitter, rgb *out)
   if (val && file) return mi_bad(c, k, "give value or filename, not both");
   char *text = NULL;
   if (file) {
-    const char *slash = strrchr(c->path, '/');
-    int dl = file[0] == '/' || !slash ? 0 : (int)(slash - c->path + 1);
-    char path[4096];
-    snprintf(path, sizeof path, "%.*s%s", dl, c->path, file);
+    char *path = mi_resolve(c, file);
+    if (!path) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     size_t tl;
     valo_error e2;
-    if (scene_text_read(path, &text, &tl, &e2)) return mi_bad(c, k, "%s", e2.message);
+    valo_status rs = scene_text_read(path, &text, &tl, &e2);
+    free(path);
+    if (rs) return mi_bad(c, k, "%s", e2.message);
     for (char *p = text; *p; p++) /* comments end at the line's end */
       if (*p == '#') while (*p && *p != '\n') *p++ = ' ';
   }

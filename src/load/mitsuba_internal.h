@@ -34,6 +34,9 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 /* The file n was read from: the scene file's path, or an included file's. */
 const char *mi_file(const mctx *c, const xml_node *n);
+/* A file name as the scene gives it, resolved against the main scene file's folder (where
+ * every relative name starts, included files' too): malloc'd, NULL when out of memory. */
+char *mi_resolve(const mctx *c, const char *name);
 /* r = a b (4x4, row-major; r may be a or b). */
 void mi_mat_mul(double r[16], const double a[16], const double b[16]);
 /* Where n is, for names of the materials and media made from unnamed elements: "line12",
