@@ -74,18 +74,18 @@ static int wrap_modes(void) {
   float px[16] = {0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 1, 3, 3, 3, 1};
   t.px = px;
   float o[4];
-  t.wrap = TEX_REPEAT;
+  t.smp.wrap = TEX_REPEAT;
   texture_lookup(&t, 1.125f, 0.5f, o); /* texel 0 again */
   CHECK(fabsf(o[0] - 0) < 1e-6f, "repeat: %g", o[0]);
-  t.wrap = TEX_CLAMP;
+  t.smp.wrap = TEX_CLAMP;
   texture_lookup(&t, 1.125f, 0.5f, o);
   CHECK(fabsf(o[0] - 3) < 1e-6f, "clamp: %g", o[0]);
-  t.wrap = TEX_MIRROR;
+  t.smp.wrap = TEX_MIRROR;
   texture_lookup(&t, 1.125f, 0.5f, o); /* mirrored: texel 3 */
   CHECK(fabsf(o[0] - 3) < 1e-6f, "mirror: %g", o[0]);
   texture_lookup(&t, -0.125f, 0.5f, o);
   CHECK(fabsf(o[0] - 0) < 1e-6f, "mirror below 0: %g", o[0]);
-  t.wrap = TEX_REPEAT;
+  t.smp.wrap = TEX_REPEAT;
   texture_lookup(&t, 0.25f, 0.5f, o); /* halfway between texel 0 and 1 */
   CHECK(fabsf(o[0] - 0.5f) < 1e-6f, "bilinear: %g", o[0]);
   return 0;

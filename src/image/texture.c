@@ -134,7 +134,7 @@ valo_status texture_checkerboard(texture *t, const float c0[3], const float c1[3
     t->px[4 * i + 3] = 1;
   }
   t->w = t->h = 2;
-  t->filter = TEX_NEAREST;
+  t->smp.filter = TEX_NEAREST;
   return VALO_OK;
 }
 
@@ -159,19 +159,19 @@ static int wrap_coord(int i, int n, tex_wrap m) {
 }
 
 void texture_texel(const texture *t, int x, int y, float out[4]) {
-  x = wrap_coord(x, t->w, t->wrap);
-  y = wrap_coord(y, t->h, t->wrap);
+  x = wrap_coord(x, t->w, t->smp.wrap);
+  y = wrap_coord(y, t->h, t->smp.wrap);
   memcpy(out, &t->px[4 * ((size_t)y * t->w + x)], 4 * sizeof(float));
 }
 
 void texture_lookup(const texture *t, float u, float v, float out[4]) {
-  if (t->has_uvm) {
-    float tu = t->uvm[0] * u + t->uvm[1] * v + t->uvm[2];
-    v = t->uvm[3] * u + t->uvm[4] * v + t->uvm[5];
+  if (t->smp.has_uvm) {
+    float tu = t->smp.uvm[0] * u + t->smp.uvm[1] * v + t->smp.uvm[2];
+    v = t->smp.uvm[3] * u + t->smp.uvm[4] * v + t->smp.uvm[5];
     u = tu;
   }
   if (!isfinite(u) || !isfinite(v)) { u = 0; v = 0; }
-  if (t->filter == TEX_NEAREST) {
+  if (t->smp.filter == TEX_NEAREST) {
     float fx = floorf(u * t->w), fy = floorf((1 - v) * t->h);
     if (fabsf(fx) > 1e8f || fabsf(fy) > 1e8f) { fx = 0; fy = 0; }
     texture_texel(t, (int)fx, (int)fy, out);

@@ -11,25 +11,22 @@
 
 typedef enum tex_wrap { TEX_REPEAT, TEX_CLAMP, TEX_MIRROR } tex_wrap;
 typedef enum tex_filter { TEX_BILINEAR, TEX_NEAREST } tex_filter;
-typedef struct texture {
-  int w, h;
-  int has_alpha;
-  float *px;        /* w*h*4, row 0 = top of the image */
+/* How a texture is looked up. */
+typedef struct tex_sampling {
   tex_wrap wrap;
   tex_filter filter;
   int has_uvm;      /* 1: (u, v) becomes (uvm[0] u + uvm[1] v + uvm[2], uvm[3] u + uvm[4] v + uvm[5]) */
   float uvm[6];
+} tex_sampling;
+
+typedef struct texture {
+  int w, h;
+  int has_alpha;
+  float *px;        /* w*h*4, row 0 = top of the image */
+  tex_sampling smp;
   int shares_px;    /* px belongs to another texture (the same image sampled another way) */
   char key[512];    /* path (or embedded id) + colour space (+ sampling), for sharing */
 } texture;
-
-/* How a texture is looked up: texture's wrap, filter, has_uvm and uvm. */
-typedef struct tex_sampling {
-  tex_wrap wrap;
-  tex_filter filter;
-  int has_uvm;
-  float uvm[6];
-} tex_sampling;
 
 /* srgb: decode 8-bit values from sRGB (colour maps) or keep them linear (data maps). */
 valo_status texture_load_file(texture *t, const char *path, int srgb, valo_error *err);
@@ -41,7 +38,7 @@ valo_status texture_load_memory(texture *t, const unsigned char *data, size_t le
  * bottom-right texels, c1 in the others. */
 valo_status texture_checkerboard(texture *t, const float c0[3], const float c1[3], valo_error *err);
 void texture_free(texture *t);
-/* RGBA at (u, v), filtered as t->filter says. */
+/* RGBA at (u, v), sampled as t->smp says. */
 void texture_lookup(const texture *t, float u, float v, float out[4]);
 /* The texel (x, y) itself (x right, y down from the top row). */
 void texture_texel(const texture *t, int x, int y, float out[4]);

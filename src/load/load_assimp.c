@@ -97,7 +97,7 @@ static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial
                      int *wrap_out) {
   int wrap = aiTextureMapMode_Wrap;
   int t = load_slot_image(s, ai, am, type, dir, srgb, &wrap);
-  if (t >= 0) s->tex[t].wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
+  if (t >= 0) s->tex[t].smp.wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
   if (wrap_out) *wrap_out = wrap;
   return t;
 }

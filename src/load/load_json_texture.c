@@ -84,8 +84,7 @@ valo_status json_get_texture(jctx *c, const cJSON *v, int srgb, const char *w, c
     return json_bad(c, w, "\"type\" must be \"bitmap\" or \"checkerboard\"");
   }
   const texture *t = &c->s->tex[*tex];
-  tex_sampling smp = {t->wrap, t->filter, t->has_uvm, {0}};
-  memcpy(smp.uvm, t->uvm, sizeof smp.uvm);
+  tex_sampling smp = t->smp;
   if (wrap) {
     if (!strcmp(wrap, "repeat")) smp.wrap = TEX_REPEAT;
     else if (!strcmp(wrap, "mirror")) smp.wrap = TEX_MIRROR;

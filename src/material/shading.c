@@ -25,8 +25,8 @@ static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
   dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
   float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
-  if (tx->has_uvm) { /* half a texel after the map of the texture coordinates */
-    float su = fmaxf(fabsf(tx->uvm[0]) * tx->w, fabsf(tx->uvm[3]) * tx->h), sv = fmaxf(fabsf(tx->uvm[1]) * tx->w, fabsf(tx->uvm[4]) * tx->h);
+  if (tx->smp.has_uvm) { /* half a texel after the map of the texture coordinates */
+    float su = fmaxf(fabsf(tx->smp.uvm[0]) * tx->w, fabsf(tx->smp.uvm[3]) * tx->h), sv = fmaxf(fabsf(tx->smp.uvm[1]) * tx->w, fabsf(tx->smp.uvm[4]) * tx->h);
     if (su > 1e-6f) hu = 0.5f / su;
     if (sv > 1e-6f) hv = 0.5f / sv;
   }

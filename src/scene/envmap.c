@@ -152,7 +152,7 @@ valo_status envmap_load_cube(envmap *e, const char *const paths[6], float scale,
   for (int i = 0; i < 6 && !st; i++) {
     st = texture_load_file(&faces[i], paths[i], 1, err);
     if (st) break;
-    faces[i].wrap = TEX_CLAMP;
+    faces[i].smp.wrap = TEX_CLAMP;
     if (faces[i].w != faces[i].h || faces[i].w < 1)
       st = err_set(err, VALO_ERR_INVALID, "%s: a cube face must be square (it is %dx%d)", paths[i], faces[i].w, faces[i].h);
     else if (i > 0 && faces[i].w != faces[0].w)

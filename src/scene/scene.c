@@ -153,7 +153,8 @@ int scene_texture_memory(scene *s, const char *name, const unsigned char *data, 
 int scene_texture_sampled(scene *s, int base, const tex_sampling *smp) {
   if (base < 0) return base;
   const texture *b = &s->tex[base];
-  if (b->wrap == smp->wrap && b->filter == smp->filter && b->has_uvm == smp->has_uvm && (!smp->has_uvm || !memcmp(b->uvm, smp->uvm, sizeof b->uvm)))
+  const tex_sampling *bs = &b->smp;
+  if (bs->wrap == smp->wrap && bs->filter == smp->filter && bs->has_uvm == smp->has_uvm && (!smp->has_uvm || !memcmp(bs->uvm, smp->uvm, sizeof bs->uvm)))
     return base;
   char key[600];
   int n = snprintf(key, sizeof key, "%s|w%d|f%d", b->key, (int)smp->wrap, (int)smp->filter);
@@ -161,10 +162,7 @@ int scene_texture_sampled(scene *s, int base, const tex_sampling *smp) {
   int i = find_texture(s, key);
   if (i >= 0) return i;
   texture t = *b;
-  t.wrap = smp->wrap;
-  t.filter = smp->filter;
-  t.has_uvm = smp->has_uvm;
-  memcpy(t.uvm, smp->uvm, sizeof t.uvm);
+  t.smp = *smp;
   t.shares_px = 1;
   return add_texture(s, &t, key);
 }
