@@ -41,7 +41,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # a lamp whose radiance is a bitmap, on a shape without a BSDF (black in Mitsuba)
           "lamp-texture": ("@tests/data/mitsuba-xml/lamp-texture.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's twosided of two BSDFs (valo's sided material)
-          "sided": ("@tests/data/mitsuba-xml/sided.xml", {"resx": "160", "resy": "96"})}
+          "sided": ("@tests/data/mitsuba-xml/sided.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's single-sided BSDFs seen from behind (valo's black_back)
+          "backs": ("@tests/data/mitsuba-xml/backs.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -316,6 +316,13 @@ static int lamp_texture_xml(void) {
   return against_mitsuba_xml_blocks("lamp-texture", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/lamp-texture.xml", "resx=160 resy=96", 256, 16, 0.03);
 }
 
+/* Mitsuba's single-sided BSDFs seen from behind (tests/data/mitsuba-xml/backs.xml): quads
+ * turned away from the camera, lit from its side; black but for the twosided one, the
+ * mask's holes and the principled with transmission. 16x16 blocks. */
+static int backs_xml(void) {
+  return against_mitsuba_xml_blocks("backs", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/backs.xml", "resx=160 resy=96", 256, 16, 0.03);
+}
+
 /* Mitsuba's twosided of two BSDFs (tests/data/mitsuba-xml/sided.xml): quads seen from the
  * front and from the back, whose backs are a rough plastic and a rough conductor; valo's
  * sided material. */
@@ -471,6 +478,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {"backs_xml", backs_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

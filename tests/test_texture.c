@@ -792,6 +792,37 @@ static int sided_material(void) {
   return 0;
 }
 
+/* "black_back": a floor seen and lit from above renders bit for bit as without it; from
+ * below it is black (a plain diffuse there is not); a blend does not take the key (its
+ * materials do). */
+static int black_back_material(void) {
+  CHECK(scratch_file("mfloor.obj", FLOOR_OBJ), "write");
+  double mean[2][2];
+  for (int side = 0; side < 2; side++)
+    for (int k = 0; k < 2; k++) {
+      char json[1024];
+      snprintf(json, sizeof json,
+               "{ \"camera\": {\"position\": [0, %d, 0.001], \"look_at\": [0,0,0], \"fov\": 60},\n"
+               "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
+               "  \"materials\": {\"f\": {\"type\": \"diffuse\", \"reflectance\": 0.8%s}},\n"
+               "  \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}],\n"
+               "  \"lights\": [{\"type\": \"point\", \"position\": [0,%d,0], \"intensity\": 10}] }\n",
+               side ? -2 : 2, k ? ", \"black_back\": true" : "", side ? -3 : 3);
+      mean[side][k] = render_json_mean_green(json);
+      CHECK(mean[side][k] >= 0, "render failed");
+    }
+  fprintf(stderr, "from above %.6f (without black_back %.6f), from below %.6f (without %.6f)\n", mean[0][1], mean[0][0], mean[1][1], mean[1][0]);
+  CHECK(mean[0][0] > 0 && mean[0][1] == mean[0][0], "from the front black_back changed the image");
+  CHECK(mean[1][0] > 0 && mean[1][1] == 0, "from behind: %g (without black_back %g)", mean[1][1], mean[1][0]);
+  const char *bad = "{ \"materials\": {\"a\": {\"type\": \"diffuse\"}, \"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"a\"], \"black_back\": true}},"
+                    " \"shapes\": [{\"file\": \"mfloor.obj\", \"material\": \"f\"}] }\n";
+  valo_scene *sc = NULL;
+  valo_error err;
+  CHECK(valo_scene_load(scratch_file("bad-back.json", bad), &sc, &err) != VALO_OK, "a blend took black_back");
+  CHECK(strstr(err.message, "unknown key \"black_back\"") && strstr(err.message, "materials.f"), "\"%s\"", err.message);
+  return 0;
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1118,7 +1149,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"roughness_maps", roughness_maps},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -411,6 +411,45 @@ static int spectrum_lists(void) {
   return 0;
 }
 
+/* Which Mitsuba BSDFs are black from behind (valo's black_back), as Mitsuba 3.9.1 renders a
+ * quad seen from behind under a constant sky: diffuse, conductors, plastics, principled
+ * without transmission and a shape's default BSDF are; dielectrics, principled with
+ * spec_trans, and whatever a twosided holds are not. A BSDF with an id used alone and in a
+ * twosided of two is two materials; a blend's components each keep their own. */
+static int black_backs(void) {
+  const char *xml = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n"
+                    "<bsdf type=\"diffuse\" id=\"w\"/>\n"
+                    "<shape type=\"rectangle\"><ref id=\"w\"/></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"roughconductor\"/></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"conductor\"/></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"roughplastic\"/></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"principled\"/></shape>\n"
+                    "<shape type=\"rectangle\"/>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"dielectric\"/></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"principled\"><float name=\"spec_trans\" value=\"0.5\"/></bsdf></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"twosided\"><bsdf type=\"roughplastic\"/></bsdf></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"twosided\"><ref id=\"w\"/><bsdf type=\"conductor\"/></bsdf></shape>\n"
+                    "<shape type=\"rectangle\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/><ref id=\"w\"/><bsdf type=\"dielectric\"/>"
+                    "</bsdf></shape>\n</scene>\n";
+  scene *s = mitsuba_scene(scratch_file("backs.xml", xml));
+  CHECK(s, "the scene does not load");
+  CHECK(s->ntris == 22, "%u triangles", s->ntris);
+  static const int want[9] = {1, 1, 1, 1, 1, 1, 0, 0, 0};
+  for (int k = 0; k < 9; k++) {
+    const material *m = &s->mats[s->tri_mat[2 * k]];
+    CHECK(m->black_back == want[k], "shape %d (%s): black_back %d", k, m->name, m->black_back);
+  }
+  const material *sided = &s->mats[s->tri_mat[18]], *blend = &s->mats[s->tri_mat[20]];
+  CHECK(sided->type == MAT_BLEND && sided->blend_by_side, "the twosided of two is not a sided material");
+  for (int k = 0; k < 2; k++)
+    CHECK(!s->mats[sided->blend[k]].black_back, "the twosided's %s (%s) is black from behind", k ? "back" : "front", s->mats[sided->blend[k]].name);
+  CHECK(blend->type == MAT_BLEND && !blend->blend_by_side && !blend->black_back, "the blend");
+  CHECK(s->mats[blend->blend[0]].black_back && !s->mats[blend->blend[1]].black_back, "the blend's diffuse %d, dielectric %d",
+        s->mats[blend->blend[0]].black_back, s->mats[blend->blend[1]].black_back);
+  scene_free(s);
+  return 0;
+}
+
 /* Mitsuba's mask as valo's stochastic opacity: the default 0.5, a number times the default
  * (a mask inside a mask), and a bitmap
  * decoded from sRGB unless raw (the ramp's texel 32 holds 130: 0.510 raw, 0.223 decoded). */
@@ -644,6 +683,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -100,6 +100,12 @@ static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
 static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m);
 static cJSON *vec3_json(double x, double y, double z) { return cJSON_CreateDoubleArray((double[]){x, y, z}, 3); }
 
+/* Mitsuba's diffuse, conductors, plastics, phong and principled without transmission are
+ * black seen from behind, unless inside a twosided. */
+static void one_sided(mctx *c, cJSON *m) {
+  if (!c->twosided) cJSON_AddTrueToObject(m, "black_back");
+}
+
 static valo_status wrapped(mctx *c, xml_node *b, cJSON *m, const char *what) {
   xml_node *in = mi_child(c, b, "bsdf", 0);
   if (!in) return mi_bad(c, b, "needs the %s BSDF inside it", what);
@@ -116,15 +122,19 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     xml_node *in[2] = {mi_child(c, b, "bsdf", 0), mi_child(c, b, "bsdf", 1)};
     cJSON *names = cJSON_AddArrayToObject(m, "materials");
     if (!names) return NOMEM;
+    c->twosided++;
     for (int i = 0; i < 2; i++) {
       char name[160];
       TRY(mi_material(c, in[i], NULL, in[i], name, sizeof name));
       cJSON_AddItemToArray(names, cJSON_CreateString(name));
     }
+    c->twosided--;
     TYPE("sided");
   } else if (!strcmp(type, "twosided")) {
-    /* valo's surfaces scatter from both sides already. */
+    /* the BSDF inside, without its black back: valo's surfaces scatter from both sides */
+    c->twosided++;
     TRY(wrapped(c, b, m, "front"));
+    c->twosided--;
   } else if (!strcmp(type, "normalmap") || !strcmp(type, "bumpmap")) {
     int normal = type[0] == 'n';
     xml_node *tex = NULL;
@@ -191,6 +201,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     cJSON_AddItemToObject(m, "weight", w);
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
+    one_sided(c, m);
     cJSON *v;
     TRY(mi_color(c, b, "reflectance", 0, &v));
     cJSON_AddItemToObject(m, "reflectance", v ? v : cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
@@ -226,6 +237,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
         TRY(set_color(c, b, "specular_reflectance", m, "base_color", 1));
         if (!cJSON_GetObjectItemCaseSensitive(m, "base_color")) cJSON_AddItemToObject(m, "base_color", vec3_json(1, 1, 1));
         TRY(roughness_of(c, b, 0.1, m));
+        one_sided(c, m);
         mi_warn_unused(c, b);
         return VALO_OK;
       }
@@ -239,6 +251,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     (void)mi_prop(c, b, "ext_eta");
     TRY(set_color(c, b, "specular_reflectance", m, "reflectance", 1));
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
+    one_sided(c, m);
   } else if (!strcmp(type, "plastic") || !strcmp(type, "roughplastic")) {
     double in = 1.49, out = 1.000277; /* polypropylene in air, Mitsuba's defaults */
     TRY(ior_prop(c, b, "int_ior", &in));
@@ -255,6 +268,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     TRY(mi_bool(c, b, "nonlinear", &nonlinear));
     cJSON_AddBoolToObject(m, "nonlinear", nonlinear);
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
+    one_sided(c, m);
   } else if (!strcmp(type, "principled")) {
     /* valo's principled: Mitsuba's lobes; anisotropy not modelled */
     TYPE("principled");
@@ -287,6 +301,8 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     double rate;
     static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate", "diffuse_reflectance_sampling_rate"};
     for (int k = 0; k < 3; k++) TRY(mi_float(c, b, rates[k], &rate)); /* how Mitsuba samples: valo's own choice */
+    const cJSON *trans = cJSON_GetObjectItemCaseSensitive(m, "spec_trans");
+    if (!trans || trans->valuedouble == 0) one_sided(c, m); /* with transmission it scatters from behind too */
   } else if (!strcmp(type, "phong")) {
     TYPE("phong");
     TRY(set_color(c, b, "diffuse_reflectance", m, "diffuse", 0));
@@ -294,6 +310,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     double e = 30;
     TRY(mi_float(c, b, "exponent", &e));
     cJSON_AddNumberToObject(m, "exponent", e);
+    one_sided(c, m);
   } else if (!strcmp(type, "null")) {
     TYPE("null");
   } else {
@@ -313,7 +330,7 @@ static valo_status add_material(mctx *c, cJSON *m, const char *name) {
 
 valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, char *name, size_t n) {
   const char *id = b ? xml_attr_get(b, "id") : NULL;
-  if (b && id && !emit) {
+  if (b && id && !emit && !c->twosided) {
     for (int i = 0; i < c->nbsdf_names; i++)
       if (!strcmp(c->bsdf_names[i].id, id)) { snprintf(name, n, "%s", c->bsdf_names[i].name); return VALO_OK; }
   }
@@ -323,13 +340,14 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
   char base[96], where[96];
   if (b) {
     st = translate_bsdf(c, b, m);
-    if (id) snprintf(base, sizeof base, "%.60s", id);
+    if (id) snprintf(base, sizeof base, c->twosided ? "%.60s+twosided" : "%.60s", id); /* twosided: without its black back */
     else snprintf(base, sizeof base, "bsdf@%s", mi_place(c, b, where, sizeof where));
   } else {
     /* Mitsuba's default BSDF: diffuse, reflectance 0.5, or 0 on a shape that emits */
     double r = emit ? 0 : 0.5;
     cJSON_AddStringToObject(m, "type", "diffuse");
     cJSON_AddItemToObject(m, "reflectance", cJSON_CreateDoubleArray((double[]){r, r, r}, 3));
+    one_sided(c, m);
     snprintf(base, sizeof base, emit ? "mitsuba-default-black" : "mitsuba-default");
   }
   if (st) { cJSON_Delete(m); return st; }
@@ -348,7 +366,7 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
     snprintf(name, n, "%s", base);
   }
   TRY(add_material(c, m, name));
-  if (b && id && !emit) {
+  if (b && id && !emit && !c->twosided) {
     void *q = realloc(c->bsdf_names, (size_t)(c->nbsdf_names + 1) * sizeof *c->bsdf_names);
     if (!q) return NOMEM;
     c->bsdf_names = q;

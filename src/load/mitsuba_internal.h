@@ -23,6 +23,7 @@ typedef struct mctx {
   int quiet;           /* no warnings (an instance after a shapegroup's first) */
   struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
+  int twosided;      /* > 0 inside a twosided BSDF: what is translated there scatters from both sides */
 } mctx;
 
 /* The document before its elements are read (load_mitsuba_doc.c): the root is <scene>,

@@ -102,6 +102,7 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   }
   if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
   if (it->m->type == MAT_BLEND) it->m = blend_pick(s, r, it); /* after the blend's own maps */
+  if (it->m->black_back && v3_dot(r->d, it->ng) > 0) it->m = &s->black;
 }
 
 bsdf bsdf_at(const scene *s, const isect *it) {

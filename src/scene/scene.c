@@ -13,6 +13,9 @@
 scene *scene_new(const char *path) {
   scene *s = calloc(1, sizeof *s);
   if (!s) return NULL;
+  s->black = material_default();
+  s->black.kd = c3(0, 0, 0);
+  snprintf(s->black.name, sizeof s->black.name, "black (a black_back material seen from behind)");
   snprintf(s->path, sizeof s->path, "%s", path ? path : "");
   s->cam_medium = MEDIUM_NONE;
   return s;

@@ -47,6 +47,8 @@ typedef struct material {
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
+  int black_back;    /* black seen from behind (the side against the winding's normal): no
+                        scattering there, as Mitsuba's BSDFs outside a twosided (JSON "black_back") */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
   int tex_alpha;     /* alpha-cutout texture (opacity map when alpha_stochastic), -1 = none */
   int tex_normal;    /* tangent-space normal map (linear, OpenGL +Y), -1 = none */
@@ -167,6 +169,7 @@ typedef struct scene {
   uint32_t ntris, cap_tris;
   material *mats;
   uint32_t nmats, cap_mats;
+  material black;    /* what a black_back material is seen from behind: black diffuse */
   struct texture *tex;
   uint32_t ntex, cap_tex;
   nk_curve *nk;            /* spectral conductor data (material.nk), nnk of them */
