@@ -43,7 +43,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's twosided of two BSDFs (valo's sided material)
           "sided": ("@tests/data/mitsuba-xml/sided.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's single-sided BSDFs seen from behind (valo's black_back)
-          "backs": ("@tests/data/mitsuba-xml/backs.xml", {"resx": "160", "resy": "96"})}
+          "backs": ("@tests/data/mitsuba-xml/backs.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's hide_emitters (valo's render.hide_emitters)
+          "hide": ("@tests/data/mitsuba-xml/hide.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -180,11 +180,75 @@ static int default_scene_clean(void) {
   return 0;
 }
 
+/* hide_emitters (Mitsuba's): a floor, a lamp facing the camera and a sky. In every
+ * integrator, pixels whose camera rays all meet the lamp or the sky (the path tracer's
+ * emission-only image is exactly the lamp's or the sky's radiance there) are black with
+ * it, and pixels that see no emitter directly are bit for bit as without it. The AO
+ * integrators draw no emitters either way: their images do not change. */
+static int hide_emitters_every_integrator(void) {
+  CHECK(scratch_file("hfloor.obj", "v -3 0 -3\nv -3 0 3\nv 3 0 3\nv 3 0 -3\nf 1 2 3 4\n") &&
+            scratch_file("hlamp.obj", "v -0.8 0.3 -1\nv 0.8 0.3 -1\nv 0.8 1.7 -1\nv -0.8 1.7 -1\nf 1 2 3 4\n"),
+        "write");
+  const char *json = "{ \"camera\": {\"position\": [0, 1, 4], \"look_at\": [0, 0.6, 0], \"fov\": 50},\n"
+                     "  \"film\": {\"width\": 32, \"height\": 24},\n"
+                     "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5},"
+                     " \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 5}},\n"
+                     "  \"shapes\": [{\"file\": \"hfloor.obj\", \"material\": \"floor\"}, {\"file\": \"hlamp.obj\", \"material\": \"lamp\"}],\n"
+                     "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.25} }\n";
+  int w, h, n = 32 * 24;
+  valo_options o;
+  valo_options_init(&o);
+  o.spp = 8;
+  o.max_depth = 0;
+  float *em = render_json_text(json, &o, &w, &h);
+  CHECK(em && w * h == n, "the emission-only render failed");
+  int lamp = 0, sky = 0, none = 0;
+  for (int i = 0; i < n; i++) {
+    if (em[3 * i] == 5) lamp++;
+    else if (em[3 * i] == 0.25f) sky++;
+    else if (em[3 * i] == 0) none++;
+  }
+  CHECK(lamp > 20 && sky > 100 && none > 100, "%d lamp, %d sky, %d other pixels", lamp, sky, none);
+  static const char *integ[] = {"path", "path-spectral", "whitted", "distribution", "photon", "vpl", "vsl", "restir-di", "restir-gi", "ao", "proximity-ao"};
+  for (size_t k = 0; k < sizeof integ / sizeof integ[0]; k++) {
+    float *img[2];
+    for (int hide = 0; hide < 2; hide++) {
+      valo_options_init(&o);
+      o.spp = 4;
+      int spectral = !strcmp(integ[k], "path-spectral");
+      snprintf(o.integrator, sizeof o.integrator, "%s", spectral ? "path" : integ[k]);
+      if (spectral) o.spectral = 1;
+      if (!strcmp(integ[k], "photon")) snprintf(o.params, sizeof o.params, "global=2000 caustic=0 gather=4");
+      o.hide_emitters = hide;
+      img[hide] = render_json_text(json, &o, &w, &h);
+      CHECK(img[hide], "%s: render failed", integ[k]);
+    }
+    int ao = strstr(integ[k], "ao") != NULL, hidden_bad = 0, kept_bad = 0, changed = 0;
+    for (int i = 0; i < n; i++) {
+      int seen = em[3 * i] == 5 || em[3 * i] == 0.25f;
+      for (int c = 0; c < 3; c++) {
+        if (img[0][3 * i + c] != img[1][3 * i + c]) changed++;
+        if (seen && !ao && img[1][3 * i + c] != 0) hidden_bad++;
+        if (em[3 * i] == 0 && img[0][3 * i + c] != img[1][3 * i + c]) kept_bad++;
+      }
+    }
+    free(img[0]);
+    free(img[1]);
+    fprintf(stderr, "%-14s %d channel values changed; %d not black where an emitter is seen, %d changed where none is\n", integ[k], changed, hidden_bad,
+            kept_bad);
+    CHECK(!hidden_bad && !kept_bad, "%s", integ[k]);
+    CHECK(ao ? changed == 0 : changed >= 3 * (lamp + sky), "%s: %d values changed", integ[k], changed);
+  }
+  free(em);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"whitted_equals_path_mirror", whitted_equals_path_mirror},
                                     {"whitted_darker_in_box", whitted_darker_in_box}, {"whitted_closed_form", whitted_closed_form},
                                     {"distribution_equals_path_at_depth", distribution_equals_path_at_depth},
                                     {"default_scene_clean", default_scene_clean},
+                                    {"hide_emitters_every_integrator", hide_emitters_every_integrator},
                                     {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

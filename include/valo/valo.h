@@ -101,6 +101,10 @@ typedef struct valo_options {
                              camera animation, or a static camera), each at spp samples
                              per pixel, calling the frame callback after each
                              (valo_render_on_frame); VALO_UNSET = one still image */
+  int hide_emitters;      /* non-zero: lights seen directly by camera rays (area lights,
+                             the environment) are not drawn; seen through a mirror or
+                             glass, and the light they cast, they are (Mitsuba's
+                             hide_emitters); VALO_UNSET = no */
 } valo_options;
 
 #define VALO_AOVS_AO 2

@@ -78,6 +78,9 @@ const option_decl option_table[] = {
      .range_text = "a distance in scene units, > 0"},
     {INFO("--spectral", NULL, NULL, "spectral rendering (path): 4 wavelengths per path, dispersion"), R(spectral), .type = OPT_FLAG,
      .hi = 1, .def = 0, .unset = VALO_UNSET},
+    {INFO("--hide-emitters", NULL, "render.hide_emitters",
+          "do not draw lights seen directly by camera rays (area lights,\nthe environment); their light and reflections stay"),
+     R(hide_emitters), .type = OPT_FLAG, .hi = 1, .def = 0, .unset = VALO_UNSET},
     {INFO("--adaptive", NULL, NULL, "adaptive sampling: --spp is the average per pixel; the\nnoisiest pixels get more (spp:FILE writes the count map)"),
      R(adaptive), .type = OPT_FLAG, .hi = VALO_ADAPTIVE_ERROR, .def = 0, .unset = VALO_UNSET},
     {INFO("--adaptive-rule", "R", NULL,
@@ -160,7 +163,7 @@ valo_status option_set(const option_decl *d, const char *value, valo_options *ro
   if (!f) return err_set(err, VALO_ERR_INVALID, "no options to set");
   double v;
   switch (d->type) {
-  case OPT_FLAG: *(int *)f = (int)d->hi; return VALO_OK;
+  case OPT_FLAG: *(int *)f = value && !strcmp(value, "0") ? 0 : (int)d->hi; return VALO_OK; /* "0": a scene file's false */
   case OPT_INT:
   case OPT_INT64:
   case OPT_REAL:

@@ -19,7 +19,7 @@ static int walk_vertex(delta_walk *w, const render_ctx *c, thread_stats *ts) {
   float wgt;
   path_state st0 = path_state_start(w->r.o); /* emission along a delta chain counts fully */
   int surface = path_trace_vertex(c, &w->r, &st0, ts, &w->it, &Le, &wgt);
-  w->L = c3_add(w->L, c3_mul(w->beta, Le));
+  if (w->depth > 0 || !c->hide_emitters) w->L = c3_add(w->L, c3_mul(w->beta, Le)); /* depth 0: the camera ray */
   if (surface && !w->hit_any) { w->first_p = w->it.p; w->hit_any = 1; }
   if (!surface || w->depth >= walk_max_depth(c)) return 0;
   w->wo = v3_neg(w->r.d);

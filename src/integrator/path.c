@@ -38,7 +38,8 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
 }
 
 static rgb path_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
-  return c->s->has_media ? path_radiance_media(c, r, smp, ts, 1) : path_radiance(c, r, smp, ts, 1);
+  int first = !c->hide_emitters;
+  return c->s->has_media ? path_radiance_media(c, r, smp, ts, first) : path_radiance(c, r, smp, ts, first);
 }
 
 const integrator_ops integrator_path = {

@@ -9,7 +9,7 @@ int recursive_vertex(const render_ctx *c, const ray *r, sampler *smp, thread_sta
   hit h;
   int found = ctx_intersect(c, r, &h, ts);
   if (found) isect_from_hit(c->s, r, &h, it);
-  *L = count_emission ? emitted_along(c, r, &h, found, it) : c3(0, 0, 0);
+  *L = count_emission && (depth > 0 || !c->hide_emitters) ? emitted_along(c, r, &h, found, it) : c3(0, 0, 0);
   if (!found || depth >= max_depth) return 0;
   *b = bsdf_at(c->s, it);
   *wo = v3_neg(r->d);

@@ -51,7 +51,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
   sampler_set_dim(smp, SDIM_WAVELENGTH);
   wavelengths wl = wavelengths_sample(sampler_1d(smp));
   if (s->has_media) {
-    spec4 Lm = path_media_walk(c, r, smp, ts, 1, &wl);
+    spec4 Lm = path_media_walk(c, r, smp, ts, !c->hide_emitters, &wl);
     return spec_to_rgb(Lm, &wl);
   }
   spec4 L = spec_const(0), beta = spec_const(1);
@@ -62,7 +62,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
     rgb Le;
     float w;
     int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
-    if (!c3_black(Le)) L = spec_add(L, spec_scale(spec_mul(beta, spec_from_rgb(Le, &wl)), w));
+    if (!c3_black(Le) && (depth > 0 || !c->hide_emitters)) L = spec_add(L, spec_scale(spec_mul(beta, spec_from_rgb(Le, &wl)), w));
     if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
     bsdf b = bsdf_at(s, &it);

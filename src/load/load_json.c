@@ -152,7 +152,10 @@ static valo_status json_settings(jctx *c, const cJSON *o, const char *section) {
     }
     char text[256];
     int name = d->type == OPT_NAME || d->type == OPT_CHOICE;
-    if (!name && cJSON_IsNumber(it)) snprintf(text, sizeof text, "%.17g", it->valuedouble);
+    if (d->type == OPT_FLAG) {
+      if (!cJSON_IsBool(it)) return json_bad(c, key, "must be true or false");
+      snprintf(text, sizeof text, "%d", cJSON_IsTrue(it) ? 1 : 0);
+    } else if (!name && cJSON_IsNumber(it)) snprintf(text, sizeof text, "%.17g", it->valuedouble);
     else if (name && cJSON_IsString(it)) snprintf(text, sizeof text, "%s", it->valuestring);
     else return json_bad(c, key, name ? "must be a string" : "must be a number");
     valo_error e;

@@ -167,6 +167,9 @@ static valo_status read_integrator(mctx *c, xml_node *n) {
   if (type && (!strcmp(type, "path") || !strcmp(type, "volpath") || !strcmp(type, "volpathmis") || !strcmp(type, "prb") || direct)) {
     TRY(mi_int(c, n, "max_depth", &depth));
     (void)mi_prop(c, n, "rr_depth");
+    int hide = 0;
+    TRY(mi_bool(c, n, "hide_emitters", &hide));
+    if (hide && !cJSON_AddTrueToObject(render, "hide_emitters")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     if (direct) { depth = 2; (void)mi_prop(c, n, "emitter_samples"); (void)mi_prop(c, n, "bsdf_samples"); }
   } else {
     mi_warn(c, n, "not an integrator valo has: rendered by path (valo render --integrator chooses another)");
