@@ -45,7 +45,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's single-sided BSDFs seen from behind (valo's black_back)
           "backs": ("@tests/data/mitsuba-xml/backs.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's hide_emitters (valo's render.hide_emitters)
-          "hide": ("@tests/data/mitsuba-xml/hide.xml", {"resx": "160", "resy": "96"})}
+          "hide": ("@tests/data/mitsuba-xml/hide.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's measured conductors by name (valo's conductor presets)
+          "metals": ("@tests/data/mitsuba-xml/metals.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -331,6 +331,12 @@ static int hide_xml(void) {
   return against_mitsuba_xml("hide", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/hide.xml", "resx=160 resy=96", 256, 0.03);
 }
 
+/* Mitsuba's measured conductors by name (tests/data/mitsuba-xml/metals.xml): rough Cr, W,
+ * Ni_palik, TiN, Hg and Ta, smooth Cu2O, Be, Rh and a-C, as valo's conductor presets. */
+static int metals_xml(void) {
+  return against_mitsuba_xml_blocks("metals", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/metals.xml", "resx=160 resy=96", 256, 16, 0.03);
+}
+
 /* Mitsuba's twosided of two BSDFs (tests/data/mitsuba-xml/sided.xml): quads seen from the
  * front and from the back, whose backs are a rough plastic and a rough conductor; valo's
  * sided material. */
@@ -486,6 +492,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {"backs_xml", backs_xml}, {"hide_xml", hide_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {"backs_xml", backs_xml}, {"hide_xml", hide_xml}, {"metals_xml", metals_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -283,7 +283,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
         return json_bad(c, where, "give either \"spectrum\" or \"preset\" / \"eta\" and \"k\", not both");
       TRY(parse_nk_spectrum(c, cJSON_GetObjectItemCaseSensitive(o, "spectrum"), where, m));
     } else if (preset) {
-      if (conductor_preset(preset, &m->eta, &m->k)) return json_bad(c, where, "unknown conductor preset (Au, Ag, Cu, Al)");
+      if (conductor_preset(preset, &m->eta, &m->k))
+        return json_bad(c, where, "unknown conductor preset (Mitsuba's names: Au, Ag, Cu, Al, Cr, Ni_palik, W, ...; docs/scene-format.md lists them)");
     } else {
       if (!cJSON_GetObjectItemCaseSensitive(o, "eta") || !cJSON_GetObjectItemCaseSensitive(o, "k"))
         return json_bad(c, where, "a conductor needs \"preset\" or both \"eta\" and \"k\"");

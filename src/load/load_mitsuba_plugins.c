@@ -242,11 +242,11 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
         return VALO_OK;
       }
       TYPE("mirror");
-    } else if (!strcmp(mat, "Au") || !strcmp(mat, "Ag") || !strcmp(mat, "Cu") || !strcmp(mat, "Al")) {
+    } else if (!conductor_preset(mat, &(rgb){0}, &(rgb){0})) {
       TYPE("conductor");
       cJSON_AddStringToObject(m, "preset", mat);
     } else {
-      return mi_bad(c, b, "valo's conductor presets are Au, Ag, Cu and Al: give eta and k for \"%s\"", mat);
+      return mi_bad(c, b, "valo has no conductor preset \"%s\" (it has Mitsuba's others but AlSb): give eta and k", mat);
     }
     (void)mi_prop(c, b, "ext_eta");
     TRY(set_color(c, b, "specular_reflectance", m, "reflectance", 1));

@@ -382,20 +382,6 @@ valo_status scene_commit(scene *s, valo_error *err) {
   return VALO_OK;
 }
 
-/* Complex indices of refraction sampled at ~650/550/450 nm (the usual RGB stand-ins,
- * from the measured data pbrt and Mitsuba ship). */
-int conductor_preset(const char *name, rgb *eta, rgb *k) {
-  static const struct { const char *n; rgb eta, k; } t[] = {
-      {"Au", {0.143f, 0.374f, 1.442f}, {3.983f, 2.385f, 1.603f}},
-      {"Ag", {0.155f, 0.117f, 0.138f}, {4.828f, 3.122f, 2.147f}},
-      {"Cu", {0.200f, 0.924f, 1.102f}, {3.912f, 2.452f, 2.142f}},
-      {"Al", {1.657f, 0.880f, 0.521f}, {9.224f, 6.270f, 4.837f}},
-  };
-  for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
-    if (!strcmp(name, t[i].n)) { *eta = t[i].eta; *k = t[i].k; return 0; }
-  return -1;
-}
-
 /* Moves an automatic camera along its view axis to the nearest distance at which all
  * eight corners of the bounds fit in the frame (2 % margin) for this aspect: a corner q
  * (relative to the look-at point; x right, y up, z away from the camera) projects inside

@@ -299,6 +299,9 @@ void scene_sphere_point_uv(const sphere_shape *sp, vec3 p, float *u, float *v);
  * v turned up to valo's convention, so a Mitsuba scene's textures land where Mitsuba puts them. */
 typedef enum { PRIM_RECTANGLE, PRIM_CUBE, PRIM_DISK } primitive_kind;
 valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err);
-/* Conductor presets: 0 on success. */
+/* Conductor presets by Mitsuba's material names (scene/conductors.c): 0 on success, -1
+ * for a name it does not hold. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
+int conductor_preset_count(void);
+const char *conductor_preset_name(int i); /* NULL past the end */
 #endif
