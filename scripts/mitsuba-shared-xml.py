@@ -47,7 +47,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's hide_emitters (valo's render.hide_emitters)
           "hide": ("@tests/data/mitsuba-xml/hide.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's measured conductors by name (valo's conductor presets)
-          "metals": ("@tests/data/mitsuba-xml/metals.xml", {"resx": "160", "resy": "96"})}
+          "metals": ("@tests/data/mitsuba-xml/metals.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's anisotropic roughness (valo's roughness_u and roughness_v)
+          "aniso": ("@tests/data/mitsuba-xml/aniso.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

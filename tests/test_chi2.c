@@ -25,7 +25,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 64
+#define CHI2_TESTS 72
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -141,8 +141,8 @@ static int test_bsdf_wo(const char *name, material m, vec3 wo);
 static int test_bsdf(const char *name, material m, float theta_o_deg);
 static double directional_albedo(const material *m, float theta_o_deg, uint64_t seed);
 
-/* Rough conductor (6 tests per distribution, GGX and Beckmann) and rough dielectric
- * seen from outside and inside (4 tests per distribution). */
+/* Rough conductor (6 tests per distribution, GGX and Beckmann, and 2 anisotropic) and
+ * rough dielectric seen from outside and inside (4 per distribution, and 2 anisotropic). */
 static int rough_conductor(void) {
   material m = material_default();
   m.type = MAT_CONDUCTOR;
@@ -157,6 +157,16 @@ static int rough_conductor(void) {
       float t = th[j] * (float)M_PI / 180;
       char name[96];
       snprintf(name, sizeof name, "%s conductor roughness %.1f, theta_o %.0f", beck ? "Beckmann" : "GGX", rough[i], th[j]);
+      rc |= test_bsdf_wo(name, m, v3(sinf(t) * 0.6f, sinf(t) * 0.8f, cosf(t)));
+    }
+  /* anisotropic: roughness u along the frame's s (x), v along t (y), wo off both axes */
+  struct { float ru, rv, th; } an[2] = {{0.2f, 0.7f, 40}, {0.8f, 0.3f, 70}};
+  for (int beck = 0; beck < 2; beck++)
+    for (int i = 0; i < 2; i++) {
+      m.roughness = an[i].ru; m.roughness_v = an[i].rv; m.anisotropic = 1; m.beckmann = beck;
+      float t = an[i].th * (float)M_PI / 180;
+      char name[96];
+      snprintf(name, sizeof name, "%s conductor roughness u %.1f v %.1f, theta_o %.0f", beck ? "Beckmann" : "GGX", an[i].ru, an[i].rv, an[i].th);
       rc |= test_bsdf_wo(name, m, v3(sinf(t) * 0.6f, sinf(t) * 0.8f, cosf(t)));
     }
   return rc;
@@ -243,6 +253,16 @@ static int rough_dielectric(void) {
              cfg[i].inside ? "inside" : "outside");
     rc |= test_bsdf_wo(name, m, v3(sinf(t), 0, cfg[i].inside ? -cosf(t) : cosf(t)));
   }
+  struct { float ru, rv, th; int inside; } an[2] = {{0.3f, 0.7f, 40, 0}, {0.7f, 0.3f, 30, 1}};
+  for (int beck = 0; beck < 2; beck++)
+    for (int i = 0; i < 2; i++) {
+      m.roughness = an[i].ru; m.roughness_v = an[i].rv; m.anisotropic = 1; m.beckmann = beck;
+      float t = an[i].th * (float)M_PI / 180;
+      char name[112];
+      snprintf(name, sizeof name, "%s dielectric roughness u %.1f v %.1f, theta_o %.0f, %s", beck ? "Beckmann" : "GGX", an[i].ru, an[i].rv, an[i].th,
+               an[i].inside ? "inside" : "outside");
+      rc |= test_bsdf_wo(name, m, v3(sinf(t) * 0.6f, sinf(t) * 0.8f, an[i].inside ? -cosf(t) : cosf(t)));
+    }
   return rc;
 }
 
@@ -305,12 +325,15 @@ static int microfacet_furnace(void) {
     m.type = (kind & 1) ? MAT_DIELECTRIC : MAT_CONDUCTOR;
     m.beckmann = kind >> 1;
     m.eta = c3(1e-3f, 1e-3f, 1e-3f); m.k = c3(1e3f, 1e3f, 1e3f); m.ior = 1.5f;
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < 5; i++) {
       for (int j = 0; j < 3; j++) {
-        m.roughness = rough[i];
+        /* the fifth: anisotropic, roughness 0.3 along u and 0.9 along v */
+        m.roughness = i < 4 ? rough[i] : 0.3f;
+        m.roughness_v = 0.9f;
+        m.anisotropic = i == 4;
         double albedo = directional_albedo(&m, th[j], 17);
-        fprintf(stderr, "%s roughness %.1f theta_o %2.0f: albedo %.4f (single-scattering loss %.1f%%)\n", label[kind],
-                rough[i], th[j], albedo, 100 * (1 - albedo));
+        fprintf(stderr, "%s roughness %s%.1f theta_o %2.0f: albedo %.4f (single-scattering loss %.1f%%)\n", label[kind], i < 4 ? "" : "u 0.3 v ",
+                i < 4 ? rough[i] : 0.9f, th[j], albedo, 100 * (1 - albedo));
         CHECK(albedo <= 1.0 + 5e-3, "albedo %.4f > 1", albedo);
         /* At normal incidence only 1/(1 + alpha^2) of the cosine-weighted normals reflect
          * above the horizon: 0.5 at roughness 1, before shadowing. */
@@ -375,10 +398,10 @@ static int ggx_albedo(void) {
  * by 1 - F(n.wo) (bsdf.c says why); it is checked for the sampling agreement only, and its
  * specular layer (white metal; black base colour) for reciprocity. */
 static int bsdf_reciprocity(void) {
-  enum { N = 8 };
+  enum { N = 10 };
   material ms[N];
   const char *names[N] = {"diffuse", "phong n=20", "glTF PBR half-metal", "rough gold", "rough glass 0.3", "rough glass 0.7", "glTF PBR metal",
-                          "glTF PBR black base"};
+                          "glTF PBR black base", "rough gold u 0.2 v 0.6", "rough glass u 0.6 v 0.25"};
   for (int i = 0; i < N; i++) ms[i] = material_default();
   ms[6].type = MAT_PBR; ms[6].kd = c3(1, 1, 1); ms[6].metallic = 1; ms[6].roughness = 0.3f;
   ms[7].type = MAT_PBR; ms[7].kd = c3(0, 0, 0); ms[7].metallic = 0; ms[7].roughness = 0.6f;
@@ -388,6 +411,8 @@ static int bsdf_reciprocity(void) {
   ms[3].type = MAT_CONDUCTOR; ms[3].eta = c3(0.143f, 0.374f, 1.442f); ms[3].k = c3(3.983f, 2.385f, 1.603f); ms[3].roughness = 0.4f;
   ms[4].type = MAT_DIELECTRIC; ms[4].ior = 1.5f; ms[4].roughness = 0.3f;
   ms[5].type = MAT_DIELECTRIC; ms[5].ior = 1.5f; ms[5].roughness = 0.7f;
+  ms[8] = ms[3]; ms[8].roughness = 0.2f; ms[8].roughness_v = 0.6f; ms[8].anisotropic = 1;
+  ms[9] = ms[4]; ms[9].roughness = 0.6f; ms[9].roughness_v = 0.25f; ms[9].anisotropic = 1;
   for (int i = 0; i < N; i++) {
     bsdf b = bsdf_from_material(&ms[i]);
     int transmits = b.type == BSDF_ROUGH_DIELECTRIC, reciprocal = i != 2;

@@ -155,7 +155,7 @@ static int bad_mitsuba(void) {
        "mx5.xml:3: <spectrum name=\"reflectance\">", "increasing wavelengths"},
       {"mx6.xml", "<scene version=\"3.0.0\">\n" SENSOR "<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/>\n"
        "<transform name=\"to_world\"><matrix value=\"1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1\"/></transform></emitter>\n</scene>", "mx6.xml:3: <emitter type=\"envmap\">", "not shear it"},
-      {"mx7.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>"
+      {"mx7.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><string name=\"material\" value=\"none\"/><float name=\"alpha_u\" value=\"0.1\"/>"
        "<float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>\n</scene>", "mx7.xml:3", "isotropic"},
       {"mx8.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"dielectric\"><float name=\"int_ior\" value=\"1\"/>"
        "<float name=\"ext_ior\" value=\"1.33\"/></bsdf></shape>\n</scene>", "mx8.xml:3", "int_ior >= ext_ior"},

@@ -964,6 +964,47 @@ static int roughness_maps(void) {
   return 0;
 }
 
+/* Anisotropic roughness (roughness_u along the surface's u direction, roughness_v along
+ * v) on a rough aluminium floor lit across it: equal values render bit for bit as
+ * "roughness"; u 0.2, v 0.6 differs from its swap by more than 1 %; and on a floor whose
+ * texture coordinates are turned by 90 degrees it renders as the swap does on the first
+ * (within 0.3 %: the frame follows the UVs). One of the two alone, or with roughness, is
+ * refused. */
+static int anisotropic_roughness(void) {
+  CHECK(scratch_file("rfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n") &&
+            scratch_file("rfloor-turned.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nf 1/1 2/2 3/3 4/4\n"),
+        "write");
+  double iso = floor_mean("{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness\": 0.4}");
+  double same = floor_mean("{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness_u\": 0.4, \"roughness_v\": 0.4}");
+  double a = floor_mean("{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness_u\": 0.2, \"roughness_v\": 0.6}");
+  double b = floor_mean("{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness_u\": 0.6, \"roughness_v\": 0.2}");
+  char json[1500];
+  snprintf(json, sizeof json,
+           "{ \"camera\": {\"position\": [0, 1.5, 2.5], \"look_at\": [0, 0, 0], \"fov\": 50},\n"
+           "  \"film\": {\"width\": 32, \"height\": 32}, \"render\": {\"spp\": 64, \"max_depth\": 1},\n"
+           "  \"materials\": {\"f\": {\"type\": \"conductor\", \"preset\": \"Al\", \"roughness_u\": 0.2, \"roughness_v\": 0.6}},\n"
+           "  \"shapes\": [{\"file\": \"rfloor-turned.obj\", \"material\": \"f\"}],\n"
+           "  \"lights\": [{\"type\": \"point\", \"position\": [0, 2, -0.5], \"intensity\": 10}] }\n");
+  double turned = render_json_mean_green(json);
+  fprintf(stderr, "roughness 0.4 %.6f, u = v = 0.4 %.6f; u 0.2 v 0.6 %.6f, u 0.6 v 0.2 %.6f; u 0.2 v 0.6 on the turned UVs %.6f\n", iso, same, a, b, turned);
+  CHECK(iso > 0 && same == iso, "u = v = 0.4 is not roughness 0.4");
+  CHECK(a > 0 && b > 0 && fabs(a / b - 1) > 0.01, "u and v swapped render alike: %.6f, %.6f", a, b);
+  CHECK(turned > 0 && fabs(turned / b - 1) < 0.003, "on turned UVs %.6f, the swap on the first %.6f", turned, b);
+  static const struct { const char *mat, *says; } bad[] = {
+      {"{\"type\": \"conductor\", \"preset\": \"Au\", \"roughness_u\": 0.2}", "give both roughness_u and roughness_v"},
+      {"{\"type\": \"dielectric\", \"roughness\": 0.3, \"roughness_u\": 0.2, \"roughness_v\": 0.5}", "not both"},
+      {"{\"type\": \"plastic\", \"roughness_u\": 0.2, \"roughness_v\": 0.5}", "unknown key \"roughness_u\""}};
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char text[600];
+    snprintf(text, sizeof text, "{ \"materials\": {\"f\": %s}, \"shapes\": [{\"file\": \"rfloor.obj\", \"material\": \"f\"}] }\n", bad[i].mat);
+    valo_scene *sc = NULL;
+    valo_error err;
+    CHECK(valo_scene_load(scratch_file("bad-aniso.json", text), &sc, &err) != VALO_OK, "case %zu loaded", i);
+    CHECK(strstr(err.message, bad[i].says) && strstr(err.message, "materials.f"), "case %zu: \"%s\" does not say \"%s\"", i, err.message, bad[i].says);
+  }
+  return 0;
+}
+
 /* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
@@ -1149,7 +1190,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

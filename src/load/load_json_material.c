@@ -194,9 +194,9 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "black_back", "bump_map", "bump_scale", "smith", NULL};
   /* (a sided material takes the same keys but type, weight and weight_raw) */
@@ -311,6 +311,18 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   double rough = m->roughness;
   TRY(json_get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;
+  /* anisotropic: roughness along the surface's u direction and along v */
+  int has_u = cJSON_GetObjectItemCaseSensitive(o, "roughness_u") != NULL, has_v = cJSON_GetObjectItemCaseSensitive(o, "roughness_v") != NULL;
+  if (has_u || has_v) {
+    if (!has_u || !has_v) return json_bad(c, where, "give both roughness_u and roughness_v");
+    if (cJSON_GetObjectItemCaseSensitive(o, "roughness")) return json_bad(c, where, "give roughness, or roughness_u and roughness_v, not both");
+    double ru = 0, rv = 0;
+    TRY(json_get_num(c, o, "roughness_u", where, 0, 1, &ru));
+    TRY(json_get_num(c, o, "roughness_v", where, 0, 1, &rv));
+    m->roughness = (float)ru;
+    m->roughness_v = (float)rv;
+    m->anisotropic = ru != rv;
+  }
   /* maps (linear unless they say otherwise) multiplying roughness (or alpha, its square)
    * and metallic by their value, the mean of their channels */
   TRY(get_data_map(c, o, "roughness_map", where, "roughness map", &m->tex_rough));

@@ -42,7 +42,7 @@ static valo_status ior_prop(mctx *c, xml_node *b, const char *name, double *v) {
 static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m) {
   double a = def_alpha, au = -1, av = -1;
   for (const char *const *n = (const char *const[]){"alpha_u", "alpha_v", NULL}; *n; n++)
-    if (mi_prop(c, b, *n) && !strcmp(mi_prop(c, b, *n)->name, "texture")) return mi_bad(c, b, "valo's microfacets are isotropic: %s cannot be a texture", *n);
+    if (mi_prop(c, b, *n) && !strcmp(mi_prop(c, b, *n)->name, "texture")) return mi_bad(c, b, "valo reads %s as a number, not a texture", *n);
   xml_node *ak = mi_prop(c, b, "alpha");
   if (ak && !strcmp(ak->name, "texture")) {
     /* valo's roughness 1 with a map multiplying alpha: alpha = the texture's value */
@@ -58,22 +58,31 @@ static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m
   }
   TRY(mi_float(c, b, "alpha_u", &au));
   TRY(mi_float(c, b, "alpha_v", &av));
+  const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
+  int aniso = 0;
   if (au >= 0 || av >= 0) {
-    if (au != av) return mi_bad(c, b, "valo's microfacets are isotropic: alpha_u and alpha_v must be equal");
+    if (!(au >= 0 && av >= 0)) return mi_bad(c, b, "give both alpha_u and alpha_v");
     if (cJSON_GetObjectItemCaseSensitive(m, "roughness_map")) return mi_bad(c, b, "an alpha texture and alpha_u, alpha_v: give one or the other");
+    if (!(au <= 1 && av <= 1)) return mi_bad(c, b, "alpha_u and alpha_v must be in [0, 1]");
+    aniso = au != av;
+    /* valo's pbr metal (a conductor of material none) and plastic are isotropic */
+    if (aniso && t && strcmp(t, "conductor") && strcmp(t, "dielectric")) return mi_bad(c, b, "valo's %s is isotropic: alpha_u and alpha_v must be equal", t);
     a = au;
   }
   if (!(a >= 0 && a <= 1)) return mi_bad(c, b, "alpha must be in [0, 1]");
   const char *dist = "beckmann";
   TRY(mi_string(c, b, "distribution", &dist));
   if (strcmp(dist, "ggx") && strcmp(dist, "beckmann")) return mi_bad(c, b, "distribution must be beckmann or ggx");
-  const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
   if (t && !strcmp(t, "pbr")) {
     if (strcmp(dist, "ggx")) mi_warn(c, b, "rendered with GGX (valo's pbr material): this %s distribution of the same alpha is not", dist);
   } else if (!cJSON_AddStringToObject(m, "distribution", dist) || !cJSON_AddStringToObject(m, "smith", "separable")) {
     return NOMEM; /* Mitsuba's Smith G is the separable one */
   }
   (void)mi_prop(c, b, "sample_visible"); /* the sampling strategy changes the noise, not the image */
+  if (aniso) { /* along the surface's u direction, and along v */
+    if (!cJSON_AddNumberToObject(m, "roughness_u", sqrt(au)) || !cJSON_AddNumberToObject(m, "roughness_v", sqrt(av))) return NOMEM;
+    return VALO_OK;
+  }
   if (!cJSON_AddNumberToObject(m, "roughness", sqrt(a))) return NOMEM; /* valo's alpha = roughness^2 */
   return VALO_OK;
 }

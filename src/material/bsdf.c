@@ -71,8 +71,13 @@ bsdf bsdf_from_material(const material *m) {
     return b;
   }
   }
-  b.alpha = m->roughness * m->roughness;
-  if (b.alpha >= 1e-3f) {
+  b.alpha = b.alpha_v = m->roughness * m->roughness;
+  if (m->anisotropic && (b.type == BSDF_CONDUCTOR || b.type == BSDF_DIELECTRIC)) {
+    /* rough if either way is; the other then no smoother than GGX's near-mirror */
+    b.alpha_v = m->roughness_v * m->roughness_v;
+    if (fmaxf(b.alpha, b.alpha_v) >= 1e-3f) b.alpha = fmaxf(b.alpha, 1e-3f), b.alpha_v = fmaxf(b.alpha_v, 1e-3f);
+  }
+  if (fmaxf(b.alpha, b.alpha_v) >= 1e-3f) {
     if (b.type == BSDF_CONDUCTOR) b.type = BSDF_ROUGH_CONDUCTOR;
     else if (b.type == BSDF_DIELECTRIC) b.type = BSDF_ROUGH_DIELECTRIC;
   }
@@ -135,7 +140,7 @@ static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
   float etap;
   if (!rd_half(b, wo, wi, &wm, &etap)) return c3(0, 0, 0);
   float F = fresnel_dielectric(v3_dot(wo, wm), b->eta);
-  float D = mf_D(b->beckmann, b->alpha, wm), G = mf_G(b->beckmann, b->separable, b->alpha, wo, wi);
+  float D = mfa_D(b->beckmann, b->alpha, b->alpha_v, wm), G = mfa_G(b->beckmann, b->separable, b->alpha, b->alpha_v, wo, wi);
   float v;
   if (etap == 1) v = D * G * F / fabsf(4 * wi.z * wo.z);
   else {
@@ -150,10 +155,10 @@ static float rd_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (!rd_half(b, wo, wi, &wm, &etap)) return 0;
   float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;
   float pdf;
-  if (etap == 1) pdf = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm))) * R / (R + T);
+  if (etap == 1) pdf = mfa_pdf_m(b->beckmann, b->alpha, b->alpha_v, wo, wm) / (4 * fabsf(v3_dot(wo, wm))) * R / (R + T);
   else {
     float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap);
-    pdf = mf_pdf_m(b->beckmann, b->alpha, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
+    pdf = mfa_pdf_m(b->beckmann, b->alpha, b->alpha_v, wo, wm) * fabsf(v3_dot(wi, wm)) / denom * T / (R + T);
   }
   return pdf;
 }
@@ -185,7 +190,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_PRINCIPLED: return principled_eval(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
-    float dg = mf_D(b->beckmann, b->alpha, wm) * mf_G(b->beckmann, b->separable, b->alpha, wo, wi) / (4 * wo.z * wi.z);
+    float dg = mfa_D(b->beckmann, b->alpha, b->alpha_v, wm) * mfa_G(b->beckmann, b->separable, b->alpha, b->alpha_v, wo, wi) / (4 * wo.z * wi.z);
     rgb F = conductor_F(b, fabsf(v3_dot(wo, wm)));
     return c3_scale(F, dg);
   }
@@ -208,7 +213,7 @@ float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   case BSDF_PRINCIPLED: return principled_pdf(b, wo, wi);
   case BSDF_ROUGH_CONDUCTOR: {
     vec3 wm = v3_norm(v3_add(wo, wi));
-    float p = mf_pdf_m(b->beckmann, b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
+    float p = mfa_pdf_m(b->beckmann, b->alpha, b->alpha_v, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
     return p;
   }
   }
@@ -302,7 +307,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     return principled_sample(b, wo, ulobe, u1, u2, s) && sample_finite(s);
   case BSDF_ROUGH_CONDUCTOR: {
     if (wo.z <= 0) return 0;
-    vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
+    vec3 wm = mfa_sample(b->beckmann, b->alpha, b->alpha_v, wo, u1, u2);
     s->wi = v3_reflect(wo, wm);
     if (s->wi.z <= 0) return 0;
     s->pdf = bsdf_pdf(b, wo, s->wi);
@@ -311,7 +316,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   }
   case BSDF_ROUGH_DIELECTRIC: {
     if (wo.z == 0) return 0;
-    vec3 wm = mf_sample(b->beckmann, b->alpha, wo, u1, u2);
+    vec3 wm = mfa_sample(b->beckmann, b->alpha, b->alpha_v, wo, u1, u2);
     /* Beckmann samples normals wo cannot see: lost (GGX samples only visible ones). */
     if (b->beckmann && v3_dot(wo, wm) * wo.z <= 0) return 0;
     float R = fresnel_dielectric(v3_dot(wo, wm), b->eta), T = 1 - R;

@@ -1,5 +1,5 @@
-/* microfacet.h — owns the isotropic microfacet distributions, in the local frame (z =
- * normal):
+/* microfacet.h — owns the microfacet distributions, in the local frame (z = normal),
+ * isotropic (below) and anisotropic (the mfa_ functions at the end):
  * - Trowbridge-Reitz (GGX): D(wm) = 1 / (pi a^2 cos^4 (1 + tan^2/a^2)^2), Smith
  *   Lambda(w) = (sqrt(1 + a^2 tan^2) - 1)/2, sampled by visible normals (Heitz 2018,
  *   "Sampling the GGX distribution of visible normals"), whose density is
@@ -144,5 +144,50 @@ static inline float mf_pdf_m(int beck, float a, vec3 w, vec3 wm) {
 }
 static inline vec3 mf_sample(int beck, float a, vec3 w, float u1, float u2) {
   return beck ? beckmann_sample_visible(a, w, u1, u2) : ggx_sample_visible(a, w, u1, u2);
+}
+
+/* Anisotropic roughness (ax along the frame's s axis, ay along t; Heitz 2014,
+ * "Understanding the masking-shadowing function", section 5): both distributions are
+ * the isotropic one of unit roughness stretched by (ax, ay), so
+ *   GGX D(wm) = 1 / (pi ax ay cos^4 (1 + (x^2/ax^2 + y^2/ay^2)/z^2)^2),
+ *   Beckmann D(wm) = exp(-(x^2/ax^2 + y^2/ay^2)/z^2) / (pi ax ay cos^4),
+ * Lambda(w) is the isotropic Lambda of the direction's own roughness
+ *   a(w) = sqrt((x^2 ax^2 + y^2 ay^2) / (x^2 + y^2)),
+ * and visible normals are sampled in the stretched frame and unstretched. The mfa_
+ * functions fall back to the isotropic ones, bit for bit, when ax == ay. */
+static inline float mf_alpha_dir(float ax, float ay, vec3 w) {
+  float s2 = w.x * w.x + w.y * w.y;
+  if (!(s2 > 0)) return ax;
+  return sqrtf((w.x * w.x * ax * ax + w.y * w.y * ay * ay) / s2);
+}
+static inline float mfa_D(int beck, float ax, float ay, vec3 wm) {
+  if (ax == ay) return mf_D(beck, ax, wm);
+  float c2 = wm.z * wm.z;
+  if (!(c2 > 0)) return 0;
+  float e = (wm.x * wm.x / (ax * ax) + wm.y * wm.y / (ay * ay)) / c2;
+  if (beck) return expf(-e) / (PI_F * ax * ay * c2 * c2);
+  return 1 / (PI_F * ax * ay * c2 * c2 * (1 + e) * (1 + e));
+}
+static inline float mfa_lambda(int beck, float ax, float ay, vec3 w) {
+  float a = mf_alpha_dir(ax, ay, w);
+  return beck ? beckmann_lambda(a, w) : ggx_lambda(a, w);
+}
+static inline float mfa_G(int beck, int sep, float ax, float ay, vec3 wo, vec3 wi) {
+  if (ax == ay) return mf_G(beck, sep, ax, wo, wi);
+  float lo = mfa_lambda(beck, ax, ay, wo), li = mfa_lambda(beck, ax, ay, wi);
+  return sep ? 1 / ((1 + lo) * (1 + li)) : 1 / (1 + lo + li);
+}
+static inline float mfa_pdf_m(int beck, float ax, float ay, vec3 w, vec3 wm) {
+  if (ax == ay) return mf_pdf_m(beck, ax, w, wm);
+  float c = fabsf(w.z);
+  if (!(c > 0)) return 0;
+  return mfa_D(beck, ax, ay, wm) * fabsf(v3_dot(w, wm)) / (c * (1 + mfa_lambda(beck, ax, ay, w)));
+}
+static inline vec3 mfa_sample(int beck, float ax, float ay, vec3 w, float u1, float u2) {
+  if (ax == ay) return mf_sample(beck, ax, w, u1, u2);
+  if (w.z < 0) w = v3_neg(w);
+  vec3 ws = v3_norm(v3(ax * w.x, ay * w.y, w.z)); /* the unit-roughness frame */
+  vec3 m = mf_sample(beck, 1, ws, u1, u2);
+  return v3_norm(v3(ax * m.x, ay * m.y, fmaxf(1e-6f, m.z)));
 }
 #endif

@@ -41,6 +41,24 @@ static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   if (v3_len2(nb) > 1e-30f && v3_finite(nb)) it->ns = v3_norm(nb);
 }
 
+/* The direction of increasing u on triangle ix (the UV derivative dp/du); without texture
+ * coordinates (or with degenerate ones) the triangle's first edge, which is dp/du of the
+ * barycentric coordinates Mitsuba then takes as u and v. */
+static vec3 surface_dpdu(const scene *s, const isect *it, const uint32_t *ix) {
+  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]);
+  if (s->tri_flags[it->tri] & TRI_HAS_UVS) {
+    vec3 e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
+    float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
+    float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
+    float det = du1 * dv2 - du2 * dv1;
+    if (fabsf(det) > 1e-20f) {
+      vec3 d = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), 1 / det);
+      if (v3_len2(d) > 1e-30f && v3_finite(d)) return d;
+    }
+  }
+  return e1;
+}
+
 /* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
  * of the ray and the triangle (as stochastic opacity is): over rays the hit scatters as
  * (1 - w) f0 + w f1. Blends inside blends are chosen in turn (at most 8 deep). */
@@ -103,6 +121,7 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
   if (it->m->type == MAT_BLEND) it->m = blend_pick(s, r, it); /* after the blend's own maps */
   if (it->m->black_back && v3_dot(r->d, it->ng) > 0) it->m = &s->black;
+  if (it->m->anisotropic) it->dpdu = surface_dpdu(s, it, ix);
 }
 
 bsdf bsdf_at(const scene *s, const isect *it) {
@@ -117,7 +136,9 @@ bsdf bsdf_at(const scene *s, const isect *it) {
   if (m->tex_rough >= 0) {
     texture_lookup(&s->tex[m->tex_rough], it->u, it->v, px);
     float r = fmaxf((px[0] + px[1] + px[2]) / 3, 0);
-    mm.roughness *= m->rough_is_alpha ? sqrtf(r) : r;
+    float f = m->rough_is_alpha ? sqrtf(r) : r;
+    mm.roughness *= f;
+    mm.roughness_v *= f;
   }
   if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
   return bsdf_from_material(&mm);
@@ -138,6 +159,14 @@ frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
     if (v3_dot(it->ng, wo) < 0) it->ng = v3_neg(it->ng);
     if (v3_dot(ns, wo) < 0) ns = v3_neg(ns);
   }
-  return frame_from_n(ns);
+  frame f = frame_from_n(ns);
+  if (bsdf_anisotropic(b)) { /* s along the surface's u direction (Gram-Schmidt against ns) */
+    vec3 t = v3_sub(it->dpdu, v3_scale(ns, v3_dot(ns, it->dpdu)));
+    if (v3_len2(t) > 1e-20f && v3_finite(t)) {
+      f.s = v3_norm(t);
+      f.t = v3_cross(ns, f.s);
+    }
+  }
+  return f;
 }
 

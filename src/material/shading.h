@@ -16,6 +16,7 @@ typedef struct isect {
   float u, v;
   uint32_t tri;
   const material *m;
+  vec3 dpdu;          /* an anisotropic material's u direction at the hit (shading_frame's s) */
 } isect;
 
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);

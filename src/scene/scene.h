@@ -39,6 +39,8 @@ typedef struct material {
   rgb eta, k;
   rgb tint;          /* conductor: multiplies its Fresnel reflectance (Mitsuba's specular_reflectance), 1 by default */
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
+  int anisotropic;   /* conductor/dielectric: roughness along the surface's u direction, roughness_v along v */
+  float roughness_v;
   float metallic;    /* MAT_PBR: 0 dielectric .. 1 metal */
   int beckmann;      /* conductor/dielectric roughness: Beckmann's distribution (JSON "distribution"), else GGX */
   int smith_separable; /* conductor/dielectric/plastic roughness: Smith's separable G (JSON "smith"), else height-correlated */
