@@ -39,7 +39,12 @@ PRINCIPLED = [
     ('glass-0.3', dict(type='principled', base_color=rgb([0.9, 0.95, 1.0]), spec_trans=1.0, roughness=0.3)),
     ('half-trans', dict(type='principled', base_color=rgb([0.8, 0.5, 0.3]), spec_trans=0.5, metallic=0.2, roughness=0.5, eta=1.33,
                         clearcoat=0.5)),
+    ('aniso-0.7', dict(type='principled', base_color=rgb([0.7, 0.5, 0.3]), metallic=0.6, roughness=0.4, anisotropic=0.7)),
+    ('aniso-glass', dict(type='principled', base_color=rgb([0.9, 0.9, 1.0]), spec_trans=1.0, roughness=0.35, anisotropic=0.5)),
 ]
+# for the anisotropic cases, also pairs at other azimuths (the frame's s is +x)
+DIRS_A = [(30, 45, 40, 225), (50, 90, 45, 270), (20, 30, 60, 200), (70, 120, 50, 300), (40, 10, 40, 190), (60, 80, 30, 250),
+          (15, 135, 65, 315), (80, 45, 75, 225), (35, 60, 25, 240), (55, 160, 50, 340)]
 # for the transmissive cases, also light below the surface and the viewer inside
 DIRS_T = [(30, 0, 150, 180), (10, 0, 170, 0), (60, 0, 130, 200), (45, 0, 100, 180), (140, 0, 150, 180), (150, 0, 40, 180),
           (120, 0, 60, 0), (170, 0, 30, 170), (100, 0, 20, 180), (160, 0, 120, 30)]
@@ -58,7 +63,7 @@ print('# Mitsuba %s, scalar_rgb: name theta_wo phi_wo theta_wi phi_wi %s' %
       (mi.__version__, 'specular(rgb) diffuse(rgb)' if plastic else 'f*cos(rgb)'))
 for name, d in (PLASTIC if plastic else PRINCIPLED):
     b = mi.load_dict(d)
-    for (to, po, ti, pi) in DIRS + (DIRS_T if not plastic and 'spec_trans' in d else []):
+    for (to, po, ti, pi) in DIRS + (DIRS_T if not plastic and 'spec_trans' in d else []) + (DIRS_A if 'anisotropic' in d else []):
         si = mi.SurfaceInteraction3f()
         si.wi = unit(to, po)
         si.sh_frame = mi.Frame3f(mi.Vector3f(0, 0, 1))

@@ -25,7 +25,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 72
+#define CHI2_TESTS 74
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -233,6 +233,16 @@ static int principled(void) {
     snprintf(name, sizeof name, "principled spec_trans %.1f roughness %.1f, theta_o %.0f, %s", tc[i].trans, tc[i].rough, tc[i].th,
              tc[i].inside ? "inside" : "outside");
     rc |= test_bsdf_wo(name, m, v3(sinf(t), 0, tc[i].inside ? -cosf(t) : cosf(t)));
+  }
+  /* anisotropic (Mitsuba's `anisotropic`): a half metal from outside, a glass from inside */
+  for (int i = 0; i < 2; i++) {
+    material m = material_default();
+    m.type = MAT_PRINCIPLED; m.ior = 1.5f; m.kd = c3(0.7f, 0.5f, 0.3f); m.roughness = 0.4f; m.anisotropy = i ? 0.5f : 0.8f; m.anisotropic = 1;
+    m.metallic = i ? 0 : 0.5f; m.spec_trans = i ? 1 : 0;
+    float t = (i ? 35 : 55) * (float)M_PI / 180;
+    char name[128];
+    snprintf(name, sizeof name, "principled anisotropic %.1f, %s", m.anisotropy, i ? "glass, inside" : "half metal");
+    rc |= test_bsdf_wo(name, m, v3(sinf(t) * 0.6f, sinf(t) * 0.8f, i ? -cosf(t) : cosf(t)));
   }
   return rc;
 }

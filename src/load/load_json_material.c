@@ -119,9 +119,9 @@ static valo_status parse_principled(jctx *c, const cJSON *o, const char *where, 
   m->kd = c3(0.5f, 0.5f, 0.5f);
   m->roughness = 0.5f;
   TRY(get_rgb_tex(c, o, "base_color", where, &m->kd, &m->tex_kd));
-  static const char *const keys[] = {"metallic", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "spec_trans"};
-  float *dst[] = {&m->metallic, &m->spec_tint, &m->sheen, &m->sheen_tint, &m->flatness, &m->clearcoat, &m->clearcoat_gloss, &m->spec_trans};
-  for (int k = 0; k < 8; k++) {
+  static const char *const keys[] = {"metallic", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic"};
+  float *dst[] = {&m->metallic, &m->spec_tint, &m->sheen, &m->sheen_tint, &m->flatness, &m->clearcoat, &m->clearcoat_gloss, &m->spec_trans, &m->anisotropy};
+  for (int k = 0; k < 9; k++) {
     double x = 0;
     TRY(json_get_num(c, o, keys[k], where, 0, 1, &x));
     *dst[k] = (float)x;
@@ -131,6 +131,7 @@ static valo_status parse_principled(jctx *c, const cJSON *o, const char *where, 
   TRY(json_get_num(c, o, "ior", where, 1.0001, 10, &ior));
   if (ior > 0 && cJSON_GetObjectItemCaseSensitive(o, "specular")) return json_bad(c, where, "give \"specular\" or \"ior\", not both");
   m->ior = ior > 0 ? (float)ior : (float)(2 / (1 - sqrt(0.08 * fmax(spec, 1e-3))) - 1);
+  m->anisotropic = m->anisotropy > 0;
   return VALO_OK;
 }
 
@@ -203,7 +204,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_blend[] = {"weight", "weight_raw", "type", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                         "bump_map", "bump_scale", NULL};
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
-                                             "clearcoat", "clearcoat_gloss", "spec_trans", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
+                                             "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};

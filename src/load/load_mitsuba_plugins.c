@@ -280,7 +280,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
     one_sided(c, m);
   } else if (!strcmp(type, "principled")) {
-    /* valo's principled: Mitsuba's lobes; anisotropy not modelled */
+    /* valo's principled: Mitsuba's lobes */
     TYPE("principled");
     TRY(set_color(c, b, "base_color", m, "base_color", 0));
     static const char *const keys[] = {"metallic", "roughness", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "specular",
@@ -307,7 +307,8 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
       cJSON_AddNumberToObject(m, "ior", eta);
     }
     TRY(mi_float(c, b, "anisotropic", &an));
-    if (an != 0) mi_warn(c, b, "anisotropic is not read: valo's principled is isotropic");
+    if (!(an >= 0 && an <= 1)) return mi_bad(c, b, "anisotropic must be in [0, 1]");
+    if (an > 0) cJSON_AddNumberToObject(m, "anisotropic", an);
     double rate;
     static const char *const rates[] = {"main_specular_sampling_rate", "clearcoat_sampling_rate", "diffuse_reflectance_sampling_rate"};
     for (int k = 0; k < 3; k++) TRY(mi_float(c, b, rates[k], &rate)); /* how Mitsuba samples: valo's own choice */

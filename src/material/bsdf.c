@@ -38,7 +38,12 @@ bsdf bsdf_from_material(const material *m) {
     b.type = BSDF_PRINCIPLED;
     b.metallic = clampf(m->metallic, 0, 1);
     b.roughness = clampf(m->roughness, 0, 1);
-    b.alpha = fmaxf(1e-3f, b.roughness * b.roughness);
+    b.alpha = b.alpha_v = fmaxf(1e-3f, b.roughness * b.roughness);
+    if (m->anisotropy > 0) { /* Mitsuba's: aspect sqrt(1 - 0.9 anisotropic), alpha / aspect along u, alpha * aspect along v */
+      float r2 = b.roughness * b.roughness, aspect = sqrtf(1 - 0.9f * clampf(m->anisotropy, 0, 1));
+      b.alpha = fmaxf(1e-3f, r2 / aspect);
+      b.alpha_v = fmaxf(1e-3f, r2 * aspect);
+    }
     b.spec_tint = m->spec_tint; b.sheen = m->sheen; b.sheen_tint = m->sheen_tint;
     b.flatness = m->flatness; b.clearcoat = m->clearcoat; b.spec_trans = clampf(m->spec_trans, 0, 1);
     b.cc_alpha = 0.1f + (0.001f - 0.1f) * clampf(m->clearcoat_gloss, 0, 1);

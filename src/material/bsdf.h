@@ -24,7 +24,7 @@ typedef struct bsdf {
   int fresnel_white;  /* conductors: F = 1, the caller applies F per wavelength (--spectral) */
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types); along the frame's s axis when anisotropic */
-  float alpha_v;      /* rough conductor and dielectric: the roughness along t (alpha when isotropic) */
+  float alpha_v;      /* rough conductor and dielectric, principled: the roughness along t (alpha when isotropic) */
   float metallic;     /* BSDF_PBR */
   int beckmann;       /* rough conductor and dielectric: the Beckmann distribution, not GGX */
   int separable;      /* rough conductor, dielectric, plastic: Smith's separable G (Mitsuba's), not the height-correlated one */
@@ -60,7 +60,7 @@ rgb material_albedo(const material *m, float cos_o);
 /* 1 if the BSDF's roughness differs along the frame's s and t (so the frame follows the
  * surface's u direction). */
 static inline int bsdf_anisotropic(const bsdf *b) {
-  return (b->type == BSDF_ROUGH_CONDUCTOR || b->type == BSDF_ROUGH_DIELECTRIC) && b->alpha != b->alpha_v;
+  return (b->type == BSDF_ROUGH_CONDUCTOR || b->type == BSDF_ROUGH_DIELECTRIC || b->type == BSDF_PRINCIPLED) && b->alpha != b->alpha_v;
 }
 /* 1 if the BSDF transmits (so the shading frame must not be flipped to wo). */
 static inline int bsdf_transmits(const bsdf *b) {

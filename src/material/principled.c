@@ -33,8 +33,12 @@ static float gtr1_D(float a, float cos_h) {
   return r * cos_h > 1e-20f ? r : 0;
 }
 
-/* GGX's separable-Smith G1 of alpha a, 0 where w sees the back of the normal m */
-static float g1_sep(float a, vec3 w, vec3 m) { return v3_dot(w, m) * w.z <= 0 ? 0 : (fabsf(w.z) >= 1 ? 1 : ggx_G1(a, w)); }
+/* GGX's separable-Smith G1 of alphas (ax, ay), 0 where w sees the back of the normal m */
+static float g1_sep(float ax, float ay, vec3 w, vec3 m) {
+  if (v3_dot(w, m) * w.z <= 0) return 0;
+  if (fabsf(w.z) >= 1) return 1;
+  return ax == ay ? ggx_G1(ax, w) : 1 / (1 + mfa_lambda(0, ax, ay, w));
+}
 
 /* The weights of the opaque lobes (1 - m)(1 - t) and of the transmissive one (1 - m) t. */
 static float w_brdf(const bsdf *b) { return (1 - b->metallic) * (1 - b->spec_trans); }
@@ -63,7 +67,7 @@ rgb principled_eval(const bsdf *b, vec3 wo, vec3 wi) {
   int front = wo.z > 0;
   float vh = v3_dot(wo, h), lh = v3_dot(wi, h);
   float fd = fresnel_dielectric(vh, b->eta);
-  float D = ggx_D(b->alpha, h), G = g1_sep(b->alpha, wo, h) * g1_sep(b->alpha, wi, h);
+  float D = mfa_D(0, b->alpha, b->alpha_v, h), G = g1_sep(b->alpha, b->alpha_v, wo, h) * g1_sep(b->alpha, b->alpha_v, wi, h);
   rgb c = b->kd, f = c3(0, 0, 0);
   if (etap != 1) { /* transmission: sqrt(c) (1 - m) t times a rough dielectric's (radiance) */
     if (!(w_bsdf(b) > 0) || !(fd < 1)) return f;
@@ -90,7 +94,7 @@ rgb principled_eval(const bsdf *b, vec3 wo, vec3 wi) {
   /* clearcoat */
   if (b->clearcoat > 0) {
     float Fcc = schlick(0.04f, vh, b->eta);
-    float g = g1_sep(0.25f, wo, h) * g1_sep(0.25f, wi, h);
+    float g = g1_sep(0.25f, 0.25f, wo, h) * g1_sep(0.25f, 0.25f, wi, h);
     f = c3_add(f, c3_scale(c3(1, 1, 1), 0.25f * b->clearcoat * Fcc * gtr1_D(b->cc_alpha, h.z) * g));
   }
   /* diffuse, retro-reflection, flatness, sheen */
@@ -141,7 +145,7 @@ float principled_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   float p[3];
   lobe_probs(b, front, p);
   vec3 v = front ? wo : v3_neg(wo); /* visible normals are sampled from wo's side */
-  float vh = v3_dot(wo, h), pm = ggx_D_visible(b->alpha, v, h);
+  float vh = v3_dot(wo, h), pm = mfa_pdf_m(0, b->alpha, b->alpha_v, v, h);
   float rs = reflect_share(b, front, fresnel_dielectric(vh, b->eta));
   if (etap != 1) {
     float den = vh + etap * v3_dot(wi, h);
@@ -169,7 +173,7 @@ int principled_sample(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, b
     if (s->wi.z <= 0) return 0; /* the reflection lobes are counted only above */
   } else {
     vec3 v = front ? wo : v3_neg(wo);
-    vec3 m = ggx_sample_visible(b->alpha, v, u1, u2); /* facing v */
+    vec3 m = mfa_sample(0, b->alpha, b->alpha_v, v, u1, u2); /* facing v */
     float ur = (ulobe - p[0] - p[1]) / p[2];
     if (ur < reflect_share(b, front, fresnel_dielectric(v3_dot(wo, m), b->eta))) {
       s->wi = v3_reflect(wo, m);

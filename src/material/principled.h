@@ -17,7 +17,9 @@
  *              weighted by (1 - t) (diffuse) and seen from outside only; from inside the
  *              surface is a rough dielectric of reflectance (1 - m) t F.
  * eta is the interior / exterior index (JSON "ior"; Mitsuba's `specular` s gives
- * eta = 2 / (1 - sqrt(0.08 s)) - 1). Mitsuba's anisotropic lobes are not modelled.
+ * eta = 2 / (1 - sqrt(0.08 s)) - 1). `anisotropic` a stretches the specular and transmissive
+ * lobes' GGX as Mitsuba does: alpha / aspect along the surface's u direction, alpha *
+ * aspect across it, aspect = sqrt(1 - 0.9 a) (both at least 0.001).
  * Sampling, as Mitsuba's: a cosine-weighted direction, GTR1 normals or GGX visible
  * normals with probabilities in proportion to (1 - m)(1 - t), clearcoat / 4 and 1; a
  * visible normal of Fresnel term F reflects with probability 1 - (1 - m) t (1 - F), else

@@ -67,6 +67,7 @@ typedef struct material {
                         alpha_stochastic): 1 = opaque, the default */
   int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
   float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, spec_trans; /* MAT_PRINCIPLED */
+  float anisotropy;  /* MAT_PRINCIPLED: Mitsuba's "anisotropic", 0..1 (sets anisotropic when > 0) */
   int blend[2];      /* MAT_BLEND: the two materials' indices */
   int blend_by_side; /* MAT_BLEND: blend[0] seen from the front (the winding's normal side), blend[1] from the back
                         (JSON "sided", Mitsuba's twosided of two BSDFs), not by weight */
