@@ -39,7 +39,7 @@ bsdf bsdf_from_material(const material *m) {
     b.metallic = clampf(m->metallic, 0, 1);
     b.roughness = clampf(m->roughness, 0, 1);
     b.alpha = b.alpha_v = fmaxf(1e-3f, b.roughness * b.roughness);
-    if (m->anisotropy > 0) { /* Mitsuba's: aspect sqrt(1 - 0.9 anisotropic), alpha / aspect along u, alpha * aspect along v */
+    if (m->anisotropic && m->anisotropy > 0) { /* Mitsuba's: aspect sqrt(1 - 0.9 anisotropic), alpha / aspect along u, alpha * aspect along v */
       float r2 = b.roughness * b.roughness, aspect = sqrtf(1 - 0.9f * clampf(m->anisotropy, 0, 1));
       b.alpha = fmaxf(1e-3f, r2 / aspect);
       b.alpha_v = fmaxf(1e-3f, r2 * aspect);

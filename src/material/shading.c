@@ -4,6 +4,20 @@
 #include "core/rng.h"
 #include <math.h>
 
+/* Triangle ix's UV derivatives dp/du and dp/dv (constant over it): 0 when its texture
+ * coordinates are degenerate. */
+static int uv_derivatives(const scene *s, const uint32_t *ix, vec3 *dpdu, vec3 *dpdv) {
+  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
+  float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
+  float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
+  float det = du1 * dv2 - du2 * dv1;
+  if (!(fabsf(det) > 1e-20f)) return 0;
+  float r = 1 / det;
+  *dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), r);
+  *dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), r);
+  return 1;
+}
+
 /* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
  * shading normal n by d(u,v) = scale * height(u,v) has tangents dp/du + d_u n and
  * dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is the new shading
@@ -13,15 +27,9 @@
  * so the slope of a bilinear linear ramp is exact. */
 static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
   const texture *tx = &s->tex[it->m->tex_bump];
-  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]), e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
-  float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
-  float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
-  float det = du1 * dv2 - du2 * dv1;
-  if (!(fabsf(det) > 1e-20f) || tx->w < 1 || tx->h < 1) return;
-  float r = 1 / det;
+  vec3 dpdu, dpdv;
+  if (!uv_derivatives(s, ix, &dpdu, &dpdv) || tx->w < 1 || tx->h < 1) return;
   vec3 n = it->ns;
-  vec3 dpdu = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), r);
-  vec3 dpdv = v3_scale(v3_sub(v3_scale(e2, du1), v3_scale(e1, du2)), r);
   dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
   dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
   float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
@@ -45,18 +53,9 @@ static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
  * coordinates (or with degenerate ones) the triangle's first edge, which is dp/du of the
  * barycentric coordinates Mitsuba then takes as u and v. */
 static vec3 surface_dpdu(const scene *s, const isect *it, const uint32_t *ix) {
-  vec3 e1 = v3_sub(s->pos[ix[1]], s->pos[ix[0]]);
-  if (s->tri_flags[it->tri] & TRI_HAS_UVS) {
-    vec3 e2 = v3_sub(s->pos[ix[2]], s->pos[ix[0]]);
-    float du1 = s->uv[2 * ix[1]] - s->uv[2 * ix[0]], dv1 = s->uv[2 * ix[1] + 1] - s->uv[2 * ix[0] + 1];
-    float du2 = s->uv[2 * ix[2]] - s->uv[2 * ix[0]], dv2 = s->uv[2 * ix[2] + 1] - s->uv[2 * ix[0] + 1];
-    float det = du1 * dv2 - du2 * dv1;
-    if (fabsf(det) > 1e-20f) {
-      vec3 d = v3_scale(v3_sub(v3_scale(e1, dv2), v3_scale(e2, dv1)), 1 / det);
-      if (v3_len2(d) > 1e-30f && v3_finite(d)) return d;
-    }
-  }
-  return e1;
+  vec3 dpdu, dpdv;
+  if ((s->tri_flags[it->tri] & TRI_HAS_UVS) && uv_derivatives(s, ix, &dpdu, &dpdv) && v3_len2(dpdu) > 1e-30f && v3_finite(dpdu)) return dpdu;
+  return v3_sub(s->pos[ix[1]], s->pos[ix[0]]);
 }
 
 /* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
