@@ -965,6 +965,52 @@ static int roughness_maps(void) {
   return 0;
 }
 
+/* "luminance": a texture read as one number per texel, linear sRGB's Y in every channel
+ * and alpha 1, as Mitsuba reads a bitmap given for a number: a red pixel (sRGB-decoded 1,
+ * 0, 0) gives 0.212671; a white pixel of alpha 0 as an opacity map is opaque with it (its
+ * alpha ignored, as Mitsuba does) and transparent without; the colour and luminance
+ * readings of one file are two textures. */
+static int luminance_textures(void) {
+  unsigned char red[3] = {255, 0, 0}, clear[4] = {255, 255, 255, 0};
+  char path[1200];
+  snprintf(path, sizeof path, "%s/red1.png", scratch_dir());
+  CHECK(stbi_write_png(path, 1, 1, 3, red, 3), "write");
+  snprintf(path, sizeof path, "%s/clear1.png", scratch_dir());
+  CHECK(stbi_write_png(path, 1, 1, 4, clear, 4), "write");
+  CHECK(scratch_file("lfloor.obj", "v -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  const char *json =
+      "{ \"materials\": {\n"
+      "  \"colour\": {\"type\": \"diffuse\", \"reflectance\": \"red1.png\"},\n"
+      "  \"y\": {\"type\": \"diffuse\", \"reflectance\": {\"file\": \"red1.png\", \"luminance\": true}},\n"
+      "  \"holey\": {\"type\": \"diffuse\", \"opacity\": \"clear1.png\"},\n"
+      "  \"solid\": {\"type\": \"diffuse\", \"opacity\": {\"file\": \"clear1.png\", \"luminance\": true}}},\n"
+      "  \"shapes\": [{\"file\": \"lfloor.obj\", \"material\": \"colour\"}, {\"file\": \"lfloor.obj\", \"material\": \"y\"},\n"
+      "    {\"file\": \"lfloor.obj\", \"material\": \"holey\"}, {\"file\": \"lfloor.obj\", \"material\": \"solid\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n";
+  scene *s = NULL;
+  valo_error err;
+  valo_options file;
+  CHECK(scene_load(scratch_file("lum.json", json), NULL, &s, &file, &err) == VALO_OK, "%s", err.message);
+  const material *m[4];
+  static const char *const names[4] = {"colour", "y", "holey", "solid"};
+  for (int i = 0; i < 4; i++) {
+    uint32_t k = 0;
+    while (k < s->nmats && strcmp(s->mats[k].name, names[i])) k++;
+    CHECK(k < s->nmats, "no material %s", names[i]);
+    m[i] = &s->mats[k];
+  }
+  float o[4], y[4];
+  texture_lookup(&s->tex[m[0]->tex_kd], 0.5f, 0.5f, o);
+  texture_lookup(&s->tex[m[1]->tex_kd], 0.5f, 0.5f, y);
+  CHECK(m[0]->tex_kd != m[1]->tex_kd && o[0] == 1 && o[1] == 0, "the colour reading: texture %d (%g %g %g)", m[0]->tex_kd, o[0], o[1], o[2]);
+  CHECK(fabsf(y[0] - 0.212671f) < 1e-6f && y[1] == y[0] && y[2] == y[0] && y[3] == 1, "luminance (%g %g %g %g), not 0.212671", y[0], y[1], y[2], y[3]);
+  const texture *h = &s->tex[m[2]->tex_alpha], *so = &s->tex[m[3]->tex_alpha];
+  CHECK(h->has_alpha && m[2]->alpha_channel && h->px[3] == 0, "without luminance the opacity map reads its alpha (0)");
+  CHECK(!so->has_alpha && !m[3]->alpha_channel && so->px[0] == 1, "with luminance the opacity map reads %g from channel %d", so->px[0], m[3]->alpha_channel);
+  scene_free(s);
+  return 0;
+}
+
 /* Anisotropic roughness (roughness_u along the surface's u direction, roughness_v along
  * v) on a rough aluminium floor lit across it: equal values render bit for bit as
  * "roughness"; u 0.2, v 0.6 differs from its swap by more than 1 %; and on a floor whose
@@ -1188,7 +1234,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

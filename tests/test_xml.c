@@ -9,6 +9,7 @@
 #include "scene/scene.h"
 #include "image/texture.h"
 #include "valo/valo.h"
+#include <stb_image_write.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -450,6 +451,38 @@ static int black_backs(void) {
   return 0;
 }
 
+/* A bitmap given for a number (a mask's opacity, a rough conductor's alpha, a blend's
+ * weight) is read as Mitsuba's eval_1 reads it: its luminance, alpha ignored. A red
+ * pixel is 0.212671 (Mitsuba 3.9.1 gives 0.2126710 for the same file), a white pixel of
+ * alpha 0 is opaque; the same red file as a colour stays red. */
+static int scalar_bitmaps(void) {
+  unsigned char red[3] = {255, 0, 0}, clear[4] = {255, 255, 255, 0};
+  char rp[1200], cp[1200], xml[3000];
+  snprintf(rp, sizeof rp, "%s/red1.png", scratch_dir());
+  snprintf(cp, sizeof cp, "%s/clear1.png", scratch_dir());
+  CHECK(stbi_write_png(rp, 1, 1, 3, red, 3) && stbi_write_png(cp, 1, 1, 4, clear, 4), "write");
+  snprintf(xml, sizeof xml,
+           "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"mask\"><texture type=\"bitmap\" name=\"opacity\"><string name=\"filename\" value=\"%s\"/></texture>"
+           "<bsdf type=\"diffuse\"/></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"roughconductor\"><texture type=\"bitmap\" name=\"alpha\"><string name=\"filename\" value=\"%s\"/>"
+           "</texture></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"blendbsdf\"><texture type=\"bitmap\" name=\"weight\"><string name=\"filename\" value=\"%s\"/>"
+           "</texture><bsdf type=\"diffuse\"/><bsdf type=\"conductor\"/></bsdf></shape>\n"
+           "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"%s\"/>"
+           "</texture></bsdf></shape>\n</scene>\n",
+           "clear1.png", "red1.png", "red1.png", "red1.png"); /* beside the scene file */
+  scene *s = mitsuba_scene(scratch_file("scalar-bitmaps.xml", xml));
+  CHECK(s, "the scene does not load");
+  const material *mask = &s->mats[s->tri_mat[0]], *rough = &s->mats[s->tri_mat[2]], *blend = &s->mats[s->tri_mat[4]], *colour = &s->mats[s->tri_mat[6]];
+  CHECK(mask->tex_alpha >= 0 && !mask->alpha_channel && s->tex[mask->tex_alpha].px[0] == 1, "the mask's white pixel of alpha 0 is not opaque");
+  CHECK(rough->tex_rough >= 0 && fabsf(s->tex[rough->tex_rough].px[0] - 0.212671f) < 1e-6f, "the red alpha map reads %g", s->tex[rough->tex_rough].px[0]);
+  CHECK(blend->type == MAT_BLEND && blend->tex_weight >= 0 && fabsf(s->tex[blend->tex_weight].px[0] - 0.212671f) < 1e-6f, "the red weight map");
+  CHECK(colour->tex_kd >= 0 && s->tex[colour->tex_kd].px[0] == 1 && s->tex[colour->tex_kd].px[1] == 0, "the colour map is not red");
+  scene_free(s);
+  return 0;
+}
+
 /* Mitsuba's mask as valo's stochastic opacity: the default 0.5, a number times the default
  * (a mask inside a mask), and a bitmap
  * decoded from sRGB unless raw (the ramp's texel 32 holds 130: 0.510 raw, 0.223 decoded). */
@@ -683,6 +716,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -1,6 +1,7 @@
 /* load_json_texture.c — owns the JSON scene format's texture values (docs/scene-format.md,
- * "Textures"): a file name, or an object giving an image file or a checkerboard and how
- * it is looked up (wrap, filter, a map of the texture coordinates). */
+ * "Textures"): a file name, or an object giving an image file or a checkerboard, whether
+ * it is read as its luminance, and how it is looked up (wrap, filter, a map of the
+ * texture coordinates). */
 #include "load/load_json_internal.h"
 #include "core/error.h"
 #include "image/texture.h"
@@ -58,10 +59,11 @@ static valo_status colour(jctx *c, const cJSON *o, const char *key, const char *
 valo_status json_get_texture(jctx *c, const cJSON *v, int srgb, const char *w, const char *what, int *tex) {
   if (cJSON_IsString(v)) return image_file(c, v->valuestring, srgb, w, what, tex);
   if (!cJSON_IsObject(v)) return json_bad(c, w, "must be a file name or a texture object ({\"file\": ...} or {\"type\": \"checkerboard\", ...})");
-  static const char *const keys[] = {"type", "file", "raw", "color0", "color1", "wrap", "filter", "uv_scale", "uv_offset", "uv_matrix", NULL};
+  static const char *const keys[] = {"type", "file", "raw", "luminance", "color0", "color1", "wrap", "filter", "uv_scale", "uv_offset", "uv_matrix", NULL};
   TRY(json_check_keys(c, v, w, keys));
   const char *type = "bitmap", *file = NULL, *wrap = NULL, *filter = NULL;
-  int raw = !srgb;
+  int raw = !srgb, lum = 0;
+  TRY(json_get_bool(c, v, "luminance", w, &lum));
   TRY(json_get_str(c, v, "type", w, &type));
   TRY(json_get_str(c, v, "file", w, &file));
   TRY(json_get_bool(c, v, "raw", w, &raw));
@@ -83,6 +85,7 @@ valo_status json_get_texture(jctx *c, const cJSON *v, int srgb, const char *w, c
   } else {
     return json_bad(c, w, "\"type\" must be \"bitmap\" or \"checkerboard\"");
   }
+  if (lum && (*tex = scene_texture_luminance(c->s, *tex)) < 0) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   const texture *t = &c->s->tex[*tex];
   tex_sampling smp = t->smp;
   if (wrap) {

@@ -50,7 +50,7 @@ static valo_status roughness_of(mctx *c, xml_node *b, double def_alpha, cJSON *m
     const char *t = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "type"));
     if (t && !strcmp(t, "plastic")) return mi_bad(c, ak, "valo's plastic tabulates its coat for one roughness: an alpha texture is not read");
     cJSON *amap;
-    TRY(mi_color(c, b, "alpha", 0, &amap));
+    TRY(mi_color(c, b, "alpha", MI_SCALAR, &amap));
     cJSON_AddItemToObject(m, "roughness_map", amap);
     if (!cJSON_AddTrueToObject(m, "roughness_map_is_alpha")) return NOMEM;
     a = 1;
@@ -153,7 +153,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (!tex) return mi_bad(c, b, "needs its map as a bitmap <texture>");
     const char *tname = xml_attr_get(tex, "name");
     cJSON *file;
-    if (tname) TRY(mi_color(c, b, tname, 0, &file));
+    if (tname) TRY(mi_color(c, b, tname, normal ? 0 : MI_SCALAR, &file));
     else {
       /* an unnamed texture child: name it for the reader */
       return mi_bad(c, tex, "give the map texture a name (name=\"%s\")", normal ? "normalmap" : "bumpmap");
@@ -170,7 +170,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     /* Mitsuba's mask lets light through with probability 1 - opacity: valo's "opacity",
      * a number (Mitsuba's default 0.5) or a texture (a bitmap sRGB-decoded unless raw). */
     cJSON *op;
-    TRY(mi_color(c, b, "opacity", 0, &op));
+    TRY(mi_color(c, b, "opacity", MI_SCALAR, &op));
     if (!op) op = cJSON_CreateNumber(0.5);
     else if (cJSON_IsArray(op)) {
       cJSON *a = cJSON_CreateNumber(cJSON_GetArrayItem(op, 0)->valuedouble);
@@ -200,7 +200,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
       TRY(mi_material(c, in[i], NULL, in[i], name, sizeof name));
       cJSON_AddItemToArray(names, cJSON_CreateString(name));
     }
-    TRY(mi_color(c, b, "weight", 0, &w));
+    TRY(mi_color(c, b, "weight", MI_SCALAR, &w));
     if (!w) return mi_bad(c, b, "needs its weight (a number or a texture), as Mitsuba does");
     if (cJSON_IsArray(w)) {
       double x = cJSON_GetArrayItem(w, 0)->valuedouble;
@@ -292,7 +292,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
         /* valo's principled reads maps for roughness and metallic: the value 1 times the map */
         if (k > 1) return mi_bad(c, tk, "valo reads textures for principled's roughness and metallic, not for %s", keys[k]);
         cJSON *map;
-        TRY(mi_color(c, b, keys[k], 0, &map));
+        TRY(mi_color(c, b, keys[k], MI_SCALAR, &map));
         cJSON_AddItemToObject(m, k ? "roughness_map" : "metallic_map", map);
         x = 1;
       } else {

@@ -410,7 +410,9 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **ou
   if (!strcmp(k->name, "ref")) return mi_bad(c, k, "refers to an id that no element has");
   if (!strcmp(k->name, "texture")) {
     if (rgb_only) return mi_bad(c, k, "valo reads a constant colour here, not a texture");
-    return mi_texture(c, k, out);
+    TRY(mi_texture(c, k, out));
+    if ((how & MI_SCALAR) && !cJSON_AddTrueToObject(*out, "luminance")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    return VALO_OK;
   }
   double v[3];
   const char *val = xml_attr_get(k, "value");

@@ -63,8 +63,9 @@ valo_status mi_transform(mctx *c, xml_node *p, const char *name, double m[16], i
  * checkerboard, with Mitsuba's raw, wrap_mode, filter_type and to_uv); *out stays NULL
  * when absent. how: MI_RGB_ONLY, a texture is an error; MI_EMITTER, an emitter's colour,
  * where Mitsuba reads a one-value <spectrum> as that much of the equal-energy spectrum
- * (a pinkish white in sRGB's D65 terms), not as grey. */
-enum { MI_RGB_ONLY = 1, MI_EMITTER = 2 };
+ * (a pinkish white in sRGB's D65 terms), not as grey; MI_SCALAR, a number Mitsuba reads
+ * from a texture as its luminance, alpha ignored (the object gets "luminance"). */
+enum { MI_RGB_ONLY = 1, MI_EMITTER = 2, MI_SCALAR = 4 };
 valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out);
 /* Parses up to n numbers separated by commas and/or spaces; returns how many. */
 int mi_numbers(const char *s, double *v, int n);

@@ -170,6 +170,27 @@ int scene_texture_sampled(scene *s, int base, const tex_sampling *smp) {
   return add_texture(s, &t, key);
 }
 
+int scene_texture_luminance(scene *s, int base) {
+  if (base < 0) return base;
+  char key[600];
+  snprintf(key, sizeof key, "%s|Y", s->tex[base].key);
+  int i = find_texture(s, key);
+  if (i >= 0) return i;
+  texture t = s->tex[base];
+  size_t n = (size_t)t.w * (size_t)t.h;
+  t.px = malloc(n * 4 * sizeof *t.px);
+  if (!t.px) return -1;
+  const float *src = s->tex[base].px;
+  for (size_t k = 0; k < n; k++) {
+    float y = 0.212671f * src[4 * k] + 0.715160f * src[4 * k + 1] + 0.072169f * src[4 * k + 2];
+    t.px[4 * k] = t.px[4 * k + 1] = t.px[4 * k + 2] = y;
+    t.px[4 * k + 3] = 1;
+  }
+  t.has_alpha = 0;
+  t.shares_px = 0;
+  return add_texture(s, &t, key);
+}
+
 int scene_texture_checkerboard(scene *s, const float c0[3], const float c1[3], valo_error *err) {
   char key[600];
   snprintf(key, sizeof key, "checkerboard|%a,%a,%a|%a,%a,%a", c0[0], c0[1], c0[2], c1[0], c1[1], c1[2]);

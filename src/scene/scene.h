@@ -225,6 +225,10 @@ int scene_texture_memory(scene *s, const char *key, const unsigned char *data, s
 /* Texture base sampled as smp says: base itself when it already is, else (found or added)
  * a texture sharing base's pixels. base < 0 is returned as is. */
 int scene_texture_sampled(scene *s, int base, const struct tex_sampling *smp);
+/* Texture base as one number per texel, its luminance (linear sRGB's Y: 0.212671 R +
+ * 0.715160 G + 0.072169 B) in every channel and alpha 1, as Mitsuba reads a bitmap given
+ * for a number: found or added (its own pixels); -1 when out of memory, base < 0 as is. */
+int scene_texture_luminance(scene *s, int base);
 /* Mitsuba's checkerboard (texture_checkerboard), found or added; -1 when out of memory. */
 int scene_texture_checkerboard(scene *s, const float c0[3], const float c1[3], valo_error *err);
 /* Surface UV of triangle t at barycentrics (b1, b2): interpolated, or on a sphere's
