@@ -15,6 +15,21 @@
 
 /* A 10 x 10 floor at y = 0, facing up (its own OBJ). */
 #define FLOOR_OBJ "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nf 1 2 3 4\n"
+/* floors at y = 0 with texture coordinates (u along +z, v along +x), 2 and 10 units wide */
+#define UV_QUAD_2 "v -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
+#define UV_QUAD_10 "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"
+/* Writes a PNG of w x h pixels of n channels into the scratch folder: 1 on success. */
+static int scratch_png(const char *name, int w, int h, int n, const unsigned char *px) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/%s", scratch_dir(), name);
+  return stbi_write_png(path, w, h, n, px, w * n) != 0;
+}
+/* The material of that name, or NULL. */
+static const material *material_named(const scene *s, const char *name) {
+  for (uint32_t m = 0; m < s->nmats; m++)
+    if (!strcmp(s->mats[m].name, name)) return &s->mats[m];
+  return NULL;
+}
 
 static float srgb_dec(int b) { float c = b / 255.0f; return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f); }
 
@@ -837,10 +852,7 @@ static float lum_at(const scene *s, int t, float u, float v) {
 static int texture_objects(void) {
   /* a 4 x 1 ramp 0, 1, 2, 3 (as 8-bit 0, 60, 120, 180, read raw) */
   unsigned char g[4] = {0, 60, 120, 180};
-  char png[1200];
-  snprintf(png, sizeof png, "%s/ramp4.png", scratch_dir());
-  CHECK(stbi_write_png(png, 4, 1, 1, g, 4), "write");
-  CHECK(scratch_file("tfloor.obj", "v -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  CHECK(scratch_png("ramp4.png", 4, 1, 1, g) && scratch_file("tfloor.obj", UV_QUAD_2), "write");
   const char *json =
       "{ \"materials\": {\n"
       "  \"near\": {\"type\": \"diffuse\", \"reflectance\": {\"file\": \"ramp4.png\", \"raw\": true, \"filter\": \"nearest\", \"wrap\": \"clamp\"}},\n"
@@ -860,10 +872,9 @@ static int texture_objects(void) {
   int t[6];
   for (int i = 0; i < 6; i++) {
     static const char *const names[6] = {"near", "near2", "plain", "moved", "turned", "check"};
-    uint32_t m = 0;
-    while (m < s->nmats && strcmp(s->mats[m].name, names[i])) m++;
-    CHECK(m < s->nmats, "no material %s", names[i]);
-    t[i] = s->mats[m].tex_kd;
+    const material *m = material_named(s, names[i]);
+    CHECK(m, "no material %s", names[i]);
+    t[i] = m->tex_kd;
     CHECK(t[i] >= 0, "%s has no texture", names[i]);
   }
   float q = 60 / 255.0f;
@@ -937,7 +948,7 @@ static int roughness_maps(void) {
   char png[1200];
   snprintf(png, sizeof png, "%s/r77.png", scratch_dir());
   CHECK(stbi_write_png(png, 1, 1, 1, &g, 1), "write");
-  CHECK(scratch_file("rfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  CHECK(scratch_file("rfloor.obj", UV_QUAD_10), "write");
   const double r = 77 / 255.0;
   char m[6][300];
   snprintf(m[0], sizeof m[0], "{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness\": 1, \"roughness_map\": \"r77.png\"}");
@@ -972,12 +983,7 @@ static int roughness_maps(void) {
  * readings of one file are two textures. */
 static int luminance_textures(void) {
   unsigned char red[3] = {255, 0, 0}, clear[4] = {255, 255, 255, 0};
-  char path[1200];
-  snprintf(path, sizeof path, "%s/red1.png", scratch_dir());
-  CHECK(stbi_write_png(path, 1, 1, 3, red, 3), "write");
-  snprintf(path, sizeof path, "%s/clear1.png", scratch_dir());
-  CHECK(stbi_write_png(path, 1, 1, 4, clear, 4), "write");
-  CHECK(scratch_file("lfloor.obj", "v -1 0 -1\nv -1 0 1\nv 1 0 1\nv 1 0 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n"), "write");
+  CHECK(scratch_png("red1.png", 1, 1, 3, red) && scratch_png("clear1.png", 1, 1, 4, clear) && scratch_file("lfloor.obj", UV_QUAD_2), "write");
   const char *json =
       "{ \"materials\": {\n"
       "  \"colour\": {\"type\": \"diffuse\", \"reflectance\": \"red1.png\"},\n"
@@ -993,12 +999,7 @@ static int luminance_textures(void) {
   CHECK(scene_load(scratch_file("lum.json", json), NULL, &s, &file, &err) == VALO_OK, "%s", err.message);
   const material *m[4];
   static const char *const names[4] = {"colour", "y", "holey", "solid"};
-  for (int i = 0; i < 4; i++) {
-    uint32_t k = 0;
-    while (k < s->nmats && strcmp(s->mats[k].name, names[i])) k++;
-    CHECK(k < s->nmats, "no material %s", names[i]);
-    m[i] = &s->mats[k];
-  }
+  for (int i = 0; i < 4; i++) CHECK((m[i] = material_named(s, names[i])), "no material %s", names[i]);
   float o[4], y[4];
   texture_lookup(&s->tex[m[0]->tex_kd], 0.5f, 0.5f, o);
   texture_lookup(&s->tex[m[1]->tex_kd], 0.5f, 0.5f, y);
@@ -1018,7 +1019,7 @@ static int luminance_textures(void) {
  * (within 0.3 %: the frame follows the UVs). One of the two alone, or with roughness, is
  * refused. */
 static int anisotropic_roughness(void) {
-  CHECK(scratch_file("rfloor.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n") &&
+  CHECK(scratch_file("rfloor.obj", UV_QUAD_10) &&
             scratch_file("rfloor-turned.obj", "v -5 0 -5\nv -5 0 5\nv 5 0 5\nv 5 0 -5\nvt 0 0\nvt 0 1\nvt 1 1\nvt 1 0\nf 1/1 2/2 3/3 4/4\n"),
         "write");
   double iso = floor_mean("{\"type\": \"conductor\", \"preset\": \"Al\", \"roughness\": 0.4}");
