@@ -50,6 +50,3 @@ int conductor_preset(const char *name, rgb *eta, rgb *k) {
     if (!strcmp(name, presets[i].n)) { *eta = presets[i].eta; *k = presets[i].k; return 0; }
   return -1;
 }
-
-int conductor_preset_count(void) { return (int)(sizeof presets / sizeof presets[0]); }
-const char *conductor_preset_name(int i) { return i >= 0 && i < conductor_preset_count() ? presets[i].n : NULL; }

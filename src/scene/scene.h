@@ -309,6 +309,4 @@ valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, 
 /* Conductor presets by Mitsuba's material names (scene/conductors.c): 0 on success, -1
  * for a name it does not hold. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
-int conductor_preset_count(void);
-const char *conductor_preset_name(int i); /* NULL past the end */
 #endif
