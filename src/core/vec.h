@@ -46,6 +46,8 @@ static inline rgb c3_scale(rgb a, float s) { return c3(a.r * s, a.g * s, a.b * s
 static inline rgb c3_sub(rgb a, rgb b) { return c3(a.r - b.r, a.g - b.g, a.b - b.b); }
 static inline float c3_max(rgb a) { return fmaxf(a.r, fmaxf(a.g, a.b)); }
 static inline float c3_lum(rgb a) { return 0.2126f * a.r + 0.7152f * a.g + 0.0722f * a.b; }
+/* The same to Mitsuba's six digits (its luminance of a linear sRGB colour). */
+static inline float c3_lum_mitsuba(rgb a) { return 0.212671f * a.r + 0.715160f * a.g + 0.072169f * a.b; }
 static inline float c3_avg(rgb a) { return (a.r + a.g + a.b) * (1.0f / 3.0f); }
 static inline int c3_black(rgb a) { return a.r == 0 && a.g == 0 && a.b == 0; }
 static inline int c3_finite(rgb a) { return isfinite(a.r) && isfinite(a.g) && isfinite(a.b); }

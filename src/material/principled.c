@@ -19,11 +19,8 @@ static float schlick(float r0, float cos_i, float eta) {
   return r0 + (1 - r0) * schlick_w(safe_sqrt(c2));
 }
 
-/* Mitsuba's luminance of a linear sRGB colour */
-static float lum_of(rgb c) { return 0.212671f * c.r + 0.715160f * c.g + 0.072169f * c.b; }
-
 static rgb tint_of(rgb c) {
-  float l = lum_of(c);
+  float l = c3_lum_mitsuba(c);
   return l > 0 ? c3_scale(c, 1 / l) : c3(1, 1, 1);
 }
 

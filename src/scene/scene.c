@@ -182,7 +182,7 @@ int scene_texture_luminance(scene *s, int base) {
   if (!t.px) return -1;
   const float *src = s->tex[base].px;
   for (size_t k = 0; k < n; k++) {
-    float y = 0.212671f * src[4 * k] + 0.715160f * src[4 * k + 1] + 0.072169f * src[4 * k + 2];
+    float y = c3_lum_mitsuba(c3(src[4 * k], src[4 * k + 1], src[4 * k + 2]));
     t.px[4 * k] = t.px[4 * k + 1] = t.px[4 * k + 2] = y;
     t.px[4 * k + 3] = 1;
   }
