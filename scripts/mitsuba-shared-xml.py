@@ -49,7 +49,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's measured conductors by name (valo's conductor presets)
           "metals": ("@tests/data/mitsuba-xml/metals.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's anisotropic roughness (valo's roughness_u and roughness_v)
-          "aniso": ("@tests/data/mitsuba-xml/aniso.xml", {"resx": "160", "resy": "96"})}
+          "aniso": ("@tests/data/mitsuba-xml/aniso.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's mesh_attribute texture of a PLY file's vertex colours (valo's vertex_colors)
+          "vertex-colors": ("@tests/data/mitsuba-xml/vertex-colors.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

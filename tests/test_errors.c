@@ -184,6 +184,12 @@ static int bad_mitsuba(void) {
       {"mx22.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/>"
        "<bsdf type=\"diffuse\"/><bsdf type=\"blendbsdf\"><float name=\"weight\" value=\"0.5\"/><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>"
        "</bsdf></shape>\n</scene>", "mx22.xml", "a blend material, which a blend cannot hold"},
+      {"mx23.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"diffuse\">\n<texture type=\"mesh_attribute\" name=\"reflectance\">"
+       "<string name=\"name\" value=\"face_color\"/></texture></bsdf></shape>\n</scene>", "mx23.xml:4: <texture type=\"mesh_attribute\" name=\"reflectance\">",
+       "not \"face_color\""},
+      {"mx24.xml", "<scene version=\"3.0.0\">\n" SENSOR "<shape type=\"sphere\"><bsdf type=\"roughconductor\">\n<texture type=\"mesh_attribute\" name=\"alpha\">"
+       "<string name=\"name\" value=\"vertex_color\"/></texture></bsdf></shape>\n</scene>", "mx24.xml:4: <texture type=\"mesh_attribute\" name=\"alpha\">",
+       "as a diffuse colour"},
   };
 #undef SENSOR
   for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {

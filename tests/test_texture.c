@@ -7,6 +7,7 @@
 #include "scene/scene.h"
 #include "image/texture.h"
 #include "image/image_io.h"
+#include "material/shading.h"
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <math.h>
@@ -108,7 +109,7 @@ static int wrap_modes(void) {
 
 /* A quad with a fully transparent alpha map hides nothing: camera rays pass through it,
  * and a floor in its shadow is lit as if it were absent. A fully opaque map blocks. */
-static double cutout_mean(const char *accel, int alpha, int with_quad) {
+static double cutout_mean(const char *backend, int alpha, int with_quad) {
   unsigned char rgba[4 * 4 * 4];
   for (int i = 0; i < 16; i++) { rgba[4 * i] = 200; rgba[4 * i + 1] = 20; rgba[4 * i + 2] = 20; rgba[4 * i + 3] = (unsigned char)alpha; }
   char png[1200];
@@ -132,7 +133,7 @@ static double cutout_mean(const char *accel, int alpha, int with_quad) {
            "  \"materials\": {\"floor\": {\"type\": \"diffuse\", \"reflectance\": 0.5}},\n"
            "  \"shapes\": [{\"file\": \"floor.obj\", \"material\": \"floor\"}%s%s%s],\n"
            "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
-           accel, with_quad ? ", {\"file\": \"leaf" : "", with_quad ? (alpha ? "255" : "0") : "", with_quad ? ".obj\"}" : "");
+           backend, with_quad ? ", {\"file\": \"leaf" : "", with_quad ? (alpha ? "255" : "0") : "", with_quad ? ".obj\"}" : "");
   int w, h;
   float *px = render_json_text(json, NULL, &w, &h);
   if (!px) return -1;
@@ -839,6 +840,152 @@ static int black_back_material(void) {
                           "unknown key \"black_back\"");
 }
 
+/* The kd a material shows at barycentrics (b1, b2) of triangle t, seen from +y. */
+static rgb kd_at(const scene *s, uint32_t t, float b1, float b2) {
+  ray r = {v3(0, 5, 0), v3(0, -1, 0), INFINITY};
+  hit h = {5, b1, b2, t};
+  isect it;
+  isect_from_hit(s, &r, &h, &it);
+  return bsdf_at(s, &it).kd;
+}
+
+/* Writes a glTF quad (y = 0, facing +y) whose COLOR_0 is n components of type ctype
+ * (5126 float, 5121 and 5123 normalized bytes and shorts) per vertex, all equal to col,
+ * its buffer in a .bin beside it; base colour factor (0.5, 1, 0.25). */
+static int gltf_colored_quad(const char *name, int ctype, int n, const double *col) {
+  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1};
+  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char buf[256];
+  size_t size = ctype == 5126 ? 4 : ctype == 5123 ? 2 : 1, clen = (4 * n * size + 3) & ~(size_t)3, len = 0;
+  memcpy(buf, pos, sizeof pos);
+  len = sizeof pos;
+  memset(buf + len, 0, clen);
+  for (int v = 0; v < 4; v++)
+    for (int k = 0; k < n; k++) {
+      double x = k < 3 ? col[k] : 1;
+      unsigned char *at = buf + len + (size_t)(v * n + k) * size;
+      if (ctype == 5126) { float f = (float)x; memcpy(at, &f, 4); }
+      else if (ctype == 5123) { uint16_t u = (uint16_t)lround(x * 65535); memcpy(at, &u, 2); }
+      else *at = (unsigned char)lround(x * 255);
+    }
+  len += clen;
+  memcpy(buf + len, idx, sizeof idx);
+  len += sizeof idx;
+  char bin[64], json[2048];
+  snprintf(bin, sizeof bin, "%s.bin", name);
+  FILE *f = fopen(scratch_path(bin), "wb");
+  if (!f || fwrite(buf, 1, len, f) != len || fclose(f)) return 0;
+  snprintf(json, sizeof json,
+           "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
+           " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 1, 0.25, 1], \"metallicFactor\": 0}}],\n"
+           " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"%s\"}],\n"
+           " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": %zu},\n"
+           "   {\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": 12}],\n"
+           " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, 0, -1], \"max\": [1, 0, 1]},\n"
+           "   {\"bufferView\": 1, \"componentType\": %d, \"count\": 4, \"type\": \"VEC%d\"%s},\n"
+           "   {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
+           len, bin, clen, 48 + clen, ctype, n, ctype == 5126 ? "" : ", \"normalized\": true");
+  char gl[64];
+  snprintf(gl, sizeof gl, "%s.gltf", name);
+  return scratch_file(gl, json) != NULL;
+}
+
+/* Vertex colours ("vertex_colors", glTF's COLOR_0): a PLY quad's 8-bit colours, each
+ * corner its own, multiply the reflectance, interpolated across each triangle (kd at
+ * corners and at inner points to 1e-6), and the PLY's own default material's; without
+ * the key, and on an OBJ without colours beside it, the reflectance alone; a quad of one colour renders as a plain material of
+ * that colour (to 1e-5); glTF's COLOR_0 as floats, bytes and shorts multiplies the base
+ * colour factor; a conductor and a blend refuse the key. */
+static int vertex_colors(void) {
+  static const char *const ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "-1 0 -1 255 0 0\n-1 0 1 0 255 0\n1 0 1 0 0 255\n1 0 -1 51 102 204\n4 0 1 2 3\n";
+  static const char *const json =
+      "{ \"materials\": {\"vc\": {\"type\": \"diffuse\", \"reflectance\": [0.5, 1, 0.8], \"vertex_colors\": true},\n"
+      "    \"plain\": {\"type\": \"diffuse\", \"reflectance\": [0.5, 1, 0.8]},\n"
+      "    \"pbr\": {\"type\": \"pbr\", \"base_color\": 0.5, \"vertex_colors\": true}},\n"
+      "  \"shapes\": [{\"file\": \"vcquad.ply\", \"material\": \"vc\"}, {\"file\": \"vcquad.ply\", \"material\": \"plain\"},\n"
+      "    {\"file\": \"mfloor.obj\", \"material\": \"vc\"}, {\"file\": \"vcquad.ply\", \"material\": \"pbr\"}, {\"file\": \"vcquad.ply\"}],\n"
+      "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n";
+  CHECK(scratch_file("vcquad.ply", ply) && scratch_file("mfloor.obj", FLOOR_OBJ), "write");
+  scene *s = NULL;
+  valo_error err;
+  valo_options file;
+  CHECK(scene_load(scratch_file("vc.json", json), NULL, &s, &file, &err) == VALO_OK, "%s", err.message);
+  CHECK(s->ntris == 10 && s->col, "%u triangles, colours %s", s->ntris, s->col ? "kept" : "dropped");
+  /* the quad's corners as the triangles hold them: (tri, b1, b2) and the colour there */
+  const float corner[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2f, 0.4f, 0.8f}};
+  const rgb refl = c3(0.5f, 1, 0.8f);
+  for (uint32_t t = 0; t < 2; t++) {
+    const uint32_t *ix = &s->idx[3 * t];
+    const float bs[4][2] = {{0, 0}, {1, 0}, {0, 1}, {0.25f, 0.35f}};
+    for (int k = 0; k < 4; k++) {
+      float w[3] = {1 - bs[k][0] - bs[k][1], bs[k][0], bs[k][1]}, e[3] = {0, 0, 0};
+      for (int j = 0; j < 3; j++) {
+        vec3 p = s->pos[ix[j]];
+        int c = p.x < 0 ? (p.z < 0 ? 0 : 1) : (p.z > 0 ? 2 : 3); /* which corner */
+        for (int ch = 0; ch < 3; ch++) e[ch] += w[j] * corner[c][ch];
+      }
+      rgb kd = kd_at(s, t, bs[k][0], bs[k][1]), plain = kd_at(s, t + 2, bs[k][0], bs[k][1]);
+      CHECK(fabsf(kd.r - e[0] * refl.r) < 1e-6f && fabsf(kd.g - e[1] * refl.g) < 1e-6f && fabsf(kd.b - e[2] * refl.b) < 1e-6f,
+            "triangle %u at (%g, %g): kd (%g %g %g), expected (%g %g %g)", t, bs[k][0], bs[k][1], kd.r, kd.g, kd.b, e[0] * refl.r, e[1] * refl.g, e[2] * refl.b);
+      CHECK(plain.r == refl.r && plain.g == refl.g && plain.b == refl.b, "without vertex_colors: (%g %g %g)", plain.r, plain.g, plain.b);
+      rgb pb = kd_at(s, t + 6, bs[k][0], bs[k][1]);
+      CHECK(fabsf(pb.r - 0.5f * e[0]) < 1e-6f && fabsf(pb.b - 0.5f * e[2]) < 1e-6f, "pbr base colour (%g %g %g)", pb.r, pb.g, pb.b);
+      rgb own = kd_at(s, t + 8, bs[k][0], bs[k][1]), base = s->mats[s->tri_mat[t + 8]].kd; /* the PLY's own (default) material shows its colours */
+      CHECK(fabsf(own.r - base.r * e[0]) < 1e-6f && fabsf(own.g - base.g * e[1]) < 1e-6f && fabsf(own.b - base.b * e[2]) < 1e-6f,
+            "the PLY's own material: (%g %g %g)", own.r, own.g, own.b);
+    }
+    rgb white = kd_at(s, t + 4, 0.3f, 0.3f);
+    CHECK(white.r == refl.r && white.g == refl.g && white.b == refl.b, "a mesh without colours: (%g %g %g)", white.r, white.g, white.b);
+  }
+  scene_free(s);
+  /* one colour everywhere renders as that colour's plain material */
+  static const char *const one =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float red\nproperty float green\nproperty float blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "-5 0 -5 0.2 0.5 0.7\n-5 0 5 0.2 0.5 0.7\n5 0 5 0.2 0.5 0.7\n5 0 -5 0.2 0.5 0.7\n4 0 1 2 3\n";
+  CHECK(scratch_file("vcone.ply", one), "write");
+  double mean[2];
+  for (int k = 0; k < 2; k++) {
+    char scn[1024];
+    snprintf(scn, sizeof scn,
+             "{ \"camera\": {\"position\": [0, 2, 0.001], \"look_at\": [0,0,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
+             "  \"materials\": {\"f\": {\"type\": \"diffuse\", \"reflectance\": %s}},\n"
+             "  \"shapes\": [{\"file\": \"vcone.ply\", \"material\": \"f\"}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0,3,0], \"intensity\": 10}] }\n",
+             k ? "[0.2, 0.5, 0.7]" : "1, \"vertex_colors\": true");
+    mean[k] = render_json_mean_green(scn);
+    CHECK(mean[k] > 0, "render failed");
+  }
+  fprintf(stderr, "one colour: vertex colours %.7f, plain %.7f\n", mean[0], mean[1]);
+  CHECK(fabs(mean[0] - mean[1]) < 1e-5 * mean[1], "vertex colours %g against the plain material %g", mean[0], mean[1]);
+  /* glTF COLOR_0: floats, normalized bytes and shorts (RGBA), times the base colour factor */
+  static const int types[3][2] = {{5126, 3}, {5121, 4}, {5123, 4}};
+  const double col[3] = {0.2, 0.4, 0.6};
+  for (int i = 0; i < 3; i++) {
+    char name[32];
+    snprintf(name, sizeof name, "vc%d", i);
+    CHECK(gltf_colored_quad(name, types[i][0], types[i][1], col), "write");
+    char path[64];
+    snprintf(path, sizeof path, "%s.gltf", name);
+    s = scene_new(scratch_path(path));
+    CHECK(load_mesh(s, scratch_path(path), NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+    CHECK(s->mats[s->tri_mat[0]].vertex_colors && s->col, "COLOR_0 of type %d not taken", types[i][0]);
+    rgb kd = kd_at(s, 0, 0.3f, 0.3f);
+    double tol = types[i][0] == 5121 ? 0.5 / 255 : 1e-5;
+    CHECK(fabs(kd.r - 0.5 * col[0]) < tol && fabs(kd.g - col[1]) < tol && fabs(kd.b - 0.25 * col[2]) < tol, "COLOR_0 of type %d: base colour (%g %g %g)",
+          types[i][0], kd.r, kd.g, kd.b);
+    scene_free(s);
+  }
+  if (material_refused("vcquad.ply", "\"f\": {\"type\": \"conductor\", \"preset\": \"Au\", \"vertex_colors\": true}", "unknown key \"vertex_colors\"")) return 1;
+  return material_refused("vcquad.ply", "\"a\": {\"type\": \"diffuse\"}, \"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"a\"], \"vertex_colors\": true}",
+                          "unknown key \"vertex_colors\"");
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1235,7 +1382,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

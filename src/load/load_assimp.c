@@ -1,5 +1,5 @@
 /* load_assimp.c — owns mesh-file import through Assimp's C API (OBJ/MTL, glTF 2.0, PLY
- * and the rest Assimp reads): node transforms, triangulated faces, normals and UVs,
+ * and the rest Assimp reads): node transforms, triangulated faces, normals, UVs and vertex colours,
  * MTL material meanings (../shared/scenes/README.md: Kd, Ke front-sided, illum 5 mirror,
  * illum 7 glass, illum 2 Phong), a file camera, and the input checks (NaN/Inf vertices,
  * out-of-range indices, degenerate or empty meshes). OBJ, PLY and glTF are checked by
@@ -230,6 +230,7 @@ typedef struct load_ctx {
 } load_ctx;
 
 _Static_assert(sizeof(struct aiVector3D) == 3 * sizeof(float), "Assimp's vectors are read as 3 floats");
+_Static_assert(sizeof(struct aiColor4D) == 4 * sizeof(float), "Assimp's colours are read as 4 floats");
 static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 *xf) {
   scene *s = c->s;
   if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) return VALO_OK;
@@ -261,7 +262,8 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   snprintf(where, sizeof where, "%s: mesh '%s'", c->path, mesh->mName.data);
   const struct aiVector3D *uv = mesh->mTextureCoords[0];
   mesh_data md = {where, mesh->mNumVertices, nt, (const float *)mesh->mVertices, (const float *)mesh->mNormals,
-                  uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat, c->smooth};
+                  uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat, c->smooth,
+                  mesh->mColors[0] ? &mesh->mColors[0]->r : NULL, sizeof(struct aiColor4D) / sizeof(float)};
   uint32_t base = s->nverts;
   valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
   free(idx);
@@ -401,7 +403,7 @@ typedef struct imported {
   int flags; /* the LOAD_MESH_ flags that change the import (LOAD_MESH_SMOOTH) */
   const struct aiScene *ai;
   obj_check oc;
-  int obj, gltf, placed;
+  int obj, gltf, ply, placed;
 } imported;
 struct mesh_cache { imported *e; int n; };
 
@@ -447,6 +449,7 @@ static valo_status import_file(const char *path, int mesh_flags, imported *im, v
    * the MTL PBR extension; Assimp then parses the repaired text. */
   im->obj = ext && !strcasecmp(ext, ".obj");
   im->gltf = ext && (!strcasecmp(ext, ".gltf") || !strcasecmp(ext, ".glb"));
+  im->ply = ext && !strcasecmp(ext, ".ply");
   obj_check *oc = &im->oc;
   struct aiFileIO io;
   if (im->obj) {
@@ -504,6 +507,10 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
         return s->tex_fatal.status;
       }
     }
+    /* glTF: a primitive's COLOR_0 multiplies its material's base colour; a PLY (which has
+     * no materials: Assimp's default one) is seen in its vertex colours */
+    for (unsigned i = 0; (c.gltf || im->ply) && i < ai->mNumMeshes; i++)
+      if (ai->mMeshes[i]->mColors[0] && ai->mMeshes[i]->mMaterialIndex < ai->mNumMaterials) s->mats[c.mat_base + ai->mMeshes[i]->mMaterialIndex].vertex_colors = 1;
     if (ai->mNumMaterials == 0) {
       material d = material_default();
       c.override_mat = scene_add_material(s, &d);

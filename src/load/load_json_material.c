@@ -192,22 +192,22 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, sided, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
   static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                          "emission", "two_sided", "black_back", "bump_map", "bump_scale", "smith", NULL};
+                                          "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "smith", NULL};
   /* (a sided material takes the same keys but type, weight and weight_raw) */
   static const char *const k_blend[] = {"weight", "weight_raw", "type", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                         "bump_map", "bump_scale", NULL};
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                             "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
+                                             "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
-                                      "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
+                                      "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
     static const char *const k_null[] = {"type", NULL};
@@ -343,6 +343,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     return json_bad(c, where, "an emitting material cannot have an opacity: give the emission a darker colour instead");
   TRY(json_get_bool(c, o, "two_sided", where, &m->two_sided));
   TRY(json_get_bool(c, o, "black_back", where, &m->black_back));
+  TRY(json_get_bool(c, o, "vertex_colors", where, &m->vertex_colors)); /* kd times the mesh's vertex colours */
   if (m->type == MAT_PLASTIC) { /* a coat already tabulated for the same index and roughness is reused (15-60 ms each) */
     const material *same = NULL;
     for (uint32_t i = 0; i < c->s->nmats && !same; i++) {

@@ -110,6 +110,19 @@ static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
 static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m);
 static cJSON *vec3_json(double x, double y, double z) { return cJSON_CreateDoubleArray((double[]){x, y, z}, 3); }
 
+/* A diffuse colour: a colour, a texture or the mesh's vertex colours (a mesh_attribute:
+ * valo's "vertex_colors" over [scale, scale, scale]); def < 0: none when absent. */
+static valo_status kd_color(mctx *c, xml_node *b, const char *mname, cJSON *m, const char *key, double def) {
+  cJSON *v;
+  c->vertex_color = 0;
+  TRY(mi_color(c, b, mname, MI_VERTEX, &v));
+  if (!v && def >= 0) v = vec3_json(def, def, def);
+  if (v) cJSON_AddItemToObject(m, key, v);
+  if (c->vertex_color) cJSON_AddTrueToObject(m, "vertex_colors");
+  c->vertex_color = 0;
+  return VALO_OK;
+}
+
 /* Mitsuba's diffuse, conductors, plastics, phong and principled without transmission are
  * black seen from behind, unless inside a twosided. */
 static void one_sided(mctx *c, cJSON *m) {
@@ -212,9 +225,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
   } else if (!strcmp(type, "diffuse")) {
     TYPE("diffuse");
     one_sided(c, m);
-    cJSON *v;
-    TRY(mi_color(c, b, "reflectance", 0, &v));
-    cJSON_AddItemToObject(m, "reflectance", v ? v : cJSON_CreateDoubleArray((double[]){0.5, 0.5, 0.5}, 3));
+    TRY(kd_color(c, b, "reflectance", m, "reflectance", 0.5));
   } else if (!strcmp(type, "dielectric") || !strcmp(type, "roughdielectric") || !strcmp(type, "thindielectric")) {
     double in = 1.5046, out = 1.00028; /* bk7 in air, Mitsuba's defaults */
     TRY(ior_prop(c, b, "int_ior", &in));
@@ -270,9 +281,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (in < out) return mi_bad(c, b, "valo's plastic coat is denser than outside (int_ior >= ext_ior)");
     TYPE("plastic");
     cJSON_AddNumberToObject(m, "ior", in / out);
-    cJSON *v;
-    TRY(mi_color(c, b, "diffuse_reflectance", 0, &v));
-    cJSON_AddItemToObject(m, "diffuse", v ? v : vec3_json(0.5, 0.5, 0.5));
+    TRY(kd_color(c, b, "diffuse_reflectance", m, "diffuse", 0.5));
     TRY(set_color(c, b, "specular_reflectance", m, "specular", 1));
     int nonlinear = 0;
     TRY(mi_bool(c, b, "nonlinear", &nonlinear));
@@ -282,7 +291,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
   } else if (!strcmp(type, "principled")) {
     /* valo's principled: Mitsuba's lobes */
     TYPE("principled");
-    TRY(set_color(c, b, "base_color", m, "base_color", 0));
+    TRY(kd_color(c, b, "base_color", m, "base_color", -1));
     static const char *const keys[] = {"metallic", "roughness", "spec_tint", "sheen", "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "specular",
                                        "spec_trans"};
     for (int k = 0; k < 10; k++) {
@@ -316,7 +325,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     if (!trans || trans->valuedouble == 0) one_sided(c, m); /* with transmission it scatters from behind too */
   } else if (!strcmp(type, "phong")) {
     TYPE("phong");
-    TRY(set_color(c, b, "diffuse_reflectance", m, "diffuse", 0));
+    TRY(kd_color(c, b, "diffuse_reflectance", m, "diffuse", -1));
     TRY(set_color(c, b, "specular_reflectance", m, "specular", 0));
     double e = 30;
     TRY(mi_float(c, b, "exponent", &e));

@@ -402,6 +402,25 @@ static valo_status mi_texture(mctx *c, xml_node *k, cJSON **out) {
   return VALO_OK;
 }
 
+/* Mitsuba's mesh_attribute texture of the mesh's vertex colours, as a diffuse colour:
+ * [scale, scale, scale], c->vertex_color set for the material's "vertex_colors". */
+static valo_status vertex_color(mctx *c, xml_node *k, int how, cJSON **out) {
+  const char *name = NULL;
+  double scale = 1;
+  TRY(mi_string(c, k, "name", &name));
+  if (!name) return mi_bad(c, k, "a mesh_attribute needs <string name=\"name\">");
+  if (strcmp(name, "vertex_color"))
+    return mi_bad(c, k, "valo reads the mesh attribute \"vertex_color\" (a PLY file's vertex colours), not \"%s\"", name);
+  if (!(how & MI_VERTEX))
+    return mi_bad(c, k, "valo reads vertex colours as a diffuse colour (diffuse reflectance, a plastic's or phong's diffuse_reflectance, principled's base_color) only");
+  TRY(mi_float(c, k, "scale", &scale));
+  if (!(scale >= 0 && scale < 1e6)) return mi_bad(c, k, "scale must be a number from 0");
+  mi_warn_unused(c, k);
+  if (!(*out = cJSON_CreateDoubleArray((double[]){scale, scale, scale}, 3))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  c->vertex_color = 1;
+  return VALO_OK;
+}
+
 valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out) {
   *out = NULL;
   int rgb_only = how & MI_RGB_ONLY;
@@ -410,6 +429,8 @@ valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **ou
   if (!strcmp(k->name, "ref")) return mi_bad(c, k, "refers to an id that no element has");
   if (!strcmp(k->name, "texture")) {
     if (rgb_only) return mi_bad(c, k, "valo reads a constant colour here, not a texture");
+    const char *type = xml_attr_get(k, "type");
+    if (type && !strcmp(type, "mesh_attribute")) return vertex_color(c, k, how, out);
     TRY(mi_texture(c, k, out));
     if ((how & MI_SCALAR) && !cJSON_AddTrueToObject(*out, "luminance")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     return VALO_OK;

@@ -24,6 +24,7 @@ typedef struct mctx {
   struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
   int twosided;      /* > 0 inside a twosided BSDF: what is translated there scatters from both sides */
+  int vertex_color;  /* set by mi_color (MI_VERTEX) when a colour is the mesh's vertex colours */
 } mctx;
 
 /* The document before its elements are read (load_mitsuba_doc.c): the root is <scene>,
@@ -64,8 +65,10 @@ valo_status mi_transform(mctx *c, xml_node *p, const char *name, double m[16], i
  * when absent. how: MI_RGB_ONLY, a texture is an error; MI_EMITTER, an emitter's colour,
  * where Mitsuba reads a one-value <spectrum> as that much of the equal-energy spectrum
  * (a pinkish white in sRGB's D65 terms), not as grey; MI_SCALAR, a number Mitsuba reads
- * from a texture as its luminance, alpha ignored (the object gets "luminance"). */
-enum { MI_RGB_ONLY = 1, MI_EMITTER = 2, MI_SCALAR = 4 };
+ * from a texture as its luminance, alpha ignored (the object gets "luminance"); MI_VERTEX,
+ * a diffuse colour, where a mesh_attribute texture of the mesh's "vertex_color" is read as
+ * [scale, scale, scale] and sets c->vertex_color (valo's vertex_colors over that colour). */
+enum { MI_RGB_ONLY = 1, MI_EMITTER = 2, MI_SCALAR = 4, MI_VERTEX = 8 };
 valo_status mi_color(mctx *c, xml_node *p, const char *name, int how, cJSON **out);
 /* Parses up to n numbers separated by commas and/or spaces; returns how many. */
 int mi_numbers(const char *s, double *v, int n);

@@ -180,7 +180,7 @@ static valo_status ser_shape(scene *s, const ser_file *f, uint32_t i, const floa
     memcpy(idx, p, 12 * (size_t)nt);
     for (uint32_t v = 0; uv && v < nv; v++) uv[2 * v + 1] = 1 - uv[2 * v + 1]; /* Mitsuba's v runs down the image */
     uint64_t added = 0, degenerate = 0;
-    mesh_data md = {where, nv, nt, pos, nrm, uv, 2, idx, (mesh_flags & LOAD_MESH_FLAT) || (flags & SER_FACE_NORMALS), (mesh_flags & LOAD_MESH_SMOOTH) != 0};
+    mesh_data md = {where, nv, nt, pos, nrm, uv, 2, idx, (mesh_flags & LOAD_MESH_FLAT) || (flags & SER_FACE_NORMALS), (mesh_flags & LOAD_MESH_SMOOTH) != 0, NULL, 0};
     st = scene_add_mesh(s, &md, xf, mat, &added, &degenerate, err);
     if (!st && !added) st = err_set(err, VALO_ERR_INVALID, "%s: no usable triangles (%llu degenerate)", where, (unsigned long long)degenerate);
     if (!st && degenerate) log_warning("%s: skipped %llu degenerate (zero-area) triangles", where, (unsigned long long)degenerate);

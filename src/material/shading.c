@@ -86,6 +86,8 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   it->p = tri_point(p0, p1, p2, h->b1, h->b2, &it->perr);
   it->ng = v3_norm(v3_cross(v3_sub(p1, p0), v3_sub(p2, p0)));
   it->tri = h->tri;
+  it->b1 = h->b1;
+  it->b2 = h->b2;
   it->m = &s->mats[s->tri_mat[h->tri]];
   float b0 = 1 - h->b1 - h->b2;
   it->ns = it->ng;
@@ -125,9 +127,11 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
 
 bsdf bsdf_at(const scene *s, const isect *it) {
   const material *m = it->m;
-  if (m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0) return bsdf_from_material(m);
+  int vc = m->vertex_colors && s->col;
+  if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0) return bsdf_from_material(m);
   material mm = *m;
   float px[4];
+  if (vc) mm.kd = c3_mul(mm.kd, scene_tri_color(s, it->tri, it->b1, it->b2));
   if (m->tex_kd >= 0) { texture_lookup(&s->tex[m->tex_kd], it->u, it->v, px); mm.kd = c3_mul(mm.kd, c3(px[0], px[1], px[2])); }
   if (m->tex_ks >= 0) { texture_lookup(&s->tex[m->tex_ks], it->u, it->v, px); mm.ks = c3_mul(mm.ks, c3(px[0], px[1], px[2])); }
   if (m->tex_ns >= 0) { texture_lookup(&s->tex[m->tex_ns], it->u, it->v, px); mm.exponent *= (px[0] + px[1] + px[2]) / 3; }

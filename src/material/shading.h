@@ -14,6 +14,7 @@ typedef struct isect {
   vec3 ng;            /* unit geometric normal (counter-clockwise winding side) */
   vec3 ns;            /* unit shading normal (interpolated, or ng) */
   float u, v;
+  float b1, b2;       /* the hit's barycentrics in triangle tri (vertex colours) */
   uint32_t tri;
   const material *m;
   vec3 dpdu;          /* an anisotropic material's u direction at the hit (shading_frame's s) */

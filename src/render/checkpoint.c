@@ -41,7 +41,9 @@ static uint64_t scene_hash(const scene *s) {
                    mt->exponent, mt->ior, mt->roughness, mt->metallic, (float)mt->type};
     h = fnv(h, v, sizeof v);
     h = fnv(h, mt->name, strnlen(mt->name, sizeof mt->name));
+    if (mt->vertex_colors) h = fnv(h, "vertex colours", 14);
   }
+  if (s->col) h = fnv(h, s->col, (size_t)s->nverts * 3 * sizeof *s->col);
   h = fnv(h, &s->nlights, sizeof s->nlights);
   return h;
 }

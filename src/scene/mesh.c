@@ -1,11 +1,13 @@
 /* mesh.c — owns appending a triangle mesh, given in a file's own arrays, to the scene:
  * placed by a transform (normals by its normal matrix, the winding kept facing the same
  * way under a mirroring one), non-finite data refused, degenerate triangles skipped.
- * Where a file gives no normals they may be computed from the faces (Mitsuba's rule).
+ * Where a file gives no normals they may be computed from the faces (Mitsuba's rule);
+ * vertex colours are kept when a file gives them.
  * Every mesh loader (Assimp's formats, Mitsuba's serialized meshes) comes through here. */
 #include "scene/scene.h"
 #include "core/error.h"
 #include "core/mat34.h"
+#include <stdlib.h>
 
 /* The angle between unit vectors a and b (stable near 0 and pi). */
 static float unit_angle(vec3 a, vec3 b) { return 2 * atan2f(v3_len(v3_sub(a, b)), v3_len(v3_add(a, b))); }
@@ -49,6 +51,10 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint
   for (int i = 0; flip && i < 3; i++)
     for (int j = 0; j < 3; j++) nm.m[i][j] = -nm.m[i][j];
   uint32_t base = s->nverts;
+  if (m->col && !s->col) { /* the first file with colours: every vertex so far white */
+    if (!(s->col = malloc((size_t)s->cap_verts * 3 * sizeof(float)))) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", m->where);
+    for (size_t i = 0; i < 3 * (size_t)s->cap_verts; i++) s->col[i] = 1;
+  }
   for (uint32_t v = 0; v < m->nverts; v++) {
     const float *p = &m->pos[3 * (size_t)v];
     vec3 pv = v3(p[0], p[1], p[2]);
@@ -66,6 +72,11 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf12, uint
     }
     s->nrm[base + v] = n;
     if (s->tan_file) memset(&s->tan_file[4 * (size_t)(base + v)], 0, 4 * sizeof(float));
+    for (int k = 0; s->col && k < 3; k++) { /* a colour the file gave (below 0 read as 0), else white */
+      float x = m->col ? m->col[(size_t)m->col_stride * v + k] : 1;
+      if (!isfinite(x)) return err_set(err, VALO_ERR_INVALID, "%s vertex %u has a colour that is not finite", m->where, v);
+      s->col[3 * (size_t)(base + v) + k] = fmaxf(x, 0);
+    }
     float u = 0, w = 0;
     if (m->uv) { u = m->uv[(size_t)m->uv_stride * v]; w = m->uv[(size_t)m->uv_stride * v + 1]; }
     s->uv[2 * (base + v)] = isfinite(u) ? u : 0;

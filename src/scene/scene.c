@@ -23,7 +23,7 @@ scene *scene_new(const char *path) {
 
 void scene_free(scene *s) {
   if (!s) return;
-  free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->idx); free(s->tri_mat); free(s->tri_flags);
+  free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->col); free(s->idx); free(s->tri_mat); free(s->tri_flags);
   free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
   for (uint32_t i = 0; i < s->nmedia; i++) density_grid_free(s->media[i].grid);
   free(s->media); free(s->shape_media); free(s->tri_media); free(s->spheres);
@@ -50,11 +50,13 @@ int scene_reserve(scene *s, uint32_t more_verts, uint32_t more_tris) {
   uint64_t nv = (uint64_t)s->nverts + more_verts, nt = (uint64_t)s->ntris + more_tris;
   if (nv > 0xFFFFFFF0u || nt > 0xFFFFFFF0u) return -1;
   if (nv > s->cap_verts) {
-    uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts, c4 = s->cap_verts;
+    uint32_t c = s->cap_verts, c2 = s->cap_verts, c3 = s->cap_verts, c4 = s->cap_verts, c5 = s->cap_verts;
     if (grow((void **)&s->pos, &c, nv, sizeof(vec3)) || grow((void **)&s->nrm, &c2, nv, sizeof(vec3)) ||
-        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)) || (s->tan_file && grow((void **)&s->tan_file, &c4, nv, 4 * sizeof(float))))
+        grow((void **)&s->uv, &c3, nv, 2 * sizeof(float)) || (s->tan_file && grow((void **)&s->tan_file, &c4, nv, 4 * sizeof(float))) ||
+        (s->col && grow((void **)&s->col, &c5, nv, 3 * sizeof(float))))
       return -1;
     if (s->tan_file) memset(s->tan_file + 4 * (size_t)s->cap_verts, 0, (size_t)(c4 - s->cap_verts) * 4 * sizeof(float)); /* none given */
+    for (size_t i = 3 * (size_t)s->cap_verts; s->col && i < 3 * (size_t)c5; i++) s->col[i] = 1; /* none given: white */
     s->cap_verts = c;
   }
   if (nt > s->cap_tris) {
@@ -223,6 +225,14 @@ void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, floa
   }
   *u = b0 * s->uv[2 * ix[0]] + b1 * s->uv[2 * ix[1]] + b2 * s->uv[2 * ix[2]];
   *v = b0 * s->uv[2 * ix[0] + 1] + b1 * s->uv[2 * ix[1] + 1] + b2 * s->uv[2 * ix[2] + 1];
+}
+
+rgb scene_tri_color(const scene *s, uint32_t t, float b1, float b2) {
+  if (!s->col) return c3(1, 1, 1);
+  const uint32_t *ix = &s->idx[3 * t];
+  const float *a = &s->col[3 * (size_t)ix[0]], *b = &s->col[3 * (size_t)ix[1]], *c = &s->col[3 * (size_t)ix[2]];
+  float b0 = 1 - b1 - b2;
+  return c3(b0 * a[0] + b1 * b[0] + b2 * c[0], b0 * a[1] + b1 * b[1] + b2 * c[1], b0 * a[2] + b1 * b[2] + b2 * c[2]);
 }
 
 int material_has_maps(const material *m) {

@@ -49,6 +49,8 @@ typedef struct material {
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
+  int vertex_colors; /* kd (diffuse, base colour) times the mesh's vertex colours, white
+                        where a mesh has none (JSON "vertex_colors", glTF's COLOR_0) */
   int black_back;    /* black seen from behind (the side against the winding's normal): no
                         scattering there, as Mitsuba's BSDFs outside a twosided (JSON "black_back") */
   int tex_kd, tex_ks, tex_ke;  /* texture indices multiplying kd, ks, emission; -1 = none */
@@ -162,6 +164,9 @@ typedef struct scene {
                                the map (VALO_OK when none) */
   char tex_user[1200];      /* while a loader reads a material's maps: "file: material 'x'",
                               named in the warning when one cannot be read */
+  float *col;              /* 3 per vertex: a colour the file gave (linear RGB; PLY's colours,
+                              glTF's COLOR_0), 1 where it gave none; NULL until a file gives
+                              one (then grown with the other vertex arrays) */
   float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and
                               the bitangent sign); w = 0 where it gave none; NULL until a
                               file gives one (then grown with the other vertex arrays) */
@@ -235,6 +240,8 @@ int scene_texture_checkerboard(scene *s, const float c0[3], const float c1[3], v
  * triangle the sphere's own layout at the point's direction from its centre (exact, so a
  * texture shows no facets). */
 void scene_tri_uv(const scene *s, uint32_t t, float b1, float b2, float *u, float *v);
+/* The vertex colour of triangle t at barycentrics (b1, b2); white when the scene has none. */
+rgb scene_tri_color(const scene *s, uint32_t t, float b1, float b2);
 /* Alpha test: 1 if the hit on triangle t at (b1, b2) counts. A cutout compares the map
  * with alpha_cutoff; an opacity a < 1 lets the hit count with probability a, decided by a
  * hash of key (the ray's, geometry/accel.h) and t: the same ray meets the same answer
@@ -278,6 +285,8 @@ typedef struct mesh_data {
   int uv_stride;
   const uint32_t *idx;
   int flat, smooth;
+  const float *col;        /* col_stride floats per vertex, RGB first (NULL: none) */
+  int col_stride;
 } mesh_data;
 /* Appends m placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps each
  * triangle's front side), every triangle of material mat (< s->nmats). Non-finite
