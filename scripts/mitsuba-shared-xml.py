@@ -51,7 +51,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's anisotropic roughness (valo's roughness_u and roughness_v)
           "aniso": ("@tests/data/mitsuba-xml/aniso.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's mesh_attribute texture of a PLY file's vertex colours (valo's vertex_colors)
-          "vertex-colors": ("@tests/data/mitsuba-xml/vertex-colors.xml", {"resx": "160", "resy": "96"})}
+          "vertex-colors": ("@tests/data/mitsuba-xml/vertex-colors.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's cylinder (valo's cylinder)
+          "cylinders": ("@tests/data/mitsuba-xml/cylinders.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -253,7 +253,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
 static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfirst, uint32_t mend) {
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
-  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "subdivisions", "flip_normals", "smooth",
+  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "p0", "p1", "subdivisions", "flip_normals", "smooth",
                                      "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", "flip_v", "uv_frame", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
@@ -327,8 +327,10 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "face_normals")) return json_bad(c, where, "\"face_normals\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "shape_index")) return json_bad(c, where, "\"shape_index\" is a mesh's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "smooth_normals")) return json_bad(c, where, "\"smooth_normals\" is a mesh's");
-  if (mesh && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a sphere's, rectangle's, cube's or disk's");
+  if (mesh && cJSON_GetObjectItemCaseSensitive(o, "mitsuba_uv")) return json_bad(c, where, "\"mitsuba_uv\" is a sphere's, rectangle's, cube's, disk's or cylinder's");
   if (!sphere && cJSON_GetObjectItemCaseSensitive(o, "uv_frame")) return json_bad(c, where, "\"uv_frame\" is a sphere's");
+  if (strcmp(type, "cylinder") && (cJSON_GetObjectItemCaseSensitive(o, "p0") || cJSON_GetObjectItemCaseSensitive(o, "p1")))
+    return json_bad(c, where, "\"p0\" and \"p1\" are a cylinder's");
   if (!mesh && cJSON_GetObjectItemCaseSensitive(o, "flip_v")) return json_bad(c, where, "\"flip_v\" is a mesh file's");
   if (sphere && (cJSON_GetObjectItemCaseSensitive(o, "transform") || cJSON_GetObjectItemCaseSensitive(o, "file")))
     return json_bad(c, where, "a sphere is placed by \"center\" and \"radius\" (no \"transform\" or \"file\")");
@@ -385,17 +387,26 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
     TRY(scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err));
     return mitsuba_uv ? scene_sphere_uv(c->s, c->s->nspheres - 1, rot) : VALO_OK;
   }
-  static const char *const prims[] = {"rectangle", "cube", "disk"};
-  for (int k = 0; k < 3; k++) {
+  static const char *const prims[] = {"rectangle", "cube", "disk", "cylinder"};
+  for (int k = 0; k < 4; k++) {
     if (strcmp(type, prims[k])) continue;
     float xf[12];
     TRY(shape_transform(c, o, where, xf));
-    int flip = 0, mitsuba_uv = 0;
+    int flip = 0, mitsuba_uv = 0, cyl = k == PRIM_CYLINDER;
     TRY(json_get_bool(c, o, "flip_normals", where, &flip));
     TRY(json_get_bool(c, o, "mitsuba_uv", where, &mitsuba_uv));
-    static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "file"};
-    for (int j = 0; j < 5; j++)
-      if (cJSON_GetObjectItemCaseSensitive(o, own[j])) {
+    if (cyl) { /* the unit cylinder from p0 to p1 of radius r, then the transform (Mitsuba's order) */
+      vec3 p0 = v3(0, 0, 0), p1 = v3(0, 0, 1);
+      double r = 1;
+      TRY(json_get_vec(c, o, "p0", where, 0, &p0));
+      TRY(json_get_vec(c, o, "p1", where, 0, &p1));
+      TRY(json_get_num(c, o, "radius", where, 1e-9, 1e9, &r));
+      if (!(v3_len(v3_sub(p1, p0)) > 0)) return json_bad(c, where, "a cylinder's p0 and p1 must differ");
+      scene_cylinder_place(p0, p1, (float)r, xf);
+    }
+    static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "file", "p0", "p1"};
+    for (int j = 0; j < 7; j++)
+      if (!(cyl && (j == 1 || j > 4)) && cJSON_GetObjectItemCaseSensitive(o, own[j])) {
         char msg[160];
         snprintf(msg, sizeof msg, "a %s takes no \"%s\": it is the unit shape placed by \"transform\"", type, own[j]);
         return json_bad(c, where, msg);
@@ -407,7 +418,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
     }
     return scene_add_primitive(c->s, (primitive_kind)k, xf, flip, mitsuba_uv, mat, c->err);
   }
-  return json_bad(c, where, "unknown shape type (mesh, sphere, rectangle, cube, disk)");
+  return json_bad(c, where, "unknown shape type (mesh, sphere, rectangle, cube, disk, cylinder)");
 }
 
 static valo_status parse_light(jctx *c, const cJSON *o, int index) {

@@ -270,8 +270,21 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     if (has_xf) TRY(matrix_json(c, m, sh));
     if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
     cJSON_AddTrueToObject(sh, "mitsuba_uv"); /* its textures where Mitsuba puts them */
+  } else if (!strcmp(type, "cylinder")) {
+    vec3 p0 = v3(0, 0, 0), p1 = v3(0, 0, 1);
+    double r = 1;
+    TRY(mi_point(c, n, "p0", &p0));
+    TRY(mi_point(c, n, "p1", &p1));
+    TRY(mi_float(c, n, "radius", &r));
+    cJSON_AddStringToObject(sh, "type", "cylinder");
+    cJSON_AddItemToObject(sh, "p0", vec_json(p0.x, p0.y, p0.z));
+    cJSON_AddItemToObject(sh, "p1", vec_json(p1.x, p1.y, p1.z));
+    TRY(put_num(c, sh, "radius", r));
+    if (has_xf) TRY(matrix_json(c, m, sh));
+    if (flip) cJSON_AddTrueToObject(sh, "flip_normals");
+    cJSON_AddTrueToObject(sh, "mitsuba_uv"); /* its textures where Mitsuba puts them */
   } else {
-    return mi_bad(c, n, "valo reads obj, ply, serialized, sphere, rectangle, cube and disk shapes");
+    return mi_bad(c, n, "valo reads obj, ply, serialized, sphere, rectangle, cube, disk and cylinder shapes");
   }
   /* Material: the shape's BSDF (or Mitsuba's default), with its area emitter's radiance. */
   xml_node *b = mi_child(c, n, "bsdf", 0);

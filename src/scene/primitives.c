@@ -1,6 +1,6 @@
 /* primitives.c — owns the shapes a scene file describes by kind rather than by mesh:
- * the tessellated sphere and Mitsuba's unit rectangle, cube and disk, placed by a
- * 3x4 transform. */
+ * the tessellated sphere and Mitsuba's unit rectangle, cube, disk and cylinder, placed
+ * by a 3x4 transform. */
 #include "scene/scene.h"
 #include "core/error.h"
 #include "core/mat34.h"
@@ -152,7 +152,54 @@ static void cube_uv_mitsuba(int axis, float sgn, vec3 p, float *u, float *v) {
   *v = 1 - mv;
 }
 
+#define CYLINDER_SEGMENTS 256
+
+/* Mitsuba's cylinder: the tube of radius 1 around z from z = 0 to 1, no caps, facing out;
+ * CYLINDER_SEGMENTS facets whose vertex normals point straight out from the axis, so that
+ * their interpolation at a hit on a facet is the true cylinder's normal there (the facet's
+ * chord and the normals' blend are the same blend of two radii). u = phi / 2 pi from +x
+ * towards +y, v = z (Mitsuba's v, turned up to valo's convention, is 1 - z). */
+static valo_status add_cylinder(scene *s, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err) {
+  enum { NV = 2 * (CYLINDER_SEGMENTS + 1), NT = 2 * CYLINDER_SEGMENTS };
+  mat34 m = m34_from(xf);
+  float det = m34_det(&m);
+  if (!(fabsf(det) > 0) || !isfinite(det)) return err_set(err, VALO_ERR_INVALID, "%s: a shape's transform is singular (it flattens the shape)", s->path);
+  float lp[3 * NV], ln[3 * NV], luv[2 * NV];
+  uint32_t li[3 * NT];
+  for (int k = 0; k <= CYLINDER_SEGMENTS; k++) {
+    double phi = 2 * M_PI * k / CYLINDER_SEGMENTS;
+    float x = k == CYLINDER_SEGMENTS ? 1 : (float)cos(phi), y = k == CYLINDER_SEGMENTS ? 0 : (float)sin(phi);
+    for (int z = 0; z < 2; z++) {
+      int v = 2 * k + z;
+      lp[3 * v] = x; lp[3 * v + 1] = y; lp[3 * v + 2] = (float)z;
+      ln[3 * v] = flip ? -x : x; ln[3 * v + 1] = flip ? -y : y; ln[3 * v + 2] = 0;
+      luv[2 * v] = (float)k / CYLINDER_SEGMENTS;
+      luv[2 * v + 1] = mitsuba_uv ? 1.0f - (float)z : (float)z;
+    }
+  }
+  for (int k = 0; k < CYLINDER_SEGMENTS; k++) { /* counter-clockwise seen from outside (flipped: from inside) */
+    uint32_t a = 2u * (uint32_t)k, q[6] = {a, a + 2, a + 3, a, a + 3, a + 1};
+    for (int j = 0; j < 6; j++) li[6 * k + j] = q[flip ? 5 - j : j];
+  }
+  mesh_data md = {s->path, NV, NT, lp, ln, luv, 2, li, 0, 0, NULL, 0};
+  uint64_t added = 0, degenerate = 0;
+  return scene_add_mesh(s, &md, xf, mat, &added, &degenerate, err);
+}
+
+void scene_cylinder_place(vec3 p0, vec3 p1, float r, float xf[12]) {
+  vec3 d = v3_sub(p1, p0);
+  float len = v3_len(d);
+  vec3 n = v3_scale(d, 1 / len);
+  /* the frame around n as Mitsuba builds it (Duff et al. 2017), so phi starts where Mitsuba's does */
+  float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+  vec3 sx = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x), ty = v3(b, sign + n.y * n.y * a, -n.y);
+  mat34 l = {{{sx.x * r, ty.x * r, n.x * len, p0.x}, {sx.y * r, ty.y * r, n.y * len, p0.y}, {sx.z * r, ty.z * r, n.z * len, p0.z}}};
+  mat34 m = m34_from(xf), out = m34_mul(&m, &l);
+  memcpy(xf, &out.m[0][0], 12 * sizeof(float));
+}
+
 valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err) {
+  if (kind == PRIM_CYLINDER) return add_cylinder(s, xf, flip, mitsuba_uv, mat, err);
   if (kind == PRIM_RECTANGLE) {
     const vec3 p[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
     const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1}, uv_mi[8] = {0, 1, 1, 1, 1, 0, 0, 0};

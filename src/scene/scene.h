@@ -308,13 +308,19 @@ valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot);
 /* The UV of sphere sp's layout at point p (its direction from the centre). */
 void scene_sphere_point_uv(const sphere_shape *sp, vec3 p, float *u, float *v);
 /* Mitsuba's unit shapes, flat-shaded: the rectangle [-1, 1]^2 at z = 0 facing +z, the
- * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments);
- * placed by xf (3x4 row-major, NULL = identity; a mirroring one keeps the front side);
- * flip: facing the other way. UVs span [0, 1]^2 on each (each face of the cube), or with
- * mitsuba_uv as Mitsuba lays them out (its cube's faces, its disk's polar (r, phi / 2 pi)),
- * v turned up to valo's convention, so a Mitsuba scene's textures land where Mitsuba puts them. */
-typedef enum { PRIM_RECTANGLE, PRIM_CUBE, PRIM_DISK } primitive_kind;
+ * cube [-1, 1]^3 facing out, the disk of radius 1 at z = 0 facing +z (256 segments); and
+ * smooth-shaded the cylinder of radius 1 around z from 0 to 1, open, facing out (256
+ * facets, the true cylinder's normals); placed by xf (3x4 row-major, NULL = identity; a
+ * mirroring one keeps the front side); flip: facing the other way. UVs span [0, 1]^2 on
+ * each (each face of the cube; the cylinder's (phi / 2 pi, z)), or with mitsuba_uv as
+ * Mitsuba lays them out (its cube's faces, its disk's polar (r, phi / 2 pi), its
+ * cylinder's (phi / 2 pi, z)), v turned up to valo's convention, so a Mitsuba scene's
+ * textures land where Mitsuba puts them. */
+typedef enum { PRIM_RECTANGLE, PRIM_CUBE, PRIM_DISK, PRIM_CYLINDER } primitive_kind;
 valo_status scene_add_primitive(scene *s, primitive_kind kind, const float *xf, int flip, int mitsuba_uv, uint32_t mat, valo_error *err);
+/* xf (3x4 row-major) times the placement of the unit cylinder from p0 to p1 (p0 != p1) of
+ * radius r, its x axis where Mitsuba's cylinder puts it (its u = 0). */
+void scene_cylinder_place(vec3 p0, vec3 p1, float r, float xf[12]);
 /* Conductor presets by Mitsuba's material names (scene/conductors.c): 0 on success, -1
  * for a name it does not hold. */
 int conductor_preset(const char *name, rgb *eta, rgb *k);
