@@ -53,7 +53,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's mesh_attribute texture of a PLY file's vertex colours (valo's vertex_colors)
           "vertex-colors": ("@tests/data/mitsuba-xml/vertex-colors.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's cylinder (valo's cylinder)
-          "cylinders": ("@tests/data/mitsuba-xml/cylinders.xml", {"resx": "160", "resy": "96"})}
+          "cylinders": ("@tests/data/mitsuba-xml/cylinders.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's specular_transmittance on dielectrics (valo's transmittance)
+          "tinted-glass": ("@tests/data/mitsuba-xml/tinted-glass.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

@@ -849,10 +849,15 @@ static rgb kd_at(const scene *s, uint32_t t, float b1, float b2) {
   return bsdf_at(s, &it).kd;
 }
 
-/* Writes a glTF quad (y = 0, facing +y) whose COLOR_0 is n components of type ctype
- * (5126 float, 5121 and 5123 normalized bytes and shorts) per vertex, all equal to col,
- * its buffer in a .bin beside it; base colour factor (0.5, 1, 0.25). */
-static int gltf_colored_quad(const char *name, int ctype, int n, const double *col) {
+/* Writes a glTF quad (y = 0, facing +y, 2 x 2) whose COLOR_0 is n components of type
+ * ctype (5126 float, 5121 and 5123 normalized bytes and shorts) per vertex, all equal to
+ * col (n = 0: none), its buffer in a .bin beside it; its material mat (JSON; NULL: base
+ * colour factor (0.5, 1, 0.25), metallic 0) and the document's "extensionsUsed" used
+ * (JSON; NULL: none). */
+static int gltf_quad(const char *name, int ctype, int n, const double *col, const char *mat, const char *used) {
+  static const double white[3] = {1, 1, 1};
+  int attr = n > 0; /* without COLOR_0 the accessor stays, unused */
+  if (!attr) { n = 3; ctype = 5126; col = white; }
   static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1};
   static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
   unsigned char buf[256];
@@ -876,16 +881,18 @@ static int gltf_colored_quad(const char *name, int ctype, int n, const double *c
   FILE *f = fopen(scratch_path(bin), "wb");
   if (!f || fwrite(buf, 1, len, f) != len || fclose(f)) return 0;
   snprintf(json, sizeof json,
-           "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
-           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"COLOR_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
-           " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 1, 0.25, 1], \"metallicFactor\": 0}}],\n"
+           "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],%s%s%s\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0%s}, \"indices\": 2, \"material\": 0}]}],\n"
+           " \"materials\": [%s],\n"
            " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"%s\"}],\n"
            " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": %zu},\n"
            "   {\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": 12}],\n"
            " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, 0, -1], \"max\": [1, 0, 1]},\n"
            "   {\"bufferView\": 1, \"componentType\": %d, \"count\": 4, \"type\": \"VEC%d\"%s},\n"
            "   {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
-           len, bin, clen, 48 + clen, ctype, n, ctype == 5126 ? "" : ", \"normalized\": true");
+           used ? " \"extensionsUsed\": " : "", used ? used : "", used ? "," : "", attr ? ", \"COLOR_0\": 1" : "",
+           mat ? mat : "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 1, 0.25, 1], \"metallicFactor\": 0}}", len, bin, clen, 48 + clen,
+           ctype, n, ctype == 5126 ? "" : ", \"normalized\": true");
   char gl[64];
   snprintf(gl, sizeof gl, "%s.gltf", name);
   return scratch_file(gl, json) != NULL;
@@ -969,7 +976,7 @@ static int vertex_colors(void) {
   for (int i = 0; i < 3; i++) {
     char name[32];
     snprintf(name, sizeof name, "vc%d", i);
-    CHECK(gltf_colored_quad(name, types[i][0], types[i][1], col), "write");
+    CHECK(gltf_quad(name, types[i][0], types[i][1], col, NULL, NULL), "write");
     char path[64];
     snprintf(path, sizeof path, "%s.gltf", name);
     s = scene_new(scratch_path(path));
@@ -984,6 +991,121 @@ static int vertex_colors(void) {
   if (material_refused("vcquad.ply", "\"f\": {\"type\": \"conductor\", \"preset\": \"Au\", \"vertex_colors\": true}", "unknown key \"vertex_colors\"")) return 1;
   return material_refused("vcquad.ply", "\"a\": {\"type\": \"diffuse\"}, \"f\": {\"type\": \"blend\", \"materials\": [\"a\", \"a\"], \"vertex_colors\": true}",
                           "unknown key \"vertex_colors\"");
+}
+
+/* glTF's KHR_materials_transmission, _ior and _volume (gltf_material.c): full
+ * transmission without a volume is a thin dielectric tinted by the base colour factor,
+ * with a thickness a dielectric of the file's ior and roughness; partial transmission over
+ * a metal is the blend of the pbr material at metallic m / (1 - w) and the glass at weight
+ * w = t (1 - m); none leaves the pbr material, and an emitting one stays opaque with a
+ * warning, as does an ior below 1 (read as 1.5); a thin pane seen face on under a white
+ * sky shows R + (1 - R) tint (R the pane's reflectance, 2r / (1 + r), r = 0.04); the blend
+ * renders as the JSON blend of the same two materials; a file that only uses an extension
+ * valo does not read loads with a warning naming it, one that requires it is refused. */
+static int gltf_transmission(void) {
+#define PBR(base, m, r) "\"pbrMetallicRoughness\": {\"baseColorFactor\": [" base ", 1], \"metallicFactor\": " #m ", \"roughnessFactor\": " #r "}"
+  static const struct { const char *mat; mat_type type; float ior, rough, weight; } cases[] = {
+      {"{" PBR("0.9, 0.6, 0.3", 0, 0) ", \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}}}", MAT_THIN_DIELECTRIC, 1.5f, 0, 0},
+      {"{" PBR("1, 1, 1", 0, 0.2) ", \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 1.33},"
+       " \"KHR_materials_volume\": {\"thicknessFactor\": 0.5}}}", MAT_DIELECTRIC, 1.33f, 0.2f, 0},
+      {"{" PBR("0.9, 0.6, 0.3", 0.2, 0.4) ", \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 0.5}}}", MAT_BLEND, 1.5f, 0.4f, 0.4f},
+      {"{" PBR("0.9, 0.6, 0.3", 0, 0.4) "}", MAT_PBR, 1.5f, 0.4f, 0},
+      {"{" PBR("1, 1, 1", 0, 0) ", \"emissiveFactor\": [1, 1, 1], \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}}}", MAT_PBR, 1.5f, 0, 0},
+      {"{" PBR("1, 1, 1", 0, 0) ", \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 0.9}}}",
+       MAT_THIN_DIELECTRIC, 1.5f, 0, 0}};
+#undef PBR
+  static const char *const used = "[\"KHR_materials_transmission\", \"KHR_materials_ior\", \"KHR_materials_volume\"]";
+  valo_error err;
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    char name[32], path[64];
+    snprintf(name, sizeof name, "tr%zu", i);
+    snprintf(path, sizeof path, "%s.gltf", name);
+    CHECK(gltf_quad(name, 0, 0, NULL, cases[i].mat, used), "write");
+    scene *s = scene_new(scratch_path(path));
+    warnings_capture(1);
+    valo_status st = load_mesh(s, scratch_path(path), NULL, UINT32_MAX, 0, NULL, &err);
+    char said[1024];
+    snprintf(said, sizeof said, "%s", warnings_text());
+    warnings_capture(0);
+    CHECK(st == VALO_OK, "%s", err.message);
+    const material *m = &s->mats[s->tri_mat[0]], *g = m;
+    CHECK(m->type == cases[i].type, "case %zu: material type %d, expected %d", i, (int)m->type, (int)cases[i].type);
+    if (m->type == MAT_BLEND) {
+      const material *o = &s->mats[m->blend[0]];
+      g = &s->mats[m->blend[1]];
+      CHECK(fabsf(m->weight - cases[i].weight) < 1e-6f && o->type == MAT_PBR && fabsf(o->metallic - 0.2f / 0.6f) < 1e-6f && fabsf(o->roughness - 0.4f) < 1e-6f &&
+                g->type == MAT_THIN_DIELECTRIC,
+            "case %zu: blend weight %g of %d (metallic %g) and %d", i, m->weight, (int)o->type, o->metallic, (int)g->type);
+    }
+    if (g->type == MAT_DIELECTRIC || g->type == MAT_THIN_DIELECTRIC) {
+      rgb base = i == 1 || i == 5 ? c3(1, 1, 1) : c3(0.9f, 0.6f, 0.3f);
+      CHECK(fabsf(g->ior - cases[i].ior) < 1e-6f && fabsf(g->roughness - cases[i].rough) < 1e-6f && fabsf(g->transmittance.r - base.r) < 1e-6f &&
+                fabsf(g->transmittance.g - base.g) < 1e-6f && fabsf(g->transmittance.b - base.b) < 1e-6f && c3_black(g->kd),
+            "case %zu: glass of ior %g, roughness %g, transmittance (%g %g %g)", i, g->ior, g->roughness, g->transmittance.r, g->transmittance.g, g->transmittance.b);
+    }
+    int warned = strstr(said, "transmission is not read") != NULL || strstr(said, "ior 0.9 is read as 1.5") != NULL;
+    CHECK(warned == (i >= 4), "case %zu: warnings \"%s\"", i, said);
+    scene_free(s);
+  }
+  /* the thin pane face on (a 2 degree field) under a white sky: R + (1 - R) tint */
+  const double r = 0.04, R = 2 * r / (1 + r), tint[3] = {0.9, 0.6, 0.3};
+  static const char *const pane =
+      "{ \"camera\": {\"position\": [0, 5, 0.0001], \"look_at\": [0,0,0], \"fov\": 2},\n"
+      "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 256},\n"
+      "  \"environment\": {\"type\": \"constant\", \"radiance\": 1},\n"
+      "  \"shapes\": [{\"file\": \"tr0.gltf\"}] }\n";
+  int w, h;
+  float *px = render_json_text(pane, NULL, &w, &h);
+  CHECK(px, "render failed");
+  for (int c = 0; c < 3; c++) {
+    double mean = 0;
+    for (int i = 0; i < w * h; i++) mean += px[3 * i + c];
+    mean /= w * h;
+    double want = R + (1 - R) * tint[c];
+    fprintf(stderr, "pane channel %d: %.5f, R + (1 - R) tint %.5f\n", c, mean, want);
+    CHECK(fabs(mean - want) < 0.01 * want, "pane channel %d: %g, expected %g", c, mean, want);
+  }
+  free(px);
+  /* the blend against the JSON blend of the same two materials, on the same quad */
+  double mean[2];
+  for (int k = 0; k < 2; k++) {
+    char scn[1400];
+    snprintf(scn, sizeof scn,
+             "{ \"camera\": {\"position\": [0, 3, 2], \"look_at\": [0,0,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 64},\n"
+             "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.5},\n"
+             "  \"materials\": {\"o\": {\"type\": \"pbr\", \"base_color\": [0.9, 0.6, 0.3], \"metallic\": %.9g, \"roughness\": 0.4},\n"
+             "    \"g\": {\"type\": \"thindielectric\", \"transmittance\": [0.9, 0.6, 0.3]},\n"
+             "    \"b\": {\"type\": \"blend\", \"materials\": [\"o\", \"g\"], \"weight\": 0.4}},\n"
+             "  \"shapes\": [{\"file\": \"tr2.gltf\"%s}, {\"type\": \"rectangle\", \"transform\": {\"rotate_x\": -90, \"translate\": [0, -1, 0]}}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
+             (double)(0.2f / 0.6f), k ? ", \"material\": \"b\"" : "");
+    mean[k] = render_json_mean_green(scn);
+    CHECK(mean[k] > 0, "render failed");
+  }
+  fprintf(stderr, "partial transmission: glTF %.6f, JSON blend %.6f\n", mean[0], mean[1]);
+  CHECK(fabs(mean[0] - mean[1]) < 1e-4 * mean[1], "glTF %g against the JSON blend %g", mean[0], mean[1]);
+  /* extensions: used and not read, a warning; required and not read, refused */
+  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_clearcoat\"]"), "write");
+  scene *s = scene_new(scratch_path("trx.gltf"));
+  warnings_capture(1);
+  valo_status st = load_mesh(s, scratch_path("trx.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
+  int used_said = strstr(warnings_text(), "uses KHR_materials_clearcoat, which valo does not read") != NULL;
+  warnings_capture(0);
+  scene_free(s);
+  CHECK(st == VALO_OK && used_said, "a file using KHR_materials_clearcoat: %s", st ? err.message : "no warning");
+  char *text = read_text_file(scratch_path("trx.gltf"));
+  CHECK(text, "read");
+  char req[4096]; /* the same file, requiring what it uses */
+  snprintf(req, sizeof req, "{\"extensionsRequired\": [\"KHR_materials_clearcoat\"], %s", text + 1);
+  free(text);
+  scratch_file("trr.gltf", req);
+  s = scene_new(scratch_path("trr.gltf"));
+  st = load_mesh(s, scratch_path("trr.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
+  scene_free(s);
+  CHECK(st != VALO_OK && strstr(err.message, "requires the extension KHR_materials_clearcoat") && strstr(err.message, "trr.gltf"), "required: %s",
+        st ? err.message : "loaded");
+  return 0;
 }
 
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
@@ -1382,7 +1504,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -1,8 +1,10 @@
 /* gltf_objects.c — owns the glTF check's nodes and the objects that only name others
  * (gltf_check_internal.h): node trees, scenes, materials' texture references (and
  * KHR_texture_transform, which Assimp indexes without looking), textures, images,
- * cameras, skins, animations and KHR_lights_punctual lights. */
+ * cameras, skins, animations and KHR_lights_punctual lights; the extensions a file uses
+ * and requires. */
 #include "load/gltf_check_internal.h"
+#include "core/error.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -203,8 +205,39 @@ static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx
   return check_texture_refs(g, o, ctx);
 }
 
+/* The extensions valo reads (Assimp imports them and valo uses what it imports). A file
+ * that requires any other is refused, as the glTF specification asks of a loader; one
+ * that only uses others is read with a warning naming them. */
+static const char *const read_extensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
+                                              "KHR_materials_ior", "KHR_materials_volume", NULL};
+static int is_read(const char *name) {
+  for (int i = 0; read_extensions[i]; i++)
+    if (!strcmp(name, read_extensions[i])) return 1;
+  return 0;
+}
+static valo_status check_extensions(gc *g) {
+  char unread[512] = "";
+  for (int req = 1; req >= 0; req--) {
+    const char *key = req ? "extensionsRequired" : "extensionsUsed";
+    uint32_t a = json_get(&g->d, 1, key);
+    if (!a) continue;
+    if (N(g, a)->t != J_ARR) return gl_bad(g, "\"%s\" must be an array of names", key);
+    for (uint32_t c = N(g, a)->child; c; c = N(g, c)->next) {
+      if (N(g, c)->t != J_STR) return gl_bad(g, "\"%s\" must be an array of names", key);
+      const char *name = N(g, c)->str;
+      if (is_read(name)) continue;
+      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s and %s)", name, read_extensions[0],
+                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4]);
+      if (strlen(unread) + strlen(name) + 3 < sizeof unread) snprintf(unread + strlen(unread), sizeof unread - strlen(unread), "%s%s", unread[0] ? ", " : "", name);
+    }
+  }
+  if (unread[0]) log_warning("%s: uses %s, which valo does not read: it renders without them", g->path, unread);
+  return VALO_OK;
+}
+
 valo_status gl_check_objects(gc *g) {
-  valo_status st = gl_each(g, g->arr[K_SCENE], "scene", check_scene);
+  valo_status st = check_extensions(g);
+  if (!st) st = gl_each(g, g->arr[K_SCENE], "scene", check_scene);
   if (!st) st = gl_each(g, g->arr[K_MAT], "material", check_material);
   if (!st) st = gl_each(g, g->arr[K_TEX], "texture", check_texture);
   if (!st) st = gl_each(g, g->arr[K_IMG], "image", check_image);

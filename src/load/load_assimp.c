@@ -19,6 +19,7 @@
 #include <assimp/ObjMaterial.h>
 #include "image/texture.h"
 #include "load/gltf_check.h"
+#include "load/gltf_material.h"
 #include "load/import_probe.h"
 #include "load/obj_check.h"
 #include "load/ply_check.h"
@@ -500,6 +501,11 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
       material m = convert_material(ai->mMaterials[i], im->obj ? &im->oc : NULL);
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
       convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, im->obj ? &im->oc : NULL);
+      if (c.gltf) { /* KHR_materials_transmission: a glass, or a blend with one (gltf_material.c) */
+        int tt = load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL);
+        st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, err);
+        if (st) return st;
+      }
       s->tex_user[0] = 0;
       s->mats[c.mat_base + i] = m;
       if (s->tex_fatal.status) {
@@ -510,7 +516,11 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
     /* glTF: a primitive's COLOR_0 multiplies its material's base colour; a PLY (which has
      * no materials: Assimp's default one) is seen in its vertex colours */
     for (unsigned i = 0; (c.gltf || im->ply) && i < ai->mNumMeshes; i++)
-      if (ai->mMeshes[i]->mColors[0] && ai->mMeshes[i]->mMaterialIndex < ai->mNumMaterials) s->mats[c.mat_base + ai->mMeshes[i]->mMaterialIndex].vertex_colors = 1;
+      if (ai->mMeshes[i]->mColors[0] && ai->mMeshes[i]->mMaterialIndex < ai->mNumMaterials) {
+        material *mt = &s->mats[c.mat_base + ai->mMeshes[i]->mMaterialIndex];
+        mt->vertex_colors = 1;
+        if (mt->type == MAT_BLEND) s->mats[mt->blend[0]].vertex_colors = s->mats[mt->blend[1]].vertex_colors = 1; /* hits see its parts */
+      }
     if (ai->mNumMaterials == 0) {
       material d = material_default();
       c.override_mat = scene_add_material(s, &d);

@@ -195,8 +195,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
   static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
   static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
-  static const char *const k_thin[] = {"type", "ior", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "transmittance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
+  static const char *const k_thin[] = {"type", "ior", "transmittance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
   static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                           "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "smith", NULL};
@@ -250,6 +250,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     double ior = 1.5;
     TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
     m->ior = (float)ior;
+    TRY(json_get_rgb(c, o, "transmittance", where, &m->transmittance)); /* tints what it transmits, at each crossing */
     const char *disp = NULL;
     TRY(json_get_str(c, o, "dispersion", where, &disp));
     if (disp) {

@@ -95,7 +95,8 @@ static valo_status set_color(mctx *c, xml_node *b, const char *mname, cJSON *m, 
   return VALO_OK;
 }
 
-/* The specular tint Mitsuba allows on its smooth and rough dielectrics: valo has none. */
+/* The reflection tint Mitsuba allows on its smooth and rough dielectrics: valo has none
+ * (its transmission tint is valo's transmittance). */
 static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
   cJSON *v;
   TRY(mi_color(c, b, name, MI_RGB_ONLY, &v));
@@ -103,7 +104,7 @@ static valo_status no_tint(mctx *c, xml_node *b, const char *name) {
   int one = 1;
   for (int i = 0; i < 3; i++) one &= cJSON_GetArrayItem(v, i)->valuedouble == 1;
   cJSON_Delete(v);
-  if (!one) mi_warn(c, b, "%s is not read: valo's glass reflects and transmits what Fresnel gives", name);
+  if (!one) mi_warn(c, b, "%s is not read: valo's glass reflects what Fresnel gives", name);
   return VALO_OK;
 }
 
@@ -236,7 +237,7 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
     cJSON_AddNumberToObject(m, "ior", in / out);
     if (type[0] == 'r') TRY(roughness_of(c, b, 0.1, m));
     TRY(no_tint(c, b, "specular_reflectance"));
-    TRY(no_tint(c, b, "specular_transmittance"));
+    TRY(set_color(c, b, "specular_transmittance", m, "transmittance", MI_RGB_ONLY));
   } else if (!strcmp(type, "conductor") || !strcmp(type, "roughconductor")) {
     const char *mat = "none";
     TRY(mi_string(c, b, "material", &mat));

@@ -26,7 +26,7 @@ bsdf bsdf_from_material(const material *m) {
   bsdf b;
   memset(&b, 0, sizeof b);
   b.kd = m->kd; b.ks = m->ks; b.exponent = m->exponent; b.eta = m->ior;
-  b.cond_eta = m->eta; b.cond_k = m->k; b.cond_tint = m->tint;
+  b.cond_eta = m->eta; b.cond_k = m->k; b.cond_tint = m->tint; b.trans = m->transmittance;
   b.beckmann = m->beckmann && m->type != MAT_PBR;
   b.separable = m->smith_separable && m->type != MAT_PBR;
   b.p_first = 1;
@@ -151,6 +151,7 @@ static rgb rd_eval(const bsdf *b, vec3 wo, vec3 wi) {
   else {
     float denom = sqr(v3_dot(wi, wm) + v3_dot(wo, wm) / etap) * wi.z * wo.z;
     v = D * G * (1 - F) * fabsf(v3_dot(wi, wm) * v3_dot(wo, wm) / denom) / (etap * etap);
+    return c3_scale(b->trans, v);
   }
   return c3(v, v, v);
 }
@@ -275,7 +276,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     s->pdf = 0;
     s->delta = 1;
     s->wi = ulobe < R ? v3(-wo.x, -wo.y, wo.z) : v3_neg(wo);
-    s->weight = c3(1, 1, 1);
+    s->weight = ulobe < R ? c3(1, 1, 1) : b->trans;
     return 1;
   }
   case BSDF_DIELECTRIC: {
@@ -293,7 +294,7 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     if (!refract_dir(wo, n, etap, &wt)) return 0; /* cannot happen: F = 1 under TIR */
     s->wi = wt;
     s->eta_scale = 1 / (etap * etap);
-    s->weight = c3(s->eta_scale, s->eta_scale, s->eta_scale);
+    s->weight = c3_scale(b->trans, s->eta_scale);
     return 1;
   }
   case BSDF_PBR: {

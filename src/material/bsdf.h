@@ -21,6 +21,7 @@ typedef struct bsdf {
   float exponent;
   float eta;          /* dielectric: interior index / exterior index */
   rgb cond_eta, cond_k, cond_tint;
+  rgb trans;          /* dielectrics: the tint of what they transmit (material.transmittance) */
   int fresnel_white;  /* conductors: F = 1, the caller applies F per wavelength (--spectral) */
   float p_first;      /* probability of the first lobe (diffuse) in mixtures */
   float alpha;        /* GGX roughness (rough types); along the frame's s axis when anisotropic */

@@ -77,6 +77,7 @@ material material_default(void) {
   m.exponent = 1;
   m.ior = 1.5f;
   m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
+  m.transmittance = c3(1, 1, 1);
   m.bump_scale = 1;
   m.tint = c3(1, 1, 1);
   m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = -1;

@@ -38,6 +38,8 @@ typedef struct material {
   float ior;
   rgb eta, k;
   rgb tint;          /* conductor: multiplies its Fresnel reflectance (Mitsuba's specular_reflectance), 1 by default */
+  rgb transmittance; /* dielectrics: multiplies the light they transmit at each crossing (Mitsuba's
+                        specular_transmittance, glTF's base colour on transmission), 1 by default */
   float roughness;   /* conductor/dielectric: GGX alpha = roughness^2; < 0.0316 is smooth */
   int anisotropic;   /* conductor/dielectric: roughness along the surface's u direction, roughness_v along v */
   float roughness_v;

@@ -1,0 +1,81 @@
+/* gltf_material.c — owns the glTF material extensions valo reads beyond the core
+ * metallic-roughness model (load_assimp.c): KHR_materials_transmission with
+ * KHR_materials_ior and KHR_materials_volume. The glTF BSDF is
+ *   mix(metal, fresnel_mix(ior, mix(diffuse, specular BTDF, t), specular BRDF), metallic)
+ * so with w = t (1 - metallic) it is exactly the blend of valo's pbr material at metallic
+ * m' = metallic / (1 - w) with weight 1 - w and a glass with weight w: a dielectric of the
+ * same ior and roughness when the volume extension gives a thickness (the mesh bounds the
+ * glass), a thin dielectric otherwise (glTF's thin-walled default), its transmission tinted
+ * by the base colour factor. */
+#include "load/gltf_material.h"
+#include "core/error.h"
+#include <assimp/material.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static float mat_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned idx, float def) {
+  ai_real v;
+  unsigned int n = 1;
+  if (aiGetMaterialFloatArray(am, key, type, idx, &v, &n) == aiReturn_SUCCESS && n == 1 && isfinite(v)) return (float)v;
+  return def;
+}
+
+valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, valo_error *err) {
+  float t = mat_float(am, AI_MATKEY_TRANSMISSION_FACTOR, 0);
+  if (!(t > 0)) return VALO_OK;
+  if (t > 1) t = 1;
+  if (!c3_black(m->emission)) {
+    log_warning("%s: an emitting material's transmission is not read (it renders opaque)", where);
+    return VALO_OK;
+  }
+  material glass = *m;
+  float thick = mat_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, 0);
+  glass.type = thick > 0 ? MAT_DIELECTRIC : MAT_THIN_DIELECTRIC;
+  if (!(m->ior >= 1 && m->ior <= 10)) {
+    log_warning("%s: KHR_materials_ior %g is read as 1.5 (valo's glass takes 1 to 10)", where, (double)m->ior);
+    glass.ior = 1.5f;
+  }
+  glass.transmittance = m->kd;
+  glass.kd = c3(0, 0, 0);
+  glass.metallic = 0;
+  glass.tex_kd = -1;
+  if (m->tex_kd >= 0) log_warning("%s: its base colour texture does not tint the light it transmits (its base colour factor does)", where);
+  if (glass.type == MAT_THIN_DIELECTRIC && m->roughness > 0.0316f)
+    log_warning("%s: thin-walled transmission (no KHR_materials_volume thickness) is rendered smooth, not at roughness %g", where, (double)m->roughness);
+  float dist = mat_float(am, AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, INFINITY);
+  struct aiColor4D ac;
+  if (isfinite(dist) && aiGetMaterialColor(am, AI_MATKEY_VOLUME_ATTENUATION_COLOR, &ac) == aiReturn_SUCCESS && (ac.r < 1 || ac.g < 1 || ac.b < 1))
+    log_warning("%s: KHR_materials_volume attenuation is not read (the glass is clear)", where);
+  /* the blend carries the maps that move the surface and its opacity; its parts neither */
+  glass.tex_normal = glass.tex_bump = glass.tex_alpha = -1;
+  glass.opacity = 1;
+  glass.alpha_stochastic = 0;
+  float w = t * (1 - clampf(m->metallic, 0, 1));
+  if (w >= 1 && tex_trans < 0) { /* all glass */
+    glass.tex_normal = m->tex_normal; glass.tex_bump = m->tex_bump;
+    glass.tex_alpha = m->tex_alpha; glass.opacity = m->opacity; glass.alpha_stochastic = m->alpha_stochastic;
+    *m = glass;
+    return VALO_OK;
+  }
+  material opaque = *m, blend = material_default();
+  opaque.metallic = w < 1 ? clampf(m->metallic / (1 - w), 0, 1) : 1;
+  opaque.tex_normal = opaque.tex_bump = opaque.tex_alpha = -1;
+  opaque.opacity = 1;
+  opaque.alpha_stochastic = 0;
+  snprintf(opaque.name, sizeof opaque.name, "%.50s (opaque)", m->name);
+  snprintf(glass.name, sizeof glass.name, "%.50s (glass)", m->name);
+  uint32_t a = scene_add_material(s, &opaque), b = a == UINT32_MAX ? a : scene_add_material(s, &glass);
+  if (b == UINT32_MAX) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  blend.type = MAT_BLEND;
+  blend.blend[0] = (int)a;
+  blend.blend[1] = (int)b;
+  blend.weight = w;
+  blend.tex_weight = tex_trans; /* glTF's transmission texture: its red channel times the factor */
+  blend.tex_normal = m->tex_normal; blend.tex_bump = m->tex_bump; blend.bump_scale = m->bump_scale;
+  blend.tex_alpha = m->tex_alpha; blend.alpha_channel = m->alpha_channel; blend.alpha_cutoff = m->alpha_cutoff;
+  blend.opacity = m->opacity; blend.alpha_stochastic = m->alpha_stochastic;
+  memcpy(blend.name, m->name, sizeof blend.name);
+  *m = blend;
+  return VALO_OK;
+}
