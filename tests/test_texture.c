@@ -1108,6 +1108,82 @@ static int gltf_transmission(void) {
   return 0;
 }
 
+/* glTF's KHR_texture_transform: a quad with texture coordinates whose base colour,
+ * metallic-roughness, normal and emissive textures each carry a transform; looked up at
+ * points of the quad, each equals its image looked up where the extension's formula
+ * sends the point (uv' = offset + R (scale uv), R = [cos sin; -sin cos], in glTF's v-down
+ * space); the extension's own example (offset (0, 1), a quarter turn, scale 0.5) maps
+ * the quad onto the image's lower left quadrant; a texture on coordinate set 1 is warned
+ * about. */
+static int gltf_texture_transform(void) {
+  unsigned char ramp[16 * 16 * 3];
+  for (int y = 0; y < 16; y++)
+    for (int x = 0; x < 16; x++) { unsigned char *p = &ramp[3 * (16 * y + x)]; p[0] = (unsigned char)(16 * x + 8); p[1] = (unsigned char)(16 * y + 8); p[2] = 128; }
+  CHECK(scratch_png("uvramp.png", 16, 16, 3, ramp), "write");
+  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1}, uv[8] = {0, 0, 0, 1, 1, 1, 1, 0};
+  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char buf[96];
+  memcpy(buf, pos, 48); memcpy(buf + 48, uv, 32); memcpy(buf + 80, idx, 12);
+  FILE *f = fopen(scratch_path("uvt.bin"), "wb");
+  CHECK(f && fwrite(buf, 1, 92, f) == 92 && !fclose(f), "write");
+  static const struct { double off[2], rot, scale[2]; } tf[4] = {{{0.25, 0.1}, 0, {1, 1}}, {{0, 1}, M_PI / 2, {0.5, 0.5}}, {{0.3, -0.2}, 0.4, {0.7, 1.3}}, {{0.1, 0.2}, -1.1, {-0.6, 0.8}}};
+  char ext[4][200];
+  for (int k = 0; k < 4; k++)
+    snprintf(ext[k], sizeof ext[k], "\"extensions\": {\"KHR_texture_transform\": {\"offset\": [%.17g, %.17g], \"rotation\": %.17g, \"scale\": [%.17g, %.17g]}}",
+             tf[k].off[0], tf[k].off[1], tf[k].rot, tf[k].scale[0], tf[k].scale[1]);
+  char json[4096];
+  snprintf(json, sizeof json,
+           "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_texture_transform\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
+           " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, %s}, \"metallicRoughnessTexture\": {\"index\": 0, %s}},\n"
+           "   \"normalTexture\": {\"index\": 0, %s}, \"emissiveTexture\": {\"index\": 0, %s}, \"emissiveFactor\": [1, 1, 1]},\n"
+           "   {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"texCoord\": 1}}}],\n"
+           " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"uvramp.png\"}],\n"
+           " \"buffers\": [{\"byteLength\": 92, \"uri\": \"uvt.bin\"}],\n"
+           " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}],\n"
+           " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, 0, -1], \"max\": [1, 0, 1]},\n"
+           "   {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
+           ext[0], ext[1], ext[2], ext[3]);
+  const char *path = scratch_file("uvt.gltf", json);
+  CHECK(path, "write");
+  scene *s = scene_new(path);
+  valo_error err;
+  warnings_capture(1);
+  valo_status st = load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err);
+  int set1 = strstr(warnings_text(), "texture coordinate set 1") != NULL;
+  warnings_capture(0);
+  CHECK(st == VALO_OK, "%s", err.message);
+  CHECK(set1, "a texture on coordinate set 1 was not warned about");
+  const material *m = &s->mats[s->tri_mat[0]];
+  const int slots[4] = {m->tex_kd, m->tex_mr, m->tex_normal, m->tex_ke};
+  for (int k = 0; k < 4; k++) {
+    CHECK(slots[k] >= 0 && s->tex[slots[k]].smp.has_uvm, "slot %d: no transformed texture", k);
+    texture base = s->tex[slots[k]];
+    base.smp.has_uvm = 0;
+    double c = cos(tf[k].rot), sn = sin(tf[k].rot);
+    float lo[2] = {1, 1}, hi[2] = {0, 0};
+    for (int i = 0; i < 9; i++) {
+      float u = 0.05f + 0.45f * (float)(i % 3), v = 0.05f + 0.45f * (float)(i / 3); /* valo's (v up) */
+      double gu = u, gv = 1 - v;                                                    /* glTF's (v down) */
+      double su = tf[k].scale[0] * gu, sv = tf[k].scale[1] * gv;
+      double tu = tf[k].off[0] + c * su + sn * sv, tv = tf[k].off[1] - sn * su + c * sv;
+      float got[4], want[4];
+      texture_lookup(&s->tex[slots[k]], u, v, got);
+      texture_lookup(&base, (float)tu, (float)(1 - tv), want);
+      for (int ch = 0; ch < 3; ch++)
+        CHECK(fabsf(got[ch] - want[ch]) < 2e-3f, "slot %d at (%g, %g): %g, the image at glTF's (%g, %g): %g", k, u, v, got[ch], tu, tv, want[ch]);
+      if (k == 1) { /* the example: inside the lower left quadrant (valo's v up) */
+        float vu = (float)tu, vv = (float)(1 - tv);
+        lo[0] = fminf(lo[0], vu); lo[1] = fminf(lo[1], vv); hi[0] = fmaxf(hi[0], vu); hi[1] = fmaxf(hi[1], vv);
+      }
+    }
+    if (k == 1) CHECK(lo[0] >= -1e-6f && lo[1] >= -1e-6f && hi[0] <= 0.5f + 1e-6f && hi[1] <= 0.5f + 1e-6f, "the example reaches (%g, %g) to (%g, %g)", lo[0], lo[1], hi[0], hi[1]);
+  }
+  scene_free(s);
+  return 0;
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1504,7 +1580,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

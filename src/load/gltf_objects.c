@@ -200,16 +200,56 @@ static valo_status check_scene(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   return gl_index_array(g, o, "nodes", g->n[K_NODE], "node", ctx) ? g->err->status : VALO_OK;
 }
 
+/* Member `key` of v when it is a number, else def. */
+static double num_or(gc *g, uint32_t v, const char *key, double def) {
+  uint32_t x = json_get(&g->d, v, key);
+  return x && N(g, x)->t == J_NUM ? N(g, x)->num : def;
+}
+static double elem_or(gc *g, uint32_t v, const char *key, int k, double def) {
+  uint32_t a = json_get(&g->d, v, key);
+  uint32_t x = a && N(g, a)->t == J_ARR ? N(g, a)->child : 0;
+  if (x && k) x = N(g, x)->next;
+  return x && N(g, x)->t == J_NUM ? N(g, x)->num : def;
+}
+
+/* The KHR_texture_transform of material i's textures valo reads, kept for the loader as
+ * valo's uv_matrix: glTF's uv' = offset + R (scale * uv), R = [c s; -s c] (rotation
+ * counter-clockwise in glTF's v-down texture space, as the extension's own example and
+ * three.js read it), turned into valo's v-up coordinates (F M F, F(u, v) = (u, 1 - v)). A
+ * texture on another coordinate set than the first is warned about: valo reads set 0. */
+static valo_status record_transforms(gc *g, uint32_t o, uint32_t i, const char *ctx) {
+  uint32_t pbr = json_get(&g->d, o, "pbrMetallicRoughness"), ext = json_get(&g->d, o, "extensions");
+  uint32_t slot_of[GLTF_SLOTS] = {json_get(&g->d, pbr, "baseColorTexture"), json_get(&g->d, pbr, "metallicRoughnessTexture"),
+                                  json_get(&g->d, o, "normalTexture"), json_get(&g->d, o, "emissiveTexture"),
+                                  json_get(&g->d, json_get(&g->d, ext, "KHR_materials_transmission"), "transmissionTexture")};
+  for (int k = 0; k < GLTF_SLOTS; k++) {
+    uint32_t info = slot_of[k];
+    if (!info || N(g, info)->t != J_OBJ) continue;
+    uint32_t tt = json_get(&g->d, json_get(&g->d, info, "extensions"), "KHR_texture_transform");
+    double set = num_or(g, tt, "texCoord", num_or(g, info, "texCoord", 0));
+    if (set != 0) log_warning("%s: %s: a texture reads texture coordinate set %g; valo reads set 0 only", g->path, ctx, set);
+    if (!tt || N(g, tt)->t != J_OBJ) continue;
+    double r = num_or(g, tt, "rotation", 0), c = cos(r), sn = sin(r);
+    double sx = elem_or(g, tt, "scale", 0, 1), sy = elem_or(g, tt, "scale", 1, 1), ox = elem_or(g, tt, "offset", 0, 0), oy = elem_or(g, tt, "offset", 1, 0);
+    double a = c * sx, b = sn * sy, d = -sn * sx, e = c * sy; /* glTF's M: [a b ox; d e oy] */
+    gltf_uvt *u = realloc(g->oc->uvt, (size_t)(g->oc->nuvt + 1) * sizeof *u);
+    if (!u) return gl_bad(g, "out of memory");
+    g->oc->uvt = u;
+    u[g->oc->nuvt++] = (gltf_uvt){i, k, {(float)a, (float)-b, (float)(b + ox), (float)-d, (float)e, (float)(1 - e - oy)}};
+  }
+  return VALO_OK;
+}
+
 static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
-  (void)i;
-  return check_texture_refs(g, o, ctx);
+  valo_status st = check_texture_refs(g, o, ctx);
+  return st ? st : record_transforms(g, o, i, ctx);
 }
 
 /* The extensions valo reads (Assimp imports them and valo uses what it imports). A file
  * that requires any other is refused, as the glTF specification asks of a loader; one
  * that only uses others is read with a warning naming them. */
 static const char *const read_extensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
-                                              "KHR_materials_ior", "KHR_materials_volume", NULL};
+                                              "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", NULL};
 static int is_read(const char *name) {
   for (int i = 0; read_extensions[i]; i++)
     if (!strcmp(name, read_extensions[i])) return 1;
@@ -226,8 +266,8 @@ static valo_status check_extensions(gc *g) {
       if (N(g, c)->t != J_STR) return gl_bad(g, "\"%s\" must be an array of names", key);
       const char *name = N(g, c)->str;
       if (is_read(name)) continue;
-      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s and %s)", name, read_extensions[0],
-                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4]);
+      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s, %s and %s)", name, read_extensions[0],
+                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4], read_extensions[5]);
       if (strlen(unread) + strlen(name) + 3 < sizeof unread) snprintf(unread + strlen(unread), sizeof unread - strlen(unread), "%s%s", unread[0] ? ", " : "", name);
     }
   }

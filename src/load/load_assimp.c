@@ -161,8 +161,19 @@ static int looks_like_normal_map(const texture *t) {
   return b > 0.7 && fabs(r - 0.5) < 0.15 && fabs(g - 0.5) < 0.15 && spread > 0.2;
 }
 
+/* glTF: texture t of material mi's slot as its KHR_texture_transform samples it (recorded
+ * by gltf_check), a texture sharing t's pixels; t itself when there is none. */
+static int transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t) {
+  const float *m = t >= 0 && oc ? obj_check_uvt(oc, mi, slot) : NULL;
+  if (!m) return t;
+  tex_sampling smp = s->tex[t].smp;
+  smp.has_uvm = 1;
+  memcpy(smp.uvm, m, sizeof smp.uvm);
+  return scene_texture_sampled(s, t, &smp);
+}
+
 static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf,
-                             const obj_check *oc) {
+                             const obj_check *oc, unsigned mi) {
   int wrap = 0;
   const mtl_pbr *pb = oc ? obj_check_pbr(oc, m->name) : NULL;
   if (pb && pb->map_pr[0]) m->tex_rough = texture_in(s, dir, pb->map_pr, 0);
@@ -196,6 +207,10 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
     m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
     m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, dir, 0, NULL);
     if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, dir, 0, NULL);
+    m->tex_kd = transformed(s, oc, mi, GLTF_SLOT_BASE, m->tex_kd);
+    m->tex_mr = transformed(s, oc, mi, GLTF_SLOT_MR, m->tex_mr);
+    m->tex_normal = transformed(s, oc, mi, GLTF_SLOT_NORMAL, m->tex_normal);
+    m->tex_ke = transformed(s, oc, mi, GLTF_SLOT_EMISSIVE, m->tex_ke);
   }
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
@@ -498,11 +513,12 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
     const char *slash = strrchr(path, '/');
     if (slash) snprintf(dir, sizeof dir, "%.*s/", (int)(slash - path), path);
     for (unsigned i = 0; i < ai->mNumMaterials; i++) {
-      material m = convert_material(ai->mMaterials[i], im->obj ? &im->oc : NULL);
+      const obj_check *oc = im->obj || im->gltf ? &im->oc : NULL;
+      material m = convert_material(ai->mMaterials[i], oc);
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, im->obj ? &im->oc : NULL);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc, i);
       if (c.gltf) { /* KHR_materials_transmission: a glass, or a blend with one (gltf_material.c) */
-        int tt = load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL);
+        int tt = transformed(s, oc, i, GLTF_SLOT_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
         st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, err);
         if (st) return st;
       }
