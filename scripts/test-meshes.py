@@ -1,21 +1,23 @@
-# vertex-color-meshes.py — writes the two meshes of tests/data/mitsuba-xml/vertex-colors.xml:
+# test-meshes.py — writes the PLY meshes of tests/data/mitsuba-xml: for vertex-colors.xml,
 # vc-floor.ply, a 4 x 4 floor of 12 x 12 quads whose float vertex colours vary across it,
-# and vc-ball.ply, a UV sphere (24 x 12, its exact normals) coloured by its normal. ASCII
-# PLY with float red, green, blue, the form Mitsuba 3 writes (it reads 8-bit colours as
-# 0-255). Optional tooling: the files are committed.
+# and vc-ball.ply, a UV sphere (24 x 12, its exact normals) coloured by its normal (ASCII
+# PLY with float red, green, blue, the form Mitsuba 3 writes: it reads 8-bit colours as
+# 0-255); for shading-backs.xml, coarse-ball.ply, a UV sphere of 8 x 5 facets with its
+# exact normals. Optional tooling: the files are committed.
 #
-#   python3 scripts/vertex-color-meshes.py
+#   python3 scripts/test-meshes.py
 import math, os
 
 OUT = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests", "data", "mitsuba-xml")
 
 
-def write(name, verts, faces, normals):
+def write(name, verts, faces, normals, colors=True):
     with open(os.path.join(OUT, name), "w") as f:
         f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\nproperty float z\n" % len(verts))
         if normals:
             f.write("property float nx\nproperty float ny\nproperty float nz\n")
-        f.write("property float red\nproperty float green\nproperty float blue\n")
+        if colors:
+            f.write("property float red\nproperty float green\nproperty float blue\n")
         f.write("element face %d\nproperty list uchar int vertex_indices\nend_header\n" % len(faces))
         for v in verts:
             f.write(" ".join("%.6g" % x for x in v) + "\n")
@@ -47,21 +49,22 @@ def area(verts, t):
     return 0.5 * math.sqrt(sum(x * x for x in n))
 
 
-def ball():
-    nu, nv, verts, faces = 24, 12, [], []
+def ball(nu=24, nv=12, name="vc-ball.ply", colors=True):
+    verts, faces = [], []
     for j in range(nv + 1):
         th = math.pi * j / nv
         for i in range(nu + 1):
             ph = 2 * math.pi * i / nu
             n = (math.sin(th) * math.cos(ph), math.cos(th), math.sin(th) * math.sin(ph))
-            verts.append(n + n + tuple(0.5 + 0.45 * c for c in n))
+            verts.append(n + n + (tuple(0.5 + 0.45 * c for c in n) if colors else ()))
     for j in range(nv):
         for i in range(nu):
             a = j * (nu + 1) + i
             faces += [(a, a + 1, a + nu + 2), (a, a + nu + 2, a + nu + 1)]
     faces = [t for t in faces if area(verts, t) > 1e-9]  # none at the poles
-    write("vc-ball.ply", verts, faces, True)
+    write(name, verts, faces, True, colors)
 
 
 floor()
 ball()
+ball(8, 5, "coarse-ball.ply", False)
