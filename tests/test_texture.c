@@ -1000,8 +1000,10 @@ static int vertex_colors(void) {
  * w = t (1 - m); none leaves the pbr material, and an emitting one stays opaque with a
  * warning, as does an ior below 1 (read as 1.5); a thin pane seen face on under a white
  * sky shows R + (1 - R) tint (R the pane's reflectance, 2r / (1 + r), r = 0.04); the blend
- * renders as the JSON blend of the same two materials; a file that only uses an extension
- * valo does not read loads with a warning naming it, one that requires it is refused. */
+ * renders as the JSON blend of the same two materials; a volume's attenuation is an
+ * absorbing medium inside the mesh (a cube of ior 1 seen face on shows colour^(side /
+ * distance)); a file that only uses an extension valo does not read loads with a warning
+ * naming it, one that requires it is refused. */
 static int gltf_transmission(void) {
 #define PBR(base, m, r) "\"pbrMetallicRoughness\": {\"baseColorFactor\": [" base ", 1], \"metallicFactor\": " #m ", \"roughnessFactor\": " #r "}"
   static const struct { const char *mat; mat_type type; float ior, rough, weight; } cases[] = {
@@ -1085,9 +1087,50 @@ static int gltf_transmission(void) {
   }
   fprintf(stderr, "partial transmission: glTF %.6f, JSON blend %.6f\n", mean[0], mean[1]);
   CHECK(fabs(mean[0] - mean[1]) < 1e-4 * mean[1], "glTF %g against the JSON blend %g", mean[0], mean[1]);
+  /* a volume's attenuation: an absorbing medium inside the mesh. A cube of side 2 of ior 1
+   * (no reflection, no bending) seen face on under a white sky shows colour^(2 / distance) */
+  static const float cpos[24] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
+  static const uint16_t cidx[36] = {0, 3, 2, 0, 2, 1, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 7, 6, 3, 6, 2, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+  FILE *f = fopen(scratch_path("cube.bin"), "wb");
+  CHECK(f && fwrite(cpos, 1, 96, f) == 96 && fwrite(cidx, 1, 72, f) == 72 && !fclose(f), "write");
+  char cube[2048];
+  snprintf(cube, sizeof cube,
+           "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": %s, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 0}]}],\n"
+           " \"materials\": [{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"roughnessFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1},\n"
+           "   \"KHR_materials_ior\": {\"ior\": 1}, \"KHR_materials_volume\": {\"thicknessFactor\": 2, \"attenuationColor\": [0.5, 0.7, 0.9], \"attenuationDistance\": 0.5}}}],\n"
+           " \"buffers\": [{\"byteLength\": 168, \"uri\": \"cube.bin\"}],\n"
+           " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 96}, {\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 72}],\n"
+           " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 8, \"type\": \"VEC3\", \"min\": [-1, -1, -1], \"max\": [1, 1, 1]},\n"
+           "   {\"bufferView\": 1, \"componentType\": 5123, \"count\": 36, \"type\": \"SCALAR\"}]}\n",
+           used);
+  CHECK(scratch_file("cube.gltf", cube), "write");
+  scene *s = scene_new(scratch_path("cube.gltf"));
+  CHECK(load_mesh(s, scratch_path("cube.gltf"), NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+  const double att[3] = {0.5, 0.7, 0.9};
+  CHECK(s->nmedia == 1 && s->nshape_media == 1 && s->shape_media[0].interior == 0 && s->shape_media[0].exterior == MEDIUM_NONE, "%u media, %u boundaries",
+        s->nmedia, s->nshape_media);
+  CHECK(fabs(s->media[0].sigma_a.r + log(att[0]) / 0.5) < 1e-5 && fabs(s->media[0].sigma_a.b + log(att[2]) / 0.5) < 1e-5 && c3_black(s->media[0].sigma_s),
+        "sigma_a (%g %g %g)", s->media[0].sigma_a.r, s->media[0].sigma_a.g, s->media[0].sigma_a.b);
+  scene_free(s);
+  static const char *const through =
+      "{ \"camera\": {\"position\": [0, 0, 6], \"look_at\": [0,0,0], \"fov\": 5},\n"
+      "  \"film\": {\"width\": 8, \"height\": 8}, \"render\": {\"spp\": 256},\n"
+      "  \"environment\": {\"type\": \"constant\", \"radiance\": 1},\n"
+      "  \"shapes\": [{\"file\": \"cube.gltf\"}] }\n";
+  px = render_json_text(through, NULL, &w, &h);
+  CHECK(px, "render failed");
+  for (int c = 0; c < 3; c++) {
+    double avg = 0, want = pow(att[c], 2 / 0.5), sd = sqrt(want * (1 - want) / (w * h * 256.0));
+    for (int i = 0; i < w * h; i++) avg += px[3 * i + c];
+    avg /= w * h;
+    fprintf(stderr, "through the cube, channel %d: %.5f, colour^4 %.5f (sd %.5f)\n", c, avg, want, sd);
+    CHECK(fabs(avg - want) < 5 * sd, "through the cube, channel %d: %g, expected %g", c, avg, want);
+  }
+  free(px);
   /* extensions: used and not read, a warning; required and not read, refused */
   CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_clearcoat\"]"), "write");
-  scene *s = scene_new(scratch_path("trx.gltf"));
+  s = scene_new(scratch_path("trx.gltf"));
   warnings_capture(1);
   valo_status st = load_mesh(s, scratch_path("trx.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
   int used_said = strstr(warnings_text(), "uses KHR_materials_clearcoat, which valo does not read") != NULL;

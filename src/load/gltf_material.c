@@ -1,18 +1,25 @@
-/* gltf_material.c — owns the glTF material extensions valo reads beyond the core
- * metallic-roughness model (load_assimp.c): KHR_materials_transmission with
+/* gltf_material.c — owns the glTF material meanings valo reads beyond the core
+ * metallic-roughness model (load_assimp.c): KHR_texture_transform on a texture, COLOR_0
+ * (and a PLY's colours) as vertex colours, KHR_materials_transmission with
  * KHR_materials_ior and KHR_materials_volume. The glTF BSDF is
  *   mix(metal, fresnel_mix(ior, mix(diffuse, specular BTDF, t), specular BRDF), metallic)
  * so with w = t (1 - metallic) it is exactly the blend of valo's pbr material at metallic
  * m' = metallic / (1 - w) with weight 1 - w and a glass with weight w: a dielectric of the
  * same ior and roughness when the volume extension gives a thickness (the mesh bounds the
- * glass), a thin dielectric otherwise (glTF's thin-walled default), its transmission tinted
- * by the base colour factor. */
+ * glass, and its attenuation becomes an absorbing medium inside it), a thin dielectric
+ * otherwise (glTF's thin-walled default), its transmission tinted by the base colour
+ * factor. */
 #include "load/gltf_material.h"
 #include "core/error.h"
+#include "image/texture.h"
 #include <assimp/material.h>
+#include <assimp/scene.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#define TRY_ST(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
 static float mat_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned idx, float def) {
   ai_real v;
@@ -21,7 +28,35 @@ static float mat_float(const struct aiMaterial *am, const char *key, unsigned ty
   return def;
 }
 
-valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, valo_error *err) {
+/* KHR_materials_volume's absorption: a medium of sigma_a = -ln(attenuationColor) /
+ * attenuationDistance (no scattering), appended to s; -1 when the glass is clear. */
+static valo_status volume_medium(scene *s, const struct aiMaterial *am, const char *where, int32_t *med, valo_error *err) {
+  *med = -1;
+  float dist = mat_float(am, AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, INFINITY);
+  struct aiColor4D ac;
+  if (!(dist > 0) || !isfinite(dist) || aiGetMaterialColor(am, AI_MATKEY_VOLUME_ATTENUATION_COLOR, &ac) != aiReturn_SUCCESS) return VALO_OK;
+  float c[3] = {ac.r, ac.g, ac.b}, sa[3];
+  int any = 0;
+  for (int k = 0; k < 3; k++) {
+    float x = isfinite(c[k]) ? clampf(c[k], 1e-6f, 1) : 1;
+    sa[k] = -logf(x) / dist;
+    any |= sa[k] > 0;
+  }
+  if (!any) return VALO_OK;
+  medium md;
+  memset(&md, 0, sizeof md);
+  md.sigma_a = c3(sa[0], sa[1], sa[2]);
+  snprintf(md.name, sizeof md.name, "%.50s (volume)", where);
+  medium *q = realloc(s->media, (s->nmedia + 1) * sizeof *q);
+  if (!q) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  s->media = q;
+  q[s->nmedia] = md;
+  *med = (int32_t)s->nmedia++;
+  return VALO_OK;
+}
+
+valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, int32_t *med, valo_error *err) {
+  *med = -1;
   float t = mat_float(am, AI_MATKEY_TRANSMISSION_FACTOR, 0);
   if (!(t > 0)) return VALO_OK;
   if (t > 1) t = 1;
@@ -43,10 +78,7 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   if (m->tex_kd >= 0) log_warning("%s: its base colour texture does not tint the light it transmits (its base colour factor does)", where);
   if (glass.type == MAT_THIN_DIELECTRIC && m->roughness > 0.0316f)
     log_warning("%s: thin-walled transmission (no KHR_materials_volume thickness) is rendered smooth, not at roughness %g", where, (double)m->roughness);
-  float dist = mat_float(am, AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, INFINITY);
-  struct aiColor4D ac;
-  if (isfinite(dist) && aiGetMaterialColor(am, AI_MATKEY_VOLUME_ATTENUATION_COLOR, &ac) == aiReturn_SUCCESS && (ac.r < 1 || ac.g < 1 || ac.b < 1))
-    log_warning("%s: KHR_materials_volume attenuation is not read (the glass is clear)", where);
+  if (glass.type == MAT_DIELECTRIC) TRY_ST(volume_medium(s, am, where, med, err));
   /* the blend carries the maps that move the surface and its opacity; its parts neither */
   glass.tex_normal = glass.tex_bump = glass.tex_alpha = -1;
   glass.opacity = 1;
@@ -78,4 +110,22 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   memcpy(blend.name, m->name, sizeof blend.name);
   *m = blend;
   return VALO_OK;
+}
+
+int gltf_transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t) {
+  const float *m = t >= 0 && oc ? obj_check_uvt(oc, mi, slot) : NULL;
+  if (!m) return t;
+  tex_sampling smp = s->tex[t].smp;
+  smp.has_uvm = 1;
+  memcpy(smp.uvm, m, sizeof smp.uvm);
+  return scene_texture_sampled(s, t, &smp);
+}
+
+void mesh_vertex_colors(scene *s, const struct aiScene *ai, uint32_t mat_base) {
+  for (unsigned i = 0; i < ai->mNumMeshes; i++)
+    if (ai->mMeshes[i]->mColors[0] && ai->mMeshes[i]->mMaterialIndex < ai->mNumMaterials) {
+      material *mt = &s->mats[mat_base + ai->mMeshes[i]->mMaterialIndex];
+      mt->vertex_colors = 1;
+      if (mt->type == MAT_BLEND) s->mats[mt->blend[0]].vertex_colors = s->mats[mt->blend[1]].vertex_colors = 1; /* hits see its parts */
+    }
 }

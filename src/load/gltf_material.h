@@ -1,13 +1,25 @@
-/* gltf_material.h — owns the glTF material extensions read on top of Assimp's import
+/* gltf_material.h — owns the glTF material meanings read on top of Assimp's import
  * (gltf_material.c says how). */
 #ifndef VALO_GLTF_MATERIAL_H
 #define VALO_GLTF_MATERIAL_H
 #include "scene/scene.h"
+#include "load/obj_check.h"
 struct aiMaterial;
+struct aiScene;
+
+/* Texture t of glTF material mi's slot (GLTF_SLOT_...) as its KHR_texture_transform
+ * samples it (gltf_check records them in oc): a texture sharing t's pixels; t itself when
+ * there is none (or t < 0). */
+int gltf_transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t);
+/* The materials (from mat_base, the file's first) of ai's meshes that have vertex colours
+ * take vertex_colors, a blend's two parts too: glTF's COLOR_0 multiplies the base colour,
+ * and a PLY (no materials: Assimp's default one) is seen in its colours. */
+void mesh_vertex_colors(scene *s, const struct aiScene *ai, uint32_t mat_base);
 
 /* KHR_materials_transmission (with _ior and _volume) on the glTF material m, already the
  * pbr model with its maps: m becomes a glass, or a blend of m and a glass whose two parts
- * are appended to s (tex_trans: the transmission texture, -1 for none). where names the
- * material in warnings (what is not read). */
-valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, valo_error *err);
+ * are appended to s (tex_trans: the transmission texture, -1 for none); *med is the
+ * absorbing medium appended to s for the volume's attenuation (inside the meshes of this
+ * material), or -1. where names the material in warnings (what is not read). */
+valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, int32_t *med, valo_error *err);
 #endif

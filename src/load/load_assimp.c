@@ -161,17 +161,6 @@ static int looks_like_normal_map(const texture *t) {
   return b > 0.7 && fabs(r - 0.5) < 0.15 && fabs(g - 0.5) < 0.15 && spread > 0.2;
 }
 
-/* glTF: texture t of material mi's slot as its KHR_texture_transform samples it (recorded
- * by gltf_check), a texture sharing t's pixels; t itself when there is none. */
-static int transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t) {
-  const float *m = t >= 0 && oc ? obj_check_uvt(oc, mi, slot) : NULL;
-  if (!m) return t;
-  tex_sampling smp = s->tex[t].smp;
-  smp.has_uvm = 1;
-  memcpy(smp.uvm, m, sizeof smp.uvm);
-  return scene_texture_sampled(s, t, &smp);
-}
-
 static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf,
                              const obj_check *oc, unsigned mi) {
   int wrap = 0;
@@ -207,10 +196,10 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
     m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
     m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, dir, 0, NULL);
     if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, dir, 0, NULL);
-    m->tex_kd = transformed(s, oc, mi, GLTF_SLOT_BASE, m->tex_kd);
-    m->tex_mr = transformed(s, oc, mi, GLTF_SLOT_MR, m->tex_mr);
-    m->tex_normal = transformed(s, oc, mi, GLTF_SLOT_NORMAL, m->tex_normal);
-    m->tex_ke = transformed(s, oc, mi, GLTF_SLOT_EMISSIVE, m->tex_ke);
+    m->tex_kd = gltf_transformed(s, oc, mi, GLTF_SLOT_BASE, m->tex_kd);
+    m->tex_mr = gltf_transformed(s, oc, mi, GLTF_SLOT_MR, m->tex_mr);
+    m->tex_normal = gltf_transformed(s, oc, mi, GLTF_SLOT_NORMAL, m->tex_normal);
+    m->tex_ke = gltf_transformed(s, oc, mi, GLTF_SLOT_EMISSIVE, m->tex_ke);
   }
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
@@ -243,6 +232,7 @@ typedef struct load_ctx {
   int smooth;        /* LOAD_MESH_SMOOTH: normals computed where the file has none */
   valo_options *file; /* the render settings the file asks for (a camera's film aspect) */
   int flip_v;        /* LOAD_MESH_FLIP_V: v' = 1 - v */
+  int32_t *mat_medium; /* glTF: per file material, the medium its volume bounds (-1: none), or NULL */
 } load_ctx;
 
 _Static_assert(sizeof(struct aiVector3D) == 3 * sizeof(float), "Assimp's vectors are read as 3 floats");
@@ -281,8 +271,16 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
                   uv ? &uv->x : NULL, sizeof *uv / sizeof(float), idx, c->flat, c->smooth,
                   mesh->mColors[0] ? &mesh->mColors[0]->r : NULL, sizeof(struct aiColor4D) / sizeof(float)};
   uint32_t base = s->nverts;
+  uint32_t first = s->ntris;
   valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
   free(idx);
+  int32_t med = c->mat_medium && c->override_mat == UINT32_MAX && mesh->mMaterialIndex < c->ai->mNumMaterials ? c->mat_medium[mesh->mMaterialIndex] : -1;
+  if (st == VALO_OK && med >= 0 && s->ntris > first) { /* a glTF volume: absorbing inside, vacuum outside */
+    shape_media *q = realloc(s->shape_media, (s->nshape_media + 1) * sizeof *q);
+    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
+    s->shape_media = q;
+    q[s->nshape_media++] = (shape_media){first, s->ntris, med, MEDIUM_NONE};
+  }
   for (uint32_t v = base; st == VALO_OK && uv && c->flip_v && v < s->nverts; v++) s->uv[2 * (size_t)v + 1] = 1 - s->uv[2 * (size_t)v + 1];
   for (unsigned v = 0; st == VALO_OK && has_tan && v < mesh->mNumVertices; v++) {
     vec3 n = s->nrm[base + v];
@@ -500,11 +498,25 @@ static valo_status import_file(const char *path, int mesh_flags, imported *im, v
 }
 
 /* Places an imported file's triangles (and its materials, camera and lights) in s. */
+static valo_status place_with(load_ctx *cp, imported *im, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags);
 static valo_status place(scene *s, imported *im, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags, valo_options *file,
                          valo_error *err) {
+  load_ctx c = {s, path, im->ai, s->nmats, override_mat, 0, 0, err, im->gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file,
+                 (mesh_flags & LOAD_MESH_FLIP_V) != 0, NULL};
+  if (override_mat == UINT32_MAX && c.gltf) {
+    if (!(c.mat_medium = malloc((im->ai->mNumMaterials + 1) * sizeof *c.mat_medium))) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    for (unsigned i = 0; i <= im->ai->mNumMaterials; i++) c.mat_medium[i] = -1;
+  }
+  valo_status st = place_with(&c, im, path, xf12, override_mat, mesh_flags);
+  free(c.mat_medium);
+  return st;
+}
+
+static valo_status place_with(load_ctx *cp, imported *im, const char *path, const float *xf12, uint32_t override_mat, int mesh_flags) {
+  load_ctx c = *cp; /* (mat_medium freed by place) */
+  scene *s = c.s;
+  valo_error *err = c.err;
   const struct aiScene *ai = im->ai;
-  load_ctx c = {s, path, ai, s->nmats, override_mat, 0, 0, err, im->gltf, (mesh_flags & LOAD_MESH_FLAT) != 0, (mesh_flags & LOAD_MESH_SMOOTH) != 0, file,
-                 (mesh_flags & LOAD_MESH_FLIP_V) != 0};
   valo_status st = VALO_OK;
   if (override_mat == UINT32_MAX) {
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
@@ -518,8 +530,8 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
       convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc, i);
       if (c.gltf) { /* KHR_materials_transmission: a glass, or a blend with one (gltf_material.c) */
-        int tt = transformed(s, oc, i, GLTF_SLOT_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
-        st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, err);
+        int tt = gltf_transformed(s, oc, i, GLTF_SLOT_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
+        st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, &c.mat_medium[i], err);
         if (st) return st;
       }
       s->tex_user[0] = 0;
@@ -529,14 +541,7 @@ static valo_status place(scene *s, imported *im, const char *path, const float *
         return s->tex_fatal.status;
       }
     }
-    /* glTF: a primitive's COLOR_0 multiplies its material's base colour; a PLY (which has
-     * no materials: Assimp's default one) is seen in its vertex colours */
-    for (unsigned i = 0; (c.gltf || im->ply) && i < ai->mNumMeshes; i++)
-      if (ai->mMeshes[i]->mColors[0] && ai->mMeshes[i]->mMaterialIndex < ai->mNumMaterials) {
-        material *mt = &s->mats[c.mat_base + ai->mMeshes[i]->mMaterialIndex];
-        mt->vertex_colors = 1;
-        if (mt->type == MAT_BLEND) s->mats[mt->blend[0]].vertex_colors = s->mats[mt->blend[1]].vertex_colors = 1; /* hits see its parts */
-      }
+    if (c.gltf || im->ply) mesh_vertex_colors(s, ai, c.mat_base);
     if (ai->mNumMaterials == 0) {
       material d = material_default();
       c.override_mat = scene_add_material(s, &d);
