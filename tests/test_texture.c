@@ -8,6 +8,7 @@
 #include "image/texture.h"
 #include "image/image_io.h"
 #include "material/shading.h"
+#include "material/bsdf.h"
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <math.h>
@@ -1227,6 +1228,67 @@ static int gltf_texture_transform(void) {
   return 0;
 }
 
+/* glTF's KHR_materials_ior and KHR_materials_specular on the opaque model (pbr's "ior",
+ * "specular", "specular_color"): F0 = min(((ior - 1) / (ior + 1))^2 colour, 1) factor and
+ * F90 = factor; the specular lobe at normal incidence scales by F0 / 0.04 against the
+ * default material, at grazing the dielectric's Fresnel reaches F90; a glTF quad with both
+ * extensions gets those values and renders as the JSON pbr material with the same keys;
+ * KHR_materials_specular is no longer warned about. */
+static int gltf_specular(void) {
+  material d = material_default(), m = material_default();
+  d.type = m.type = MAT_PBR;
+  d.kd = m.kd = c3(0, 0, 0);
+  d.metallic = m.metallic = 0;
+  d.roughness = m.roughness = 0.3f;
+  material_pbr_specular(&m, 1.33f, 0.5f, c3(1, 0.5f, 0.25f));
+  double r = 0.33 / 2.33, f0 = r * r;
+  const double want[3] = {f0 * 0.5, f0 * 0.5 * 0.5, f0 * 0.25 * 0.5};
+  CHECK(fabs(m.f0.r - want[0]) < 1e-7 && fabs(m.f0.g - want[1]) < 1e-7 && fabs(m.f0.b - want[2]) < 1e-7 && m.f90 == 0.5f, "F0 (%g %g %g), F90 %g", m.f0.r,
+        m.f0.g, m.f0.b, m.f90);
+  bsdf bd = bsdf_from_material(&d), bm = bsdf_from_material(&m);
+  rgb ed = bsdf_eval(&bd, v3(0, 0, 1), v3(0, 0, 1)), em = bsdf_eval(&bm, v3(0, 0, 1), v3(0, 0, 1));
+  CHECK(fabs(em.r / ed.r - want[0] / 0.04) < 1e-4 * want[0] / 0.04 && fabs(em.b / ed.b - want[2] / 0.04) < 1e-4 * want[2] / 0.04,
+        "at normal incidence (%g %g %g) against the default's %g", em.r, em.g, em.b, ed.r);
+  vec3 wo = v3(sinf(1.55f), 0, cosf(1.55f)), wi = v3(-wo.x, 0, wo.z); /* grazing mirror pair: v.h = cos 1.55 */
+  rgb gd = bsdf_eval(&bd, wo, wi), gm = bsdf_eval(&bm, wo, wi);
+  double s5 = pow(1 - cos(1.55), 5), Fd = 0.04 + 0.96 * s5, Fm = want[0] + (0.5 - want[0]) * s5;
+  CHECK(fabs(gm.r / gd.r - Fm / Fd) < 1e-3 * Fm / Fd, "at grazing %g, the default %g: ratio %g, expected %g", gm.r, gd.r, gm.r / gd.r, Fm / Fd);
+  /* the same through a glTF file and a JSON material */
+  static const char *const mat =
+      "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.2, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}, \"extensions\": {"
+      "\"KHR_materials_ior\": {\"ior\": 1.33}, \"KHR_materials_specular\": {\"specularFactor\": 0.5, \"specularColorFactor\": [1, 0.5, 0.25]}}}";
+  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\"]"), "write");
+  scene *s = scene_new(scratch_path("spec.gltf"));
+  valo_error err;
+  warnings_capture(1);
+  valo_status st = load_mesh(s, scratch_path("spec.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
+  int warned = warnings_text()[0] != 0;
+  warnings_capture(0);
+  CHECK(st == VALO_OK, "%s", err.message);
+  const material *g = &s->mats[s->tri_mat[0]];
+  CHECK(!warned && g->type == MAT_PBR && fabs(g->f0.r - want[0]) < 1e-7 && fabs(g->f0.b - want[2]) < 1e-7 && g->f90 == 0.5f, "glTF: F0 (%g %g %g), F90 %g%s",
+        g->f0.r, g->f0.g, g->f0.b, g->f90, warned ? ", warned" : "");
+  scene_free(s);
+  double mean[2];
+  for (int k = 0; k < 2; k++) {
+    char scn[1200];
+    snprintf(scn, sizeof scn,
+             "{ \"camera\": {\"position\": [0, 3, 2], \"look_at\": [0,0,0], \"fov\": 60},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
+             "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.5},\n"
+             "  \"materials\": {\"p\": {\"type\": \"pbr\", \"base_color\": [0.6, 0.4, 0.2], \"metallic\": 0, \"roughness\": 0.3, \"ior\": 1.33,\n"
+             "    \"specular\": 0.5, \"specular_color\": [1, 0.5, 0.25]}},\n"
+             "  \"shapes\": [{\"file\": \"spec.gltf\"%s}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
+             k ? ", \"material\": \"p\"" : "");
+    mean[k] = render_json_mean_green(scn);
+    CHECK(mean[k] > 0, "render failed");
+  }
+  fprintf(stderr, "glTF %.7f, JSON %.7f\n", mean[0], mean[1]);
+  CHECK(mean[0] == mean[1], "glTF %g against the JSON pbr %g", mean[0], mean[1]);
+  return 0;
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1623,7 +1685,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_specular", gltf_specular}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -129,3 +129,8 @@ void mesh_vertex_colors(scene *s, const struct aiScene *ai, uint32_t mat_base) {
       if (mt->type == MAT_BLEND) s->mats[mt->blend[0]].vertex_colors = s->mats[mt->blend[1]].vertex_colors = 1; /* hits see its parts */
     }
 }
+
+void gltf_specular(const obj_check *oc, unsigned mi, material *m) {
+  const float *sp = oc && oc->gspec && mi < oc->ngspec ? &oc->gspec[4 * (size_t)mi] : NULL;
+  material_pbr_specular(m, m->ior >= 1 && m->ior <= 10 ? m->ior : 1.5f, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
+}

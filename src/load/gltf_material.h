@@ -16,6 +16,10 @@ int gltf_transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t
  * and a PLY (no materials: Assimp's default one) is seen in its colours. */
 void mesh_vertex_colors(scene *s, const struct aiScene *ai, uint32_t mat_base);
 
+/* glTF's dielectric Fresnel on the pbr material m (file material mi): F0 from
+ * KHR_materials_ior (m->ior; 0.04 at 1.5), times KHR_materials_specular's colour (at
+ * most 1) and factor; F90 the factor (gltf_check records it in oc). */
+void gltf_specular(const obj_check *oc, unsigned mi, material *m);
 /* KHR_materials_transmission (with _ior and _volume) on the glTF material m, already the
  * pbr model with its maps: m becomes a glass, or a blend of m and a glass whose two parts
  * are appended to s (tex_trans: the transmission texture, -1 for none); *med is the

@@ -208,7 +208,7 @@ static double num_or(gc *g, uint32_t v, const char *key, double def) {
 static double elem_or(gc *g, uint32_t v, const char *key, int k, double def) {
   uint32_t a = json_get(&g->d, v, key);
   uint32_t x = a && N(g, a)->t == J_ARR ? N(g, a)->child : 0;
-  if (x && k) x = N(g, x)->next;
+  for (int j = 0; j < k && x; j++) x = N(g, x)->next;
   return x && N(g, x)->t == J_NUM ? N(g, x)->num : def;
 }
 
@@ -240,16 +240,36 @@ static valo_status record_transforms(gc *g, uint32_t o, uint32_t i, const char *
   return VALO_OK;
 }
 
+/* KHR_materials_specular's factors (its textures are not read: a warning says so). */
+static valo_status record_specular(gc *g, uint32_t o, uint32_t i, const char *ctx) {
+  uint32_t sp = json_get(&g->d, json_get(&g->d, o, "extensions"), "KHR_materials_specular");
+  if (!sp || N(g, sp)->t != J_OBJ) return VALO_OK;
+  if (!g->oc->gspec) {
+    if (!(g->oc->gspec = malloc(((size_t)g->n[K_MAT] + 1) * 4 * sizeof(float)))) return gl_bad(g, "out of memory");
+    for (size_t k = 0; k < ((size_t)g->n[K_MAT] + 1) * 4; k++) g->oc->gspec[k] = 1;
+    g->oc->ngspec = g->n[K_MAT];
+  }
+  float *v = &g->oc->gspec[4 * (size_t)i];
+  v[0] = (float)num_or(g, sp, "specularFactor", 1);
+  for (int k = 0; k < 3; k++) v[1 + k] = (float)elem_or(g, sp, "specularColorFactor", k, 1);
+  for (int k = 0; k < 4; k++)
+    if (!(v[k] >= 0 && v[k] < 1e6)) return gl_bad(g, "%s: KHR_materials_specular factors must be numbers from 0", ctx);
+  if (json_get(&g->d, sp, "specularTexture") || json_get(&g->d, sp, "specularColorTexture"))
+    log_warning("%s: %s: KHR_materials_specular's textures are not read (its factors are)", g->path, ctx);
+  return VALO_OK;
+}
+
 static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   valo_status st = check_texture_refs(g, o, ctx);
-  return st ? st : record_transforms(g, o, i, ctx);
+  if (!st) st = record_transforms(g, o, i, ctx);
+  return st ? st : record_specular(g, o, i, ctx);
 }
 
 /* The extensions valo reads (Assimp imports them and valo uses what it imports). A file
  * that requires any other is refused, as the glTF specification asks of a loader; one
  * that only uses others is read with a warning naming them. */
 static const char *const read_extensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
-                                              "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", NULL};
+                                              "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", "KHR_materials_specular", NULL};
 static int is_read(const char *name) {
   for (int i = 0; read_extensions[i]; i++)
     if (!strcmp(name, read_extensions[i])) return 1;
@@ -266,8 +286,8 @@ static valo_status check_extensions(gc *g) {
       if (N(g, c)->t != J_STR) return gl_bad(g, "\"%s\" must be an array of names", key);
       const char *name = N(g, c)->str;
       if (is_read(name)) continue;
-      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s, %s and %s)", name, read_extensions[0],
-                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4], read_extensions[5]);
+      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s, %s, %s and %s)", name, read_extensions[0],
+                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4], read_extensions[5], read_extensions[6]);
       if (strlen(unread) + strlen(name) + 3 < sizeof unread) snprintf(unread + strlen(unread), sizeof unread - strlen(unread), "%s%s", unread[0] ? ", " : "", name);
     }
   }

@@ -529,7 +529,8 @@ static valo_status place_with(load_ctx *cp, imported *im, const char *path, cons
       material m = convert_material(ai->mMaterials[i], oc);
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
       convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc, i);
-      if (c.gltf) { /* KHR_materials_transmission: a glass, or a blend with one (gltf_material.c) */
+      if (c.gltf) { /* KHR_materials_ior and _specular; _transmission: a glass, or a blend with one (gltf_material.c) */
+        gltf_specular(oc, i, &m);
         int tt = gltf_transformed(s, oc, i, GLTF_SLOT_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
         st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, &c.mat_medium[i], err);
         if (st) return st;

@@ -206,7 +206,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -224,6 +224,13 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_num(c, o, "metallic", where, 0, 1, &metal));
     m->metallic = (float)metal;
     TRY(get_data_map(c, o, "metallic_roughness_map", where, "metallic-roughness map", &m->tex_mr));
+    double ior = 1.5, spec = 1; /* the dielectric's Fresnel: glTF's KHR_materials_ior and _specular */
+    rgb spec_color = c3(1, 1, 1);
+    TRY(json_get_num(c, o, "ior", where, 1.0, 10.0, &ior));
+    TRY(json_get_num(c, o, "specular", where, 0, 1, &spec));
+    TRY(json_get_rgb(c, o, "specular_color", where, &spec_color));
+    m->ior = (float)ior;
+    material_pbr_specular(m, m->ior, (float)spec, spec_color);
   } else if (!strcmp(type, "diffuse")) {
     TRY(json_check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;

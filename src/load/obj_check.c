@@ -442,6 +442,7 @@ void obj_check_free(obj_check *oc) {
   for (int i = 0; i < oc->nfiles; i++) free(oc->files[i].text);
   free(oc->pbr);
   free(oc->uvt);
+  free(oc->gspec);
   memset(oc, 0, sizeof *oc);
 }
 

@@ -43,6 +43,9 @@ typedef struct obj_check {
   int npbr;
   gltf_uvt *uvt;                /* a glTF's texture transforms */
   int nuvt;
+  float *gspec;                 /* a glTF's KHR_materials_specular, 4 per material (specularFactor,
+                                   specularColorFactor; 1 where absent), or NULL */
+  uint32_t ngspec;
 } obj_check;
 
 /* Reads and checks the OBJ at path and the MTL files it names. Returns VALO_OK (with

@@ -27,6 +27,7 @@ bsdf bsdf_from_material(const material *m) {
   memset(&b, 0, sizeof b);
   b.kd = m->kd; b.ks = m->ks; b.exponent = m->exponent; b.eta = m->ior;
   b.cond_eta = m->eta; b.cond_k = m->k; b.cond_tint = m->tint; b.trans = m->transmittance;
+  b.f0 = m->f0; b.f90 = m->f90;
   b.beckmann = m->beckmann && m->type != MAT_PBR;
   b.separable = m->smith_separable && m->type != MAT_PBR;
   b.p_first = 1;
@@ -107,13 +108,17 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   wm = v3_norm(wm);
   float s5 = schlick_weight(fabsf(v3_dot(wo, wm)));
   float spec = ggx_D(b->alpha, wm) * ggx_G(b->alpha, wo, wi) / (4 * wo.z * wi.z);
-  /* Dielectric: F0 = 0.04 (ior 1.5). The specular layer takes F(v.h) as in the spec;
-   * the diffuse base is weighted by 1 - F(n.v) instead of the spec's 1 - F(v.h), which
-   * returns up to 35 % more energy than arrives at grazing angles (test_chi2 furnace).
-   * The price: this diffuse base is not reciprocal (test_chi2 bsdf_reciprocity). */
-  float Fd = 0.04f + 0.96f * s5, Fo = 0.04f + 0.96f * schlick_weight(wo.z);
+  /* Dielectric: F = F0 + (F90 - F0) (1 - v.h)^5, F0 = 0.04 (ior 1.5) and F90 = 1 unless
+   * KHR_materials_ior or _specular say otherwise. The specular layer takes F(v.h) as in
+   * the spec; the diffuse base is weighted by 1 - F(n.v) instead of the spec's 1 - F(v.h),
+   * which returns up to 35 % more energy than arrives at grazing angles (test_chi2
+   * furnace). The price: this diffuse base is not reciprocal (test_chi2 bsdf_reciprocity). */
+  float so = schlick_weight(wo.z);
+  float Fd[3] = {b->f0.r + (b->f90 - b->f0.r) * s5, b->f0.g + (b->f90 - b->f0.g) * s5, b->f0.b + (b->f90 - b->f0.b) * s5};
+  float Fo[3] = {b->f0.r + (b->f90 - b->f0.r) * so, b->f0.g + (b->f90 - b->f0.g) * so, b->f0.b + (b->f90 - b->f0.b) * so};
   rgb Fm = b->metal_flat ? b->kd : c3_add(b->kd, c3_scale(c3_sub(c3(1, 1, 1), b->kd), s5));
-  rgb diel = c3_add(c3_scale(b->kd, (1 - Fo) * INV_PI_F), c3(Fd * spec, Fd * spec, Fd * spec));
+  rgb diel = c3(b->kd.r * ((1 - Fo[0]) * INV_PI_F) + Fd[0] * spec, b->kd.g * ((1 - Fo[1]) * INV_PI_F) + Fd[1] * spec,
+                b->kd.b * ((1 - Fo[2]) * INV_PI_F) + Fd[2] * spec);
   return c3_add(c3_scale(diel, 1 - b->metallic), c3_scale(Fm, b->metallic * spec));
 }
 static float pbr_pdf(const bsdf *b, vec3 wo, vec3 wi) {

@@ -27,6 +27,8 @@ typedef struct bsdf {
   float alpha;        /* GGX roughness (rough types); along the frame's s axis when anisotropic */
   float alpha_v;      /* rough conductor and dielectric, principled: the roughness along t (alpha when isotropic) */
   float metallic;     /* BSDF_PBR */
+  rgb f0;             /* BSDF_PBR: the dielectric's Fresnel at normal and grazing incidence */
+  float f90;
   int beckmann;       /* rough conductor and dielectric: the Beckmann distribution, not GGX */
   int separable;      /* rough conductor, dielectric, plastic: Smith's separable G (Mitsuba's), not the height-correlated one */
   int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */

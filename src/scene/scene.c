@@ -78,6 +78,8 @@ material material_default(void) {
   m.ior = 1.5f;
   m.tex_kd = m.tex_ks = m.tex_ke = m.tex_alpha = m.tex_normal = m.tex_bump = -1;
   m.transmittance = c3(1, 1, 1);
+  m.f0 = c3(0.04f, 0.04f, 0.04f);
+  m.f90 = 1;
   m.bump_scale = 1;
   m.tint = c3(1, 1, 1);
   m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = -1;
@@ -86,6 +88,12 @@ material material_default(void) {
   m.tex_weight = -1;
   snprintf(m.name, sizeof m.name, "default");
   return m;
+}
+
+void material_pbr_specular(material *m, float ior, float factor, rgb color) {
+  float r = (ior - 1) / (ior + 1), f0 = ior == 1.5f ? 0.04f : r * r; /* 0.04 exactly at 1.5, as the model's default */
+  m->f0 = c3(fminf(f0 * color.r, 1) * factor, fminf(f0 * color.g, 1) * factor, fminf(f0 * color.b, 1) * factor);
+  m->f90 = factor;
 }
 
 uint32_t scene_add_material(scene *s, const material *m) {

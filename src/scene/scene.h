@@ -47,6 +47,9 @@ typedef struct material {
   int beckmann;      /* conductor/dielectric roughness: Beckmann's distribution (JSON "distribution"), else GGX */
   int smith_separable; /* conductor/dielectric/plastic roughness: Smith's separable G (JSON "smith"), else height-correlated */
   int metal_flat;    /* MAT_PBR: metal reflectance kd at every angle, no Schlick term (MTL PBR extension) */
+  rgb f0;            /* MAT_PBR: the dielectric's Fresnel at normal incidence (0.04, ior 1.5; glTF's
+                        KHR_materials_ior and _specular set it) */
+  float f90;         /* MAT_PBR: ... and at grazing incidence (1; KHR_materials_specular's factor) */
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
@@ -249,6 +252,10 @@ rgb scene_tri_color(const scene *s, uint32_t t, float b1, float b2);
  * hash of key (the ray's, geometry/accel.h) and t: the same ray meets the same answer
  * each time, two triangles on its way answer independently. */
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key);
+/* MAT_PBR's dielectric Fresnel as glTF's KHR_materials_ior and _specular give it: F0 =
+ * min(((ior - 1) / (ior + 1))^2 color, 1) factor (0.04 at ior 1.5, factor and color 1),
+ * F90 = factor. */
+void material_pbr_specular(material *m, float ior, float factor, rgb color);
 /* 1 if the material reads any texture map (which needs texture coordinates). */
 int material_has_maps(const material *m);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
