@@ -57,7 +57,9 @@ SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "pa
           # Mitsuba's specular_transmittance on dielectrics (valo's transmittance)
           "tinted-glass": ("@tests/data/mitsuba-xml/tinted-glass.xml", {"resx": "160", "resy": "96"}),
           # Mitsuba's one-sided BSDFs told by the shading normal on coarse smooth meshes (valo's black_back)
-          "shading-backs": ("@tests/data/mitsuba-xml/shading-backs.xml", {"resx": "160", "resy": "96"})}
+          "shading-backs": ("@tests/data/mitsuba-xml/shading-backs.xml", {"resx": "160", "resy": "96"}),
+          # Mitsuba's spot lights across their transition band (valo's linear falloff)
+          "spot-falloff": ("@tests/data/mitsuba-xml/spot-falloff.xml", {"resx": "160", "resy": "96"})}
 
 
 def resolve(path, defs, shared):

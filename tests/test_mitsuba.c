@@ -372,6 +372,12 @@ static int shading_backs_xml(void) {
   return against_mitsuba_xml_blocks("shading-backs", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/shading-backs.xml", "resx=160 resy=96", 256, 8, 0.05);
 }
 
+/* Mitsuba's spot lights across their transition band (tests/data/mitsuba-xml/spot-falloff.xml):
+ * a 30 degree band and Mitsuba's default; valo's "falloff": "linear". */
+static int spot_falloff_xml(void) {
+  return against_mitsuba_xml_blocks("spot-falloff", VALO_SOURCE_DIR "/tests/data/mitsuba-xml/spot-falloff.xml", "resx=160 resy=96", 256, 16, 0.03);
+}
+
 /* Mitsuba's twosided of two BSDFs (tests/data/mitsuba-xml/sided.xml): quads seen from the
  * front and from the back, whose backs are a rough plastic and a rough conductor; valo's
  * sided material. */
@@ -533,6 +539,6 @@ int main(int argc, char **argv) {
                                     {"glass_rough_spectral", glass_rough_spectral}, {"gold_spectral", gold_spectral},
                                     {"distribution_depth2", distribution_depth2}, {"pbr_metal", pbr_metal},
                                     {"from_xml", from_xml}, {"veach_mis_xml", veach_mis_xml}, {"sponza_serialized_xml", sponza_serialized_xml}, {"instances_xml", instances_xml},
-                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {"backs_xml", backs_xml}, {"hide_xml", hide_xml}, {"metals_xml", metals_xml}, {"aniso_xml", aniso_xml}, {"vertex_colors_xml", vertex_colors_xml}, {"cylinders_xml", cylinders_xml}, {"tinted_glass_xml", tinted_glass_xml}, {"shading_backs_xml", shading_backs_xml}, {NULL, NULL}};
+                                    {"plastic_eval", plastic_against_mitsuba}, {"plastic_xml", plastic_xml}, {"mask_xml", mask_xml}, {"opacity_xml", opacity_xml}, {"blend_xml", blend_xml}, {"principled_eval", principled_against_mitsuba}, {"principled_xml", principled_xml}, {"textures_xml", textures_xml}, {"roughness_xml", roughness_xml}, {"env_turned_xml", env_turned_xml}, {"lamp_texture_xml", lamp_texture_xml}, {"sided_xml", sided_xml}, {"backs_xml", backs_xml}, {"hide_xml", hide_xml}, {"metals_xml", metals_xml}, {"aniso_xml", aniso_xml}, {"vertex_colors_xml", vertex_colors_xml}, {"cylinders_xml", cylinders_xml}, {"tinted_glass_xml", tinted_glass_xml}, {"shading_backs_xml", shading_backs_xml}, {"spot_falloff_xml", spot_falloff_xml}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

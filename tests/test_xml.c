@@ -123,8 +123,8 @@ static int xml_equals_json(void) {
   /* The JSON the XML means: Mitsuba's horizontal 50-degree field on a 48 x 32 film is a
    * vertical one of 2 atan(tan 25 / 1.5); max_depth 5 counts the camera ray, valo's 4 does
    * not; alpha 0.09 is roughness 0.3; bk7 in air is 1.5046 / 1.00028; the spot's beam is
-   * 3/4 of its cut-off (delta 7.5 degrees); the disk, with no BSDF, is Mitsuba's default
-   * diffuse 0.5. */
+   * 3/4 of its cut-off (delta 7.5 degrees), falling off linearly in angle as Mitsuba's
+   * does; the disk, with no BSDF, is Mitsuba's default diffuse 0.5. */
   double vfov = 360 / M_PI * atan(tan(25 * M_PI / 180) / 1.5);
   char json[4096];
   snprintf(json, sizeof json,
@@ -141,7 +141,7 @@ static int xml_equals_json(void) {
            "   {\"type\": \"sphere\", \"center\": [1, 0.6, 0], \"radius\": 0.6, \"material\": \"glass\"},\n"
            "   {\"type\": \"disk\", \"transform\": {\"scale\": 0.5, \"rotate_x\": 90, \"translate\": [0, 3, 0]}, \"material\": \"lamp\"}],\n"
            " \"lights\": [{\"type\": \"point\", \"position\": [2, 3, 2], \"intensity\": 5},\n"
-           "   {\"type\": \"spot\", \"position\": [-2, 3, 2], \"look_at\": [-2, 2, 2], \"intensity\": 10, \"cone_angle\": 30, \"cone_delta_angle\": 7.5},\n"
+           "   {\"type\": \"spot\", \"position\": [-2, 3, 2], \"look_at\": [-2, 2, 2], \"intensity\": 10, \"cone_angle\": 30, \"cone_delta_angle\": 7.5, \"falloff\": \"linear\"},\n"
            "   {\"type\": \"directional\", \"direction\": [0.3, -1, -0.2], \"irradiance\": 0.5}],\n"
            " \"environment\": {\"type\": \"constant\", \"radiance\": [0.1, 0.15, 0.2]}}\n",
            vfov, 1.5046 / 1.00028);

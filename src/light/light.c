@@ -30,6 +30,7 @@ float light_power(const scene *s, const light *l) {
 static float spot_falloff(const light *l, float cos_t) {
   if (cos_t >= l->cos_inner) return 1;
   if (cos_t <= l->cos_outer) return 0;
+  if (l->spot_linear) return clampf((l->ang_outer - acosf(clampf(cos_t, -1, 1))) / (l->ang_outer - l->ang_inner), 0, 1); /* Mitsuba's */
   float d = (cos_t - l->cos_outer) / (l->cos_inner - l->cos_outer);
   return d * d * (3 - 2 * d); /* smoothstep, as pbrt-v4 */
 }

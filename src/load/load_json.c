@@ -438,7 +438,7 @@ static valo_status parse_light(jctx *c, const cJSON *o, int index) {
     TRY(json_get_vec(c, o, "position", where, 0, &l.p));
     TRY(json_get_rgb(c, o, "intensity", where, &l.L));
   } else if (!strcmp(type, "spot")) {
-    static const char *const keys[] = {"type", "position", "look_at", "intensity", "cone_angle", "cone_delta_angle", NULL};
+    static const char *const keys[] = {"type", "position", "look_at", "intensity", "cone_angle", "cone_delta_angle", "falloff", NULL};
     TRY(json_check_keys(c, o, where, keys));
     l.type = LIGHT_SPOT;
     vec3 at = v3(0, 0, 0);
@@ -453,6 +453,12 @@ static valo_status parse_light(jctx *c, const cJSON *o, int index) {
     l.dir = v3_norm(v3_sub(at, l.p));
     l.cos_outer = cosf((float)(cone * M_PI / 180));
     l.cos_inner = cosf((float)((cone - delta) * M_PI / 180));
+    const char *fall = NULL; /* across cone_delta_angle: smoothstep in the cosine (pbrt's) or linear in the angle (Mitsuba's) */
+    TRY(json_get_str(c, o, "falloff", where, &fall));
+    if (fall && strcmp(fall, "smoothstep") && strcmp(fall, "linear")) return json_bad(c, where, "falloff must be \"smoothstep\" or \"linear\"");
+    l.spot_linear = fall && !strcmp(fall, "linear");
+    l.ang_outer = (float)(cone * M_PI / 180);
+    l.ang_inner = (float)((cone - delta) * M_PI / 180);
   } else if (!strcmp(type, "directional")) {
     static const char *const keys[] = {"type", "direction", "irradiance", NULL};
     TRY(json_check_keys(c, o, where, keys));

@@ -495,6 +495,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
     TRY(color_or_one(c, e, "intensity", l, "intensity"));
     cJSON_AddNumberToObject(l, "cone_angle", cutoff);
     cJSON_AddNumberToObject(l, "cone_delta_angle", beam < cutoff ? cutoff - beam : 0);
+    cJSON_AddStringToObject(l, "falloff", "linear");
   } else if (!strcmp(type, "directional")) {
     vec3 d = v3((float)dir[0], (float)dir[1], (float)dir[2]);
     TRY(mi_point(c, e, "direction", &d));

@@ -112,6 +112,8 @@ typedef struct light {
   vec3 dir;        /* spot axis, or directional light's direction of travel (unit) */
   rgb L;           /* area/env radiance; point/spot intensity; directional irradiance */
   float cos_inner, cos_outer; /* spot falloff */
+  int spot_linear;   /* spot: falloff linear in the angle between the two (Mitsuba's), else smoothstep in the cosine (pbrt's) */
+  float ang_inner, ang_outer; /* spot_linear: the two angles (radians) */
   uint32_t tri;    /* area: triangle index */
   float area;      /* area: triangle area */
   int two_sided;
