@@ -80,7 +80,7 @@ static int wrong_type(void) {
   p = write_file("type3.json", "{ \"materials\": {\"m\": {\"type\": \"velvet\"}} }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("materials.m"); SAID("unknown material type"); NO_SANITIZER();
-  p = write_file("type4.json", "{ \"lights\": [{\"type\": \"spot\", \"falloff\": \"cubic\"}] }\n");
+  p = write_file("type4.json", "{ \"lights\": [{\"type\": \"spot\", \"position\": [0, 1, 0], \"falloff\": \"cubic\"}] }\n");
   EXPECT_FAIL(1, "render", p);
   SAID("lights[0]"); SAID("falloff must be \"smoothstep\" or \"linear\""); NO_SANITIZER();
   p = write_file("type5.json", "{ \"camera\": {\"from_file\": true, \"position\": [0,0,1]} }\n");
