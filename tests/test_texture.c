@@ -852,10 +852,10 @@ static rgb kd_at(const scene *s, uint32_t t, float b1, float b2) {
 
 /* Writes a glTF quad (y = 0, facing +y, 2 x 2) whose COLOR_0 is n components of type
  * ctype (5126 float, 5121 and 5123 normalized bytes and shorts) per vertex, all equal to
- * col (n = 0: none), its buffer in a .bin beside it; its material mat (JSON; NULL: base
- * colour factor (0.5, 1, 0.25), metallic 0) and the document's "extensionsUsed" used
- * (JSON; NULL: none). */
-static int gltf_quad(const char *name, int ctype, int n, const double *col, const char *mat, const char *used) {
+ * col (n = 0: none), its buffer in a .bin beside it; its materials mat (JSON objects;
+ * NULL: one of base colour factor (0.5, 1, 0.25), metallic 0), the primitive's the one at
+ * mat_index, and the document's "extensionsUsed" used (JSON; NULL: none). */
+static int gltf_quad(const char *name, int ctype, int n, const double *col, const char *mat, const char *used, int mat_index) {
   static const double white[3] = {1, 1, 1};
   int attr = n > 0; /* without COLOR_0 the accessor stays, unused */
   if (!attr) { n = 3; ctype = 5126; col = white; }
@@ -883,7 +883,7 @@ static int gltf_quad(const char *name, int ctype, int n, const double *col, cons
   if (!f || fwrite(buf, 1, len, f) != len || fclose(f)) return 0;
   snprintf(json, sizeof json,
            "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],%s%s%s\n"
-           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0%s}, \"indices\": 2, \"material\": 0}]}],\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0%s}, \"indices\": 2, \"material\": %d}]}],\n"
            " \"materials\": [%s],\n"
            " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"%s\"}],\n"
            " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": %zu},\n"
@@ -891,7 +891,7 @@ static int gltf_quad(const char *name, int ctype, int n, const double *col, cons
            " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, 0, -1], \"max\": [1, 0, 1]},\n"
            "   {\"bufferView\": 1, \"componentType\": %d, \"count\": 4, \"type\": \"VEC%d\"%s},\n"
            "   {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
-           used ? " \"extensionsUsed\": " : "", used ? used : "", used ? "," : "", attr ? ", \"COLOR_0\": 1" : "",
+           used ? " \"extensionsUsed\": " : "", used ? used : "", used ? "," : "", attr ? ", \"COLOR_0\": 1" : "", mat_index,
            mat ? mat : "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 1, 0.25, 1], \"metallicFactor\": 0}}", len, bin, clen, 48 + clen,
            ctype, n, ctype == 5126 ? "" : ", \"normalized\": true");
   char gl[64];
@@ -977,7 +977,7 @@ static int vertex_colors(void) {
   for (int i = 0; i < 3; i++) {
     char name[32];
     snprintf(name, sizeof name, "vc%d", i);
-    CHECK(gltf_quad(name, types[i][0], types[i][1], col, NULL, NULL), "write");
+    CHECK(gltf_quad(name, types[i][0], types[i][1], col, NULL, NULL, 0), "write");
     char path[64];
     snprintf(path, sizeof path, "%s.gltf", name);
     s = scene_new(scratch_path(path));
@@ -1023,7 +1023,7 @@ static int gltf_transmission(void) {
     char name[32], path[64];
     snprintf(name, sizeof name, "tr%zu", i);
     snprintf(path, sizeof path, "%s.gltf", name);
-    CHECK(gltf_quad(name, 0, 0, NULL, cases[i].mat, used), "write");
+    CHECK(gltf_quad(name, 0, 0, NULL, cases[i].mat, used, 0), "write");
     scene *s = scene_new(scratch_path(path));
     warnings_capture(1);
     valo_status st = load_mesh(s, scratch_path(path), NULL, UINT32_MAX, 0, NULL, &err);
@@ -1130,7 +1130,7 @@ static int gltf_transmission(void) {
   }
   free(px);
   /* extensions: used and not read, a warning; required and not read, refused */
-  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_clearcoat\"]"), "write");
+  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_clearcoat\"]", 0), "write");
   s = scene_new(scratch_path("trx.gltf"));
   warnings_capture(1);
   valo_status st = load_mesh(s, scratch_path("trx.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
@@ -1158,7 +1158,7 @@ static int gltf_transmission(void) {
  * sends the point (uv' = offset + R (scale uv), R = [cos sin; -sin cos], in glTF's v-down
  * space); the extension's own example (offset (0, 1), a quarter turn, scale 0.5) maps
  * the quad onto the image's lower left quadrant; a texture on coordinate set 1 is warned
- * about. */
+ * about; the image used through a clamping and a repeating sampler keeps both wraps. */
 static int gltf_texture_transform(void) {
   unsigned char ramp[16 * 16 * 3];
   for (int y = 0; y < 16; y++)
@@ -1179,10 +1179,11 @@ static int gltf_texture_transform(void) {
   snprintf(json, sizeof json,
            "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_texture_transform\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
            " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
-           " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, %s}, \"metallicRoughnessTexture\": {\"index\": 0, %s}},\n"
+           " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, %s}, \"metallicRoughnessTexture\": {\"index\": 1, %s}},\n"
            "   \"normalTexture\": {\"index\": 0, %s}, \"emissiveTexture\": {\"index\": 0, %s}, \"emissiveFactor\": [1, 1, 1]},\n"
-           "   {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"texCoord\": 1}}}],\n"
-           " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"uvramp.png\"}],\n"
+           "   {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 1}}}, {\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0, \"texCoord\": 1}}}],\n"
+           " \"textures\": [{\"source\": 0, \"sampler\": 0}, {\"source\": 0, \"sampler\": 1}], \"images\": [{\"uri\": \"uvramp.png\"}],\n"
+           " \"samplers\": [{\"wrapS\": 33071, \"wrapT\": 33071}, {\"wrapS\": 10497, \"wrapT\": 10497}],\n"
            " \"buffers\": [{\"byteLength\": 92, \"uri\": \"uvt.bin\"}],\n"
            " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},\n"
            "   {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}],\n"
@@ -1195,12 +1196,15 @@ static int gltf_texture_transform(void) {
   valo_error err;
   warnings_capture(1);
   valo_status st = load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err);
-  int set1 = strstr(warnings_text(), "texture coordinate set 1") != NULL;
+  int set1 = strstr(warnings_text(), "material 2: a texture reads texture coordinate set 1") != NULL;
   warnings_capture(0);
   CHECK(st == VALO_OK, "%s", err.message);
-  CHECK(set1, "a texture on coordinate set 1 was not warned about");
+  CHECK(set1, "the texture on coordinate set 1 was not warned about");
   const material *m = &s->mats[s->tri_mat[0]];
   const int slots[4] = {m->tex_kd, m->tex_mr, m->tex_normal, m->tex_ke};
+  /* one image through two samplers (the base colour clamps, the metallic-roughness repeats): each keeps its wrap */
+  CHECK(s->tex[m->tex_kd].smp.wrap == TEX_CLAMP && s->tex[m->tex_mr].smp.wrap == TEX_REPEAT, "the image's two samplers: wraps %d and %d",
+        (int)s->tex[m->tex_kd].smp.wrap, (int)s->tex[m->tex_mr].smp.wrap);
   for (int k = 0; k < 4; k++) {
     CHECK(slots[k] >= 0 && s->tex[slots[k]].smp.has_uvm, "slot %d: no transformed texture", k);
     texture base = s->tex[slots[k]];
@@ -1254,10 +1258,12 @@ static int gltf_specular(void) {
   double s5 = pow(1 - cos(1.55), 5), Fd = 0.04 + 0.96 * s5, Fm = want[0] + (0.5 - want[0]) * s5;
   CHECK(fabs(gm.r / gd.r - Fm / Fd) < 1e-3 * Fm / Fd, "at grazing %g, the default %g: ratio %g, expected %g", gm.r, gd.r, gm.r / gd.r, Fm / Fd);
   /* the same through a glTF file and a JSON material */
+  /* the second of two materials, which Assimp, meeting it first, numbers 0 */
   static const char *const mat =
-      "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.2, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}, \"extensions\": {"
+      "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.3, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}},\n"
+      "   {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.2, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}, \"extensions\": {"
       "\"KHR_materials_ior\": {\"ior\": 1.33}, \"KHR_materials_specular\": {\"specularFactor\": 0.5, \"specularColorFactor\": [1, 0.5, 0.25]}}}";
-  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\"]"), "write");
+  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\"]", 1), "write");
   scene *s = scene_new(scratch_path("spec.gltf"));
   valo_error err;
   warnings_capture(1);

@@ -112,12 +112,23 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   return VALO_OK;
 }
 
-int gltf_transformed(scene *s, const obj_check *oc, unsigned mi, int slot, int t) {
-  const float *m = t >= 0 && oc ? obj_check_uvt(oc, mi, slot) : NULL;
-  if (!m) return t;
+int gltf_transformed(scene *s, const struct aiMaterial *am, int type, int t) {
+  struct aiUVTransform x;
+  unsigned int n = sizeof x / sizeof(ai_real);
+  if (t < 0 || aiGetMaterialFloatArray(am, _AI_MATKEY_UVTRANSFORM_BASE, (unsigned)type, 0, (ai_real *)&x, &n) != aiReturn_SUCCESS ||
+      n != sizeof x / sizeof(ai_real))
+    return t;
+  /* Assimp 5.2 stores glTF's transform turned about the image's centre, v turned over:
+   * scale as given, rotation -r, and a translation it derives from the offset; undone here */
+  double sx = x.mScaling.x, sy = x.mScaling.y, r = -x.mRotation, c = cos(r), sn = sin(r);
+  double ox = x.mTranslation.x - 0.5 * sx * (-c + sn + 1), oy = 1 - sy + 0.5 * sy * (sn + c - 1) - x.mTranslation.y;
+  /* glTF's uv' = offset + R (scale uv), R = [c s; -s c] in its v-down space (counter-clockwise
+   * as the extension's own example and three.js read it), in valo's v-up coordinates: F M F */
+  double a = c * sx, b = sn * sy, d = -sn * sx, e = c * sy;
   tex_sampling smp = s->tex[t].smp;
   smp.has_uvm = 1;
-  memcpy(smp.uvm, m, sizeof smp.uvm);
+  const float uvm[6] = {(float)a, (float)-b, (float)(b + ox), (float)-d, (float)e, (float)(1 - e - oy)};
+  memcpy(smp.uvm, uvm, sizeof smp.uvm);
   return scene_texture_sampled(s, t, &smp);
 }
 
@@ -130,7 +141,33 @@ void mesh_vertex_colors(scene *s, const struct aiScene *ai, uint32_t mat_base) {
     }
 }
 
-void gltf_specular(const obj_check *oc, unsigned mi, material *m) {
-  const float *sp = oc && oc->gspec && mi < oc->ngspec ? &oc->gspec[4 * (size_t)mi] : NULL;
+/* The glTF material Assimp's material am was made from, by its signature (obj_check.h):
+ * its KHR_materials_specular values, or NULL when none matches or the ones that match
+ * disagree on them. */
+static const float *specular_of(const obj_check *oc, const struct aiMaterial *am, const char *where) {
+  if (!oc || !oc->gmat) return NULL;
+  struct aiString nm;
+  if (aiGetMaterialString(am, AI_MATKEY_NAME, &nm) != aiReturn_SUCCESS) nm.data[0] = 0;
+  struct aiColor4D base = {1, 1, 1, 1}, em = {0, 0, 0, 1};
+  aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
+  aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &em);
+  float sig[9] = {base.r, base.g, base.b, base.a, mat_float(am, AI_MATKEY_METALLIC_FACTOR, 1), mat_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), em.r, em.g, em.b};
+  const float *found = NULL;
+  int ambiguous = 0;
+  for (uint32_t i = 0; i < oc->ngmat; i++) {
+    const gltf_mat *g = &oc->gmat[i];
+    const float gs[9] = {g->base[0], g->base[1], g->base[2], g->base[3], g->metallic, g->roughness, g->emissive[0], g->emissive[1], g->emissive[2]};
+    int same = !strcmp(g->name, nm.data);
+    for (int k = 0; k < 9 && same; k++) same = fabsf(gs[k] - sig[k]) <= 1e-6f * fmaxf(1, fabsf(gs[k]));
+    if (!same) continue;
+    if (found && memcmp(found, g->specular, sizeof g->specular)) ambiguous = 1;
+    found = g->specular;
+  }
+  if (ambiguous) log_warning("%s: glTF materials alike in all Assimp reads differ in KHR_materials_specular: it is not read for them", where);
+  return ambiguous ? NULL : found;
+}
+
+void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char *where, material *m) {
+  const float *sp = specular_of(oc, am, where);
   material_pbr_specular(m, m->ior >= 1 && m->ior <= 10 ? m->ior : 1.5f, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
 }

@@ -212,57 +212,49 @@ static double elem_or(gc *g, uint32_t v, const char *key, int k, double def) {
   return x && N(g, x)->t == J_NUM ? N(g, x)->num : def;
 }
 
-/* The KHR_texture_transform of material i's textures valo reads, kept for the loader as
- * valo's uv_matrix: glTF's uv' = offset + R (scale * uv), R = [c s; -s c] (rotation
- * counter-clockwise in glTF's v-down texture space, as the extension's own example and
- * three.js read it), turned into valo's v-up coordinates (F M F, F(u, v) = (u, 1 - v)). A
- * texture on another coordinate set than the first is warned about: valo reads set 0. */
-static valo_status record_transforms(gc *g, uint32_t o, uint32_t i, const char *ctx) {
-  uint32_t pbr = json_get(&g->d, o, "pbrMetallicRoughness"), ext = json_get(&g->d, o, "extensions");
-  uint32_t slot_of[GLTF_SLOTS] = {json_get(&g->d, pbr, "baseColorTexture"), json_get(&g->d, pbr, "metallicRoughnessTexture"),
-                                  json_get(&g->d, o, "normalTexture"), json_get(&g->d, o, "emissiveTexture"),
-                                  json_get(&g->d, json_get(&g->d, ext, "KHR_materials_transmission"), "transmissionTexture")};
-  for (int k = 0; k < GLTF_SLOTS; k++) {
-    uint32_t info = slot_of[k];
-    if (!info || N(g, info)->t != J_OBJ) continue;
-    uint32_t tt = json_get(&g->d, json_get(&g->d, info, "extensions"), "KHR_texture_transform");
-    double set = num_or(g, tt, "texCoord", num_or(g, info, "texCoord", 0));
-    if (set != 0) log_warning("%s: %s: a texture reads texture coordinate set %g; valo reads set 0 only", g->path, ctx, set);
-    if (!tt || N(g, tt)->t != J_OBJ) continue;
-    double r = num_or(g, tt, "rotation", 0), c = cos(r), sn = sin(r);
-    double sx = elem_or(g, tt, "scale", 0, 1), sy = elem_or(g, tt, "scale", 1, 1), ox = elem_or(g, tt, "offset", 0, 0), oy = elem_or(g, tt, "offset", 1, 0);
-    double a = c * sx, b = sn * sy, d = -sn * sx, e = c * sy; /* glTF's M: [a b ox; d e oy] */
-    gltf_uvt *u = realloc(g->oc->uvt, (size_t)(g->oc->nuvt + 1) * sizeof *u);
-    if (!u) return gl_bad(g, "out of memory");
-    g->oc->uvt = u;
-    u[g->oc->nuvt++] = (gltf_uvt){i, k, {(float)a, (float)-b, (float)(b + ox), (float)-d, (float)e, (float)(1 - e - oy)}};
+/* A texture on another coordinate set than the first is warned about: valo reads set 0. */
+static void check_sets(gc *g, uint32_t v, const char *ctx) {
+  for (uint32_t c = N(g, v)->child; c; c = N(g, c)->next) {
+    const char *k = N(g, c)->key;
+    size_t kl = k ? strlen(k) : 0;
+    if (N(g, c)->t == J_OBJ && kl >= 7 && !strcmp(k + kl - 7, "Texture")) {
+      uint32_t tt = json_get(&g->d, json_get(&g->d, c, "extensions"), "KHR_texture_transform");
+      double set = num_or(g, tt, "texCoord", num_or(g, c, "texCoord", 0));
+      if (set != 0) log_warning("%s: %s: a texture reads texture coordinate set %g; valo reads set 0 only", g->path, ctx, set);
+    } else if (N(g, c)->t == J_OBJ && !(k && !strcmp(k, "extras"))) {
+      check_sets(g, c, ctx);
+    }
   }
-  return VALO_OK;
 }
 
-/* KHR_materials_specular's factors (its textures are not read: a warning says so). */
-static valo_status record_specular(gc *g, uint32_t o, uint32_t i, const char *ctx) {
-  uint32_t sp = json_get(&g->d, json_get(&g->d, o, "extensions"), "KHR_materials_specular");
-  if (!sp || N(g, sp)->t != J_OBJ) return VALO_OK;
-  if (!g->oc->gspec) {
-    if (!(g->oc->gspec = malloc(((size_t)g->n[K_MAT] + 1) * 4 * sizeof(float)))) return gl_bad(g, "out of memory");
-    for (size_t k = 0; k < ((size_t)g->n[K_MAT] + 1) * 4; k++) g->oc->gspec[k] = 1;
-    g->oc->ngspec = g->n[K_MAT];
+/* Material i's signature and its KHR_materials_specular factors (its textures are not
+ * read: a warning says so), for the loader (obj_check.h, gltf_mat). */
+static valo_status record_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
+  if (!g->oc->gmat) {
+    if (!(g->oc->gmat = calloc((size_t)g->n[K_MAT] + 1, sizeof *g->oc->gmat))) return gl_bad(g, "out of memory");
+    g->oc->ngmat = g->n[K_MAT];
   }
-  float *v = &g->oc->gspec[4 * (size_t)i];
-  v[0] = (float)num_or(g, sp, "specularFactor", 1);
-  for (int k = 0; k < 3; k++) v[1 + k] = (float)elem_or(g, sp, "specularColorFactor", k, 1);
+  gltf_mat *m = &g->oc->gmat[i];
+  uint32_t nm = json_get(&g->d, o, "name"), pbr = json_get(&g->d, o, "pbrMetallicRoughness");
+  snprintf(m->name, sizeof m->name, "%s", nm && N(g, nm)->t == J_STR ? N(g, nm)->str : "");
+  for (int k = 0; k < 4; k++) m->base[k] = (float)elem_or(g, pbr, "baseColorFactor", k, 1);
+  m->metallic = (float)num_or(g, pbr, "metallicFactor", 1);
+  m->roughness = (float)num_or(g, pbr, "roughnessFactor", 1);
+  for (int k = 0; k < 3; k++) m->emissive[k] = (float)elem_or(g, o, "emissiveFactor", k, 0);
+  uint32_t sp = json_get(&g->d, json_get(&g->d, o, "extensions"), "KHR_materials_specular");
+  m->specular[0] = (float)num_or(g, sp, "specularFactor", 1);
+  for (int k = 0; k < 3; k++) m->specular[1 + k] = (float)elem_or(g, sp, "specularColorFactor", k, 1);
   for (int k = 0; k < 4; k++)
-    if (!(v[k] >= 0 && v[k] < 1e6)) return gl_bad(g, "%s: KHR_materials_specular factors must be numbers from 0", ctx);
-  if (json_get(&g->d, sp, "specularTexture") || json_get(&g->d, sp, "specularColorTexture"))
+    if (!(m->specular[k] >= 0 && m->specular[k] < 1e6)) return gl_bad(g, "%s: KHR_materials_specular factors must be numbers from 0", ctx);
+  if (sp && (json_get(&g->d, sp, "specularTexture") || json_get(&g->d, sp, "specularColorTexture")))
     log_warning("%s: %s: KHR_materials_specular's textures are not read (its factors are)", g->path, ctx);
+  check_sets(g, o, ctx);
   return VALO_OK;
 }
 
 static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
   valo_status st = check_texture_refs(g, o, ctx);
-  if (!st) st = record_transforms(g, o, i, ctx);
-  return st ? st : record_specular(g, o, i, ctx);
+  return st ? st : record_material(g, o, i, ctx);
 }
 
 /* The extensions valo reads (Assimp imports them and valo uses what it imports). A file

@@ -98,7 +98,11 @@ static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial
                      int *wrap_out) {
   int wrap = aiTextureMapMode_Wrap;
   int t = load_slot_image(s, ai, am, type, dir, srgb, &wrap);
-  if (t >= 0) s->tex[t].smp.wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
+  if (t >= 0) { /* the image sampled with this slot's wrap (another slot's may differ: a texture sharing its pixels) */
+    tex_sampling smp = s->tex[t].smp;
+    smp.wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
+    t = scene_texture_sampled(s, t, &smp);
+  }
   if (wrap_out) *wrap_out = wrap;
   return t;
 }
@@ -162,7 +166,7 @@ static int looks_like_normal_map(const texture *t) {
 }
 
 static void convert_textures(scene *s, const struct aiScene *ai, const struct aiMaterial *am, material *m, const char *dir, int gltf,
-                             const obj_check *oc, unsigned mi) {
+                             const obj_check *oc) {
   int wrap = 0;
   const mtl_pbr *pb = oc ? obj_check_pbr(oc, m->name) : NULL;
   if (pb && pb->map_pr[0]) m->tex_rough = texture_in(s, dir, pb->map_pr, 0);
@@ -196,10 +200,10 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
     m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
     m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, dir, 0, NULL);
     if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, dir, 0, NULL);
-    m->tex_kd = gltf_transformed(s, oc, mi, GLTF_SLOT_BASE, m->tex_kd);
-    m->tex_mr = gltf_transformed(s, oc, mi, GLTF_SLOT_MR, m->tex_mr);
-    m->tex_normal = gltf_transformed(s, oc, mi, GLTF_SLOT_NORMAL, m->tex_normal);
-    m->tex_ke = gltf_transformed(s, oc, mi, GLTF_SLOT_EMISSIVE, m->tex_ke);
+    m->tex_kd = gltf_transformed(s, am, aiGetMaterialTextureCount(am, aiTextureType_BASE_COLOR) ? aiTextureType_BASE_COLOR : aiTextureType_DIFFUSE, m->tex_kd);
+    m->tex_mr = gltf_transformed(s, am, aiGetMaterialTextureCount(am, aiTextureType_METALNESS) ? aiTextureType_METALNESS : aiTextureType_UNKNOWN, m->tex_mr);
+    m->tex_normal = gltf_transformed(s, am, aiTextureType_NORMALS, m->tex_normal);
+    m->tex_ke = gltf_transformed(s, am, aiTextureType_EMISSIVE, m->tex_ke);
   }
   int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
@@ -275,12 +279,8 @@ static valo_status add_mesh(load_ctx *c, const struct aiMesh *mesh, const mat34 
   valo_status st = scene_add_mesh(s, &md, &xf->m[0][0], mat, &c->added, &c->degenerate, c->err);
   free(idx);
   int32_t med = c->mat_medium && c->override_mat == UINT32_MAX && mesh->mMaterialIndex < c->ai->mNumMaterials ? c->mat_medium[mesh->mMaterialIndex] : -1;
-  if (st == VALO_OK && med >= 0 && s->ntris > first) { /* a glTF volume: absorbing inside, vacuum outside */
-    shape_media *q = realloc(s->shape_media, (s->nshape_media + 1) * sizeof *q);
-    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
-    s->shape_media = q;
-    q[s->nshape_media++] = (shape_media){first, s->ntris, med, MEDIUM_NONE};
-  }
+  if (st == VALO_OK && med >= 0 && s->ntris > first && scene_add_shape_media(s, first, med, MEDIUM_NONE)) /* a glTF volume: absorbing inside */
+    return err_set(c->err, VALO_ERR_NOMEM, "%s: out of memory", c->path);
   for (uint32_t v = base; st == VALO_OK && uv && c->flip_v && v < s->nverts; v++) s->uv[2 * (size_t)v + 1] = 1 - s->uv[2 * (size_t)v + 1];
   for (unsigned v = 0; st == VALO_OK && has_tan && v < mesh->mNumVertices; v++) {
     vec3 n = s->nrm[base + v];
@@ -528,10 +528,10 @@ static valo_status place_with(load_ctx *cp, imported *im, const char *path, cons
       const obj_check *oc = im->obj || im->gltf ? &im->oc : NULL;
       material m = convert_material(ai->mMaterials[i], oc);
       snprintf(s->tex_user, sizeof s->tex_user, "%s: material '%s'", path, m.name);
-      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc, i);
+      convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc);
       if (c.gltf) { /* KHR_materials_ior and _specular; _transmission: a glass, or a blend with one (gltf_material.c) */
-        gltf_specular(oc, i, &m);
-        int tt = gltf_transformed(s, oc, i, GLTF_SLOT_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
+        gltf_specular(oc, ai->mMaterials[i], s->tex_user, &m);
+        int tt = gltf_transformed(s, ai->mMaterials[i], aiTextureType_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
         st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, &c.mat_medium[i], err);
         if (st) return st;
       }

@@ -264,11 +264,8 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   if (st) return st;
   if (inside != MEDIUM_KEEP || outside != MEDIUM_KEEP) {
     /* A medium boundary: the side not named is vacuum. */
-    shape_media *q = realloc(c->s->shape_media, (c->s->nshape_media + 1) * sizeof *q);
-    if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
-    c->s->shape_media = q;
-    shape_media sm = {first, c->s->ntris, inside == MEDIUM_KEEP ? MEDIUM_NONE : inside, outside == MEDIUM_KEEP ? MEDIUM_NONE : outside};
-    q[c->s->nshape_media++] = sm;
+    if (scene_add_shape_media(c->s, first, inside == MEDIUM_KEEP ? MEDIUM_NONE : inside, outside == MEDIUM_KEEP ? MEDIUM_NONE : outside))
+      return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   }
   const cJSON *px = cJSON_GetObjectItemCaseSensitive(o, "proximity");
   if (!px) return VALO_OK;

@@ -432,17 +432,10 @@ done:
   return st;
 }
 
-const float *obj_check_uvt(const obj_check *oc, uint32_t material, int slot) {
-  for (int i = 0; i < oc->nuvt; i++)
-    if (oc->uvt[i].material == material && oc->uvt[i].slot == slot) return oc->uvt[i].m;
-  return NULL;
-}
-
 void obj_check_free(obj_check *oc) {
   for (int i = 0; i < oc->nfiles; i++) free(oc->files[i].text);
   free(oc->pbr);
-  free(oc->uvt);
-  free(oc->gspec);
+  free(oc->gmat);
   memset(oc, 0, sizeof *oc);
 }
 

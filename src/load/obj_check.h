@@ -31,29 +31,29 @@ typedef struct obj_text {
   size_t len;
 } obj_text;
 
-/* A glTF material's KHR_texture_transform on one of its textures (recorded by
- * gltf_check.h), as valo's uv_matrix: (u, v) -> (m0 u + m1 v + m2, m3 u + m4 v + m5). */
-enum { GLTF_SLOT_BASE, GLTF_SLOT_MR, GLTF_SLOT_NORMAL, GLTF_SLOT_EMISSIVE, GLTF_SLOT_TRANSMISSION, GLTF_SLOTS };
-typedef struct gltf_uvt { uint32_t material; int slot; float m[6]; } gltf_uvt;
+/* A glTF material as gltf_check read it: what Assimp's import of it also holds (its name,
+ * base colour, metallic, roughness and emissive factors: its signature, by which the
+ * loader finds it among Assimp's materials, which Assimp numbers in the order it meets
+ * them), and what Assimp does not read (KHR_materials_specular's factor and colour). */
+typedef struct gltf_mat {
+  char name[128];
+  float base[4], metallic, roughness, emissive[3];
+  float specular[4];            /* specularFactor, specularColorFactor; 1 where absent */
+} gltf_mat;
 
 typedef struct obj_check {
   obj_text files[17];           /* [0] the OBJ, then its MTL files (a glTF: the file, its buffers) */
   int nfiles;
   mtl_pbr *pbr;                 /* one per newmtl of every MTL */
   int npbr;
-  gltf_uvt *uvt;                /* a glTF's texture transforms */
-  int nuvt;
-  float *gspec;                 /* a glTF's KHR_materials_specular, 4 per material (specularFactor,
-                                   specularColorFactor; 1 where absent), or NULL */
-  uint32_t ngspec;
+  gltf_mat *gmat;               /* a glTF's materials, or NULL */
+  uint32_t ngmat;
 } obj_check;
 
 /* Reads and checks the OBJ at path and the MTL files it names. Returns VALO_OK (with
  * warnings logged) or an error naming file and line. Free with obj_check_free. */
 valo_status obj_check_read(const char *path, obj_check *oc, valo_error *err);
 void obj_check_free(obj_check *oc);
-/* The texture transform of a glTF's material `material` on slot GLTF_SLOT_..., or NULL. */
-const float *obj_check_uvt(const obj_check *oc, uint32_t material, int slot);
 /* The PBR-extension values of material `name`, or NULL. */
 const mtl_pbr *obj_check_pbr(const obj_check *oc, const char *name);
 /* The file at path, whole and NUL-terminated (malloc'd; *len bytes before the NUL), or

@@ -90,6 +90,14 @@ material material_default(void) {
   return m;
 }
 
+int scene_add_shape_media(scene *s, uint32_t first, int32_t interior, int32_t exterior) {
+  shape_media *q = realloc(s->shape_media, (s->nshape_media + 1) * sizeof *q);
+  if (!q) return -1;
+  s->shape_media = q;
+  q[s->nshape_media++] = (shape_media){first, s->ntris, interior, exterior};
+  return 0;
+}
+
 void material_pbr_specular(material *m, float ior, float factor, rgb color) {
   float r = (ior - 1) / (ior + 1), f0 = ior == 1.5f ? 0.04f : r * r; /* 0.04 exactly at 1.5, as the model's default */
   m->f0 = c3(fminf(f0 * color.r, 1) * factor, fminf(f0 * color.g, 1) * factor, fminf(f0 * color.b, 1) * factor);

@@ -254,6 +254,10 @@ rgb scene_tri_color(const scene *s, uint32_t t, float b1, float b2);
  * hash of key (the ray's, geometry/accel.h) and t: the same ray meets the same answer
  * each time, two triangles on its way answer independently. */
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key);
+/* The triangles from first to the last added bound the media interior (against their
+ * winding normal) and exterior (MEDIUM_NONE: vacuum); later entries win. 0, or -1 when out
+ * of memory. */
+int scene_add_shape_media(scene *s, uint32_t first, int32_t interior, int32_t exterior);
 /* MAT_PBR's dielectric Fresnel as glTF's KHR_materials_ior and _specular give it: F0 =
  * min(((ior - 1) / (ior + 1))^2 color, 1) factor (0.04 at ior 1.5, factor and color 1),
  * F90 = factor. */
