@@ -1,7 +1,8 @@
 /* gltf_material.c — owns the glTF material meanings valo reads beyond the core
  * metallic-roughness model (load_assimp.c): KHR_texture_transform on a texture, COLOR_0
- * (and a PLY's colours) as vertex colours, KHR_materials_transmission with
- * KHR_materials_ior and KHR_materials_volume. The glTF BSDF is
+ * (and a PLY's colours) as vertex colours, KHR_materials_ior and KHR_materials_specular
+ * as the pbr model's Fresnel, KHR_materials_transmission with KHR_materials_volume. The
+ * glTF BSDF is
  *   mix(metal, fresnel_mix(ior, mix(diffuse, specular BTDF, t), specular BRDF), metallic)
  * so with w = t (1 - metallic) it is exactly the blend of valo's pbr material at metallic
  * m' = metallic / (1 - w) with weight 1 - w and a glass with weight w: a dielectric of the
