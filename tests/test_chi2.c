@@ -25,7 +25,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 74
+#define CHI2_TESTS 77
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -307,6 +307,17 @@ static int pbr_metallic_roughness(void) {
     snprintf(name, sizeof name, "glTF PBR metallic %.1f roughness %.1f", cfg[i].metallic, cfg[i].rough);
     rc |= test_bsdf(name, m, cfg[i].th);
   }
+  /* glTF's clearcoat layer (KHR_materials_clearcoat): a third lobe, sampled with its own pdf */
+  struct { float metallic, rough, cc, ccr, th; } ccfg[3] = {{0, 0.6f, 1, 0.05f, 30}, {1, 0.5f, 0.7f, 0.3f, 60}, {0, 0.3f, 0.5f, 0.6f, 75}};
+  for (int i = 0; i < 3; i++) {
+    material m = material_default();
+    m.type = MAT_PBR;
+    m.metallic = ccfg[i].metallic; m.roughness = ccfg[i].rough; m.kd = c3(0.7f, 0.5f, 0.3f);
+    m.clearcoat = ccfg[i].cc; m.clearcoat_roughness = ccfg[i].ccr;
+    char name[96];
+    snprintf(name, sizeof name, "glTF PBR clearcoat %.1f of roughness %.2f", ccfg[i].cc, ccfg[i].ccr);
+    rc |= test_bsdf(name, m, ccfg[i].th);
+  }
   float rough[3] = {0.1f, 0.5f, 1.0f}, th[3] = {0, 45, 80};
   for (int metal = 0; metal < 2; metal++)
     for (int i = 0; i < 3; i++)
@@ -317,6 +328,9 @@ static int pbr_metallic_roughness(void) {
         double albedo = directional_albedo(&m, th[j], 23);
         fprintf(stderr, "glTF PBR white %s roughness %.1f theta_o %2.0f: albedo %.4f\n", metal ? "metal     " : "dielectric", rough[i], th[j], albedo);
         CHECK(albedo <= 1.0 + 5e-3, "albedo %.4f > 1", albedo);
+        m.clearcoat = 1; m.clearcoat_roughness = rough[i];
+        double coated = directional_albedo(&m, th[j], 23);
+        CHECK(coated <= 1.0 + 5e-3, "under a clearcoat: albedo %.4f > 1", coated);
         CHECK(albedo > 0.25, "albedo %.4f: implausibly low (GGX single scattering at roughness 1 keeps about 0.3)", albedo);
       }
   return rc;

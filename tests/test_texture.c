@@ -1130,24 +1130,24 @@ static int gltf_transmission(void) {
   }
   free(px);
   /* extensions: used and not read, a warning; required and not read, refused */
-  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_clearcoat\"]", 0), "write");
+  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_sheen\"]", 0), "write");
   s = scene_new(scratch_path("trx.gltf"));
   warnings_capture(1);
   valo_status st = load_mesh(s, scratch_path("trx.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
-  int used_said = strstr(warnings_text(), "uses KHR_materials_clearcoat, which valo does not read") != NULL;
+  int used_said = strstr(warnings_text(), "uses KHR_materials_sheen, which valo does not read") != NULL;
   warnings_capture(0);
   scene_free(s);
-  CHECK(st == VALO_OK && used_said, "a file using KHR_materials_clearcoat: %s", st ? err.message : "no warning");
+  CHECK(st == VALO_OK && used_said, "a file using KHR_materials_sheen: %s", st ? err.message : "no warning");
   char *text = read_text_file(scratch_path("trx.gltf"));
   CHECK(text, "read");
   char req[4096]; /* the same file, requiring what it uses */
-  snprintf(req, sizeof req, "{\"extensionsRequired\": [\"KHR_materials_clearcoat\"], %s", text + 1);
+  snprintf(req, sizeof req, "{\"extensionsRequired\": [\"KHR_materials_sheen\"], %s", text + 1);
   free(text);
   scratch_file("trr.gltf", req);
   s = scene_new(scratch_path("trr.gltf"));
   st = load_mesh(s, scratch_path("trr.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
   scene_free(s);
-  CHECK(st != VALO_OK && strstr(err.message, "requires the extension KHR_materials_clearcoat") && strstr(err.message, "trr.gltf"), "required: %s",
+  CHECK(st != VALO_OK && strstr(err.message, "requires the extension KHR_materials_sheen") && strstr(err.message, "trr.gltf"), "required: %s",
         st ? err.message : "loaded");
   return 0;
 }
@@ -1232,13 +1232,14 @@ static int gltf_texture_transform(void) {
   return 0;
 }
 
-/* glTF's KHR_materials_ior and KHR_materials_specular on the opaque model (pbr's "ior",
- * "specular", "specular_color"): F0 = min(((ior - 1) / (ior + 1))^2 colour, 1) factor and
+/* glTF's KHR_materials_ior, KHR_materials_specular and KHR_materials_clearcoat on the
+ * opaque model (pbr's "ior", "specular", "specular_color", "clearcoat",
+ * "clearcoat_roughness"): F0 = min(((ior - 1) / (ior + 1))^2 colour, 1) factor and
  * F90 = factor; the specular lobe at normal incidence scales by F0 / 0.04 against the
  * default material, at grazing the dielectric's Fresnel reaches F90; a glTF quad with both
  * extensions gets those values and renders as the JSON pbr material with the same keys;
  * KHR_materials_specular is no longer warned about. */
-static int gltf_specular(void) {
+static int gltf_pbr_extensions(void) {
   material d = material_default(), m = material_default();
   d.type = m.type = MAT_PBR;
   d.kd = m.kd = c3(0, 0, 0);
@@ -1257,13 +1258,22 @@ static int gltf_specular(void) {
   rgb gd = bsdf_eval(&bd, wo, wi), gm = bsdf_eval(&bm, wo, wi);
   double s5 = pow(1 - cos(1.55), 5), Fd = 0.04 + 0.96 * s5, Fm = want[0] + (0.5 - want[0]) * s5;
   CHECK(fabs(gm.r / gd.r - Fm / Fd) < 1e-3 * Fm / Fd, "at grazing %g, the default %g: ratio %g, expected %g", gm.r, gd.r, gm.r / gd.r, Fm / Fd);
+  /* the clearcoat at normal incidence: f (1 - c 0.04) + c 0.04 D(n) / 4, D(n) = 1 / (pi alpha^2), G = 1 there */
+  material cm = d;
+  cm.clearcoat = 0.8f;
+  cm.clearcoat_roughness = 0.3f;
+  bsdf bc = bsdf_from_material(&cm);
+  rgb ec = bsdf_eval(&bc, v3(0, 0, 1), v3(0, 0, 1));
+  double ac = 0.09, coat = ed.r * (1 - 0.8 * 0.04) + 0.8 * 0.04 / (4 * M_PI * ac * ac);
+  CHECK(fabs(ec.r - coat) < 1e-4 * coat, "the clearcoat at normal incidence: %g, expected %g", ec.r, coat);
   /* the same through a glTF file and a JSON material */
   /* the second of two materials, which Assimp, meeting it first, numbers 0 */
   static const char *const mat =
       "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.3, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}},\n"
       "   {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.2, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}, \"extensions\": {"
-      "\"KHR_materials_ior\": {\"ior\": 1.33}, \"KHR_materials_specular\": {\"specularFactor\": 0.5, \"specularColorFactor\": [1, 0.5, 0.25]}}}";
-  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\"]", 1), "write");
+      "\"KHR_materials_ior\": {\"ior\": 1.33}, \"KHR_materials_specular\": {\"specularFactor\": 0.5, \"specularColorFactor\": [1, 0.5, 0.25]},"
+      " \"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8, \"clearcoatRoughnessFactor\": 0.3}}}";
+  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\", \"KHR_materials_clearcoat\"]", 1), "write");
   scene *s = scene_new(scratch_path("spec.gltf"));
   valo_error err;
   warnings_capture(1);
@@ -1272,8 +1282,10 @@ static int gltf_specular(void) {
   warnings_capture(0);
   CHECK(st == VALO_OK, "%s", err.message);
   const material *g = &s->mats[s->tri_mat[0]];
-  CHECK(!warned && g->type == MAT_PBR && fabs(g->f0.r - want[0]) < 1e-7 && fabs(g->f0.b - want[2]) < 1e-7 && g->f90 == 0.5f, "glTF: F0 (%g %g %g), F90 %g%s",
-        g->f0.r, g->f0.g, g->f0.b, g->f90, warned ? ", warned" : "");
+  CHECK(!warned && g->type == MAT_PBR && fabs(g->f0.r - want[0]) < 1e-7 && fabs(g->f0.b - want[2]) < 1e-7 && g->f90 == 0.5f && g->clearcoat == 0.8f &&
+            g->clearcoat_roughness == 0.3f,
+        "glTF: F0 (%g %g %g), F90 %g, clearcoat %g of roughness %g%s", g->f0.r, g->f0.g, g->f0.b, g->f90, g->clearcoat, g->clearcoat_roughness,
+        warned ? ", warned" : "");
   scene_free(s);
   double mean[2];
   for (int k = 0; k < 2; k++) {
@@ -1283,7 +1295,7 @@ static int gltf_specular(void) {
              "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
              "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.5},\n"
              "  \"materials\": {\"p\": {\"type\": \"pbr\", \"base_color\": [0.6, 0.4, 0.2], \"metallic\": 0, \"roughness\": 0.3, \"ior\": 1.33,\n"
-             "    \"specular\": 0.5, \"specular_color\": [1, 0.5, 0.25]}},\n"
+             "    \"specular\": 0.5, \"specular_color\": [1, 0.5, 0.25], \"clearcoat\": 0.8, \"clearcoat_roughness\": 0.3}},\n"
              "  \"shapes\": [{\"file\": \"spec.gltf\"%s}],\n"
              "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
              k ? ", \"material\": \"p\"" : "");
@@ -1691,7 +1703,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_specular", gltf_specular}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -1,7 +1,8 @@
 /* gltf_material.c — owns the glTF material meanings valo reads beyond the core
  * metallic-roughness model (load_assimp.c): KHR_texture_transform on a texture, COLOR_0
  * (and a PLY's colours) as vertex colours, KHR_materials_ior and KHR_materials_specular
- * as the pbr model's Fresnel, KHR_materials_transmission with KHR_materials_volume. The
+ * as the pbr model's Fresnel, KHR_materials_clearcoat as its coat,
+ * KHR_materials_transmission with KHR_materials_volume. The
  * glTF BSDF is
  *   mix(metal, fresnel_mix(ior, mix(diffuse, specular BTDF, t), specular BRDF), metallic)
  * so with w = t (1 - metallic) it is exactly the blend of valo's pbr material at metallic
@@ -171,4 +172,9 @@ static const float *specular_of(const obj_check *oc, const struct aiMaterial *am
 void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char *where, material *m) {
   const float *sp = specular_of(oc, am, where);
   material_pbr_specular(m, m->ior >= 1 && m->ior <= 10 ? m->ior : 1.5f, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
+  /* KHR_materials_clearcoat, which Assimp reads: its factors (its textures are not read) */
+  m->clearcoat = clampf(mat_float(am, AI_MATKEY_CLEARCOAT_FACTOR, 0), 0, 1);
+  m->clearcoat_roughness = clampf(mat_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
+  if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 0))
+    log_warning("%s: KHR_materials_clearcoat's textures are not read (its factors are)", where);
 }

@@ -206,7 +206,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -231,6 +231,11 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_rgb(c, o, "specular_color", where, &spec_color));
     m->ior = (float)ior;
     material_pbr_specular(m, m->ior, (float)spec, spec_color);
+    double cc = 0, ccr = 0; /* glTF's KHR_materials_clearcoat */
+    TRY(json_get_num(c, o, "clearcoat", where, 0, 1, &cc));
+    TRY(json_get_num(c, o, "clearcoat_roughness", where, 0, 1, &ccr));
+    m->clearcoat = (float)cc;
+    m->clearcoat_roughness = (float)ccr;
   } else if (!strcmp(type, "diffuse")) {
     TRY(json_check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;

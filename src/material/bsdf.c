@@ -68,6 +68,8 @@ bsdf bsdf_from_material(const material *m) {
   case MAT_PBR: {
     b.type = BSDF_PBR;
     b.metallic = clampf(m->metallic, 0, 1);
+    b.clearcoat = clampf(m->clearcoat, 0, 1); /* glTF's clearcoat: a GGX layer of ior 1.5 */
+    b.cc_alpha = fmaxf(1e-3f, m->clearcoat_roughness * m->clearcoat_roughness);
     b.metal_flat = m->metal_flat;
     /* Diffuse lobe weight against the specular one (never 0 unless the diffuse term is). */
     float wd = (1 - b.metallic) * c3_avg(m->kd), ws = b.metallic + (1 - b.metallic) * 0.25f;
@@ -119,14 +121,23 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   rgb Fm = b->metal_flat ? b->kd : c3_add(b->kd, c3_scale(c3_sub(c3(1, 1, 1), b->kd), s5));
   rgb diel = c3(b->kd.r * ((1 - Fo[0]) * INV_PI_F) + Fd[0] * spec, b->kd.g * ((1 - Fo[1]) * INV_PI_F) + Fd[1] * spec,
                 b->kd.b * ((1 - Fo[2]) * INV_PI_F) + Fd[2] * spec);
-  return c3_add(c3_scale(diel, 1 - b->metallic), c3_scale(Fm, b->metallic * spec));
+  rgb f = c3_add(c3_scale(diel, 1 - b->metallic), c3_scale(Fm, b->metallic * spec));
+  if (b->clearcoat > 0) { /* KHR_materials_clearcoat: mix(f, coat, clearcoat F(n.v)), F0 = 0.04 */
+    float fc = b->clearcoat * (0.04f + 0.96f * so), coat = ggx_D(b->cc_alpha, wm) * ggx_G(b->cc_alpha, wo, wi) / (4 * wo.z * wi.z);
+    f = c3_add(c3_scale(f, 1 - fc), c3(fc * coat, fc * coat, fc * coat));
+  }
+  return f;
 }
+/* The probability of sampling the clearcoat's lobe, from wo. */
+static float pbr_coat_prob(const bsdf *b, vec3 wo) { return b->clearcoat > 0 ? b->clearcoat * (0.25f + 0.5f * schlick_weight(wo.z)) : 0; }
 static float pbr_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   vec3 wm = v3_add(wo, wi);
   if (!(v3_len2(wm) > 0)) return 0;
   wm = v3_norm(wm);
   float ps = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
-  return b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps;
+  float pdf = b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps, pc = pbr_coat_prob(b, wo);
+  if (pc > 0) pdf = (1 - pc) * pdf + pc * ggx_D_visible(b->cc_alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
+  return pdf;
 }
 
 /* ---- rough dielectric (pbrt-v4 DielectricBxDF): the half vector of a refraction is
@@ -304,8 +315,13 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
   }
   case BSDF_PBR: {
     if (wo.z <= 0) return 0;
-    if (ulobe < b->p_first) s->wi = sample_cosine_hemisphere(u1, u2);
-    else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
+    float pc = pbr_coat_prob(b, wo);
+    if (pc > 0 && ulobe < pc) s->wi = v3_reflect(wo, ggx_sample_visible(b->cc_alpha, wo, u1, u2)); /* the clearcoat */
+    else {
+      if (pc > 0) ulobe = (ulobe - pc) / (1 - pc);
+      if (ulobe < b->p_first) s->wi = sample_cosine_hemisphere(u1, u2);
+      else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
+    }
     if (s->wi.z <= 0) return 0;
     s->pdf = pbr_pdf(b, wo, s->wi);
     s->weight = c3_scale(pbr_eval(b, wo, s->wi), s->wi.z / s->pdf);

@@ -73,7 +73,8 @@ typedef struct material {
   float opacity;     /* a hit counts with probability opacity (times tex_alpha's value when
                         alpha_stochastic): 1 = opaque, the default */
   int alpha_stochastic; /* 1: tex_alpha is an opacity map, not a cutout */
-  float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, spec_trans; /* MAT_PRINCIPLED */
+  float spec_tint, sheen, sheen_tint, flatness, clearcoat, clearcoat_gloss, spec_trans; /* MAT_PRINCIPLED (clearcoat: MAT_PBR's too) */
+  float clearcoat_roughness; /* MAT_PBR: glTF's KHR_materials_clearcoat layer (weight clearcoat) */
   float anisotropy;  /* MAT_PRINCIPLED: Mitsuba's "anisotropic", 0..1 (sets anisotropic when > 0) */
   int blend[2];      /* MAT_BLEND: the two materials' indices */
   int blend_by_side; /* MAT_BLEND: blend[0] seen from the front (the winding's normal side), blend[1] from the back
