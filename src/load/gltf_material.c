@@ -12,6 +12,7 @@
  * otherwise (glTF's thin-walled default), its transmission tinted by the base colour
  * factor. */
 #include "load/gltf_material.h"
+#include "load/assimp_material.h"
 #include "core/error.h"
 #include "image/texture.h"
 #include <assimp/material.h>
@@ -23,18 +24,11 @@
 
 #define TRY_ST(x) do { valo_status st_ = (x); if (st_) return st_; } while (0)
 
-static float mat_float(const struct aiMaterial *am, const char *key, unsigned type, unsigned idx, float def) {
-  ai_real v;
-  unsigned int n = 1;
-  if (aiGetMaterialFloatArray(am, key, type, idx, &v, &n) == aiReturn_SUCCESS && n == 1 && isfinite(v)) return (float)v;
-  return def;
-}
-
 /* KHR_materials_volume's absorption: a medium of sigma_a = -ln(attenuationColor) /
  * attenuationDistance (no scattering), appended to s; -1 when the glass is clear. */
 static valo_status volume_medium(scene *s, const struct aiMaterial *am, const char *where, int32_t *med, valo_error *err) {
   *med = -1;
-  float dist = mat_float(am, AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, INFINITY);
+  float dist = ai_float(am, AI_MATKEY_VOLUME_ATTENUATION_DISTANCE, INFINITY);
   struct aiColor4D ac;
   if (!(dist > 0) || !isfinite(dist) || aiGetMaterialColor(am, AI_MATKEY_VOLUME_ATTENUATION_COLOR, &ac) != aiReturn_SUCCESS) return VALO_OK;
   float c[3] = {ac.r, ac.g, ac.b}, sa[3];
@@ -59,7 +53,7 @@ static valo_status volume_medium(scene *s, const struct aiMaterial *am, const ch
 
 valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_trans, const char *where, material *m, int32_t *med, valo_error *err) {
   *med = -1;
-  float t = mat_float(am, AI_MATKEY_TRANSMISSION_FACTOR, 0);
+  float t = ai_float(am, AI_MATKEY_TRANSMISSION_FACTOR, 0);
   if (!(t > 0)) return VALO_OK;
   if (t > 1) t = 1;
   if (!c3_black(m->emission)) {
@@ -67,12 +61,8 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
     return VALO_OK;
   }
   material glass = *m;
-  float thick = mat_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, 0);
+  float thick = ai_float(am, AI_MATKEY_VOLUME_THICKNESS_FACTOR, 0);
   glass.type = thick > 0 ? MAT_DIELECTRIC : MAT_THIN_DIELECTRIC;
-  if (!(m->ior >= 1 && m->ior <= 10)) {
-    log_warning("%s: KHR_materials_ior %g is read as 1.5 (valo's glass takes 1 to 10)", where, (double)m->ior);
-    glass.ior = 1.5f;
-  }
   glass.transmittance = m->kd;
   glass.kd = c3(0, 0, 0);
   glass.metallic = 0;
@@ -81,22 +71,19 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   if (glass.type == MAT_THIN_DIELECTRIC && m->roughness > 0.0316f)
     log_warning("%s: thin-walled transmission (no KHR_materials_volume thickness) is rendered smooth, not at roughness %g", where, (double)m->roughness);
   if (glass.type == MAT_DIELECTRIC) TRY_ST(volume_medium(s, am, where, med, err));
-  /* the blend carries the maps that move the surface and its opacity; its parts neither */
-  glass.tex_normal = glass.tex_bump = glass.tex_alpha = -1;
-  glass.opacity = 1;
-  glass.alpha_stochastic = 0;
   float w = t * (1 - clampf(m->metallic, 0, 1));
-  if (w >= 1 && tex_trans < 0) { /* all glass */
-    glass.tex_normal = m->tex_normal; glass.tex_bump = m->tex_bump;
-    glass.tex_alpha = m->tex_alpha; glass.opacity = m->opacity; glass.alpha_stochastic = m->alpha_stochastic;
+  if (w >= 1 && tex_trans < 0) { /* all glass, with the material's maps and opacity */
     *m = glass;
     return VALO_OK;
   }
   material opaque = *m, blend = material_default();
   opaque.metallic = w < 1 ? clampf(m->metallic / (1 - w), 0, 1) : 1;
-  opaque.tex_normal = opaque.tex_bump = opaque.tex_alpha = -1;
-  opaque.opacity = 1;
-  opaque.alpha_stochastic = 0;
+  material *parts[2] = {&opaque, &glass};
+  for (int k = 0; k < 2; k++) { /* the blend carries the maps that move the surface and its opacity; its parts neither */
+    parts[k]->tex_normal = parts[k]->tex_bump = parts[k]->tex_alpha = -1;
+    parts[k]->opacity = 1;
+    parts[k]->alpha_stochastic = 0;
+  }
   snprintf(opaque.name, sizeof opaque.name, "%.50s (opaque)", m->name);
   snprintf(glass.name, sizeof glass.name, "%.50s (glass)", m->name);
   uint32_t a = scene_add_material(s, &opaque), b = a == UINT32_MAX ? a : scene_add_material(s, &glass);
@@ -153,7 +140,7 @@ static const float *specular_of(const obj_check *oc, const struct aiMaterial *am
   struct aiColor4D base = {1, 1, 1, 1}, em = {0, 0, 0, 1};
   aiGetMaterialColor(am, AI_MATKEY_BASE_COLOR, &base);
   aiGetMaterialColor(am, AI_MATKEY_COLOR_EMISSIVE, &em);
-  float sig[9] = {base.r, base.g, base.b, base.a, mat_float(am, AI_MATKEY_METALLIC_FACTOR, 1), mat_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), em.r, em.g, em.b};
+  float sig[9] = {base.r, base.g, base.b, base.a, ai_float(am, AI_MATKEY_METALLIC_FACTOR, 1), ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), em.r, em.g, em.b};
   const float *found = NULL;
   int ambiguous = 0;
   for (uint32_t i = 0; i < oc->ngmat; i++) {
@@ -170,11 +157,15 @@ static const float *specular_of(const obj_check *oc, const struct aiMaterial *am
 }
 
 void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char *where, material *m) {
+  if (!(m->ior >= 1 && m->ior <= 10)) {
+    log_warning("%s: KHR_materials_ior %g is read as 1.5 (valo takes 1 to 10)", where, (double)m->ior);
+    m->ior = 1.5f;
+  }
   const float *sp = specular_of(oc, am, where);
-  material_pbr_specular(m, m->ior >= 1 && m->ior <= 10 ? m->ior : 1.5f, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
+  material_pbr_specular(m, m->ior, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
   /* KHR_materials_clearcoat, which Assimp reads: its factors (its textures are not read) */
-  m->clearcoat = clampf(mat_float(am, AI_MATKEY_CLEARCOAT_FACTOR, 0), 0, 1);
-  m->clearcoat_roughness = clampf(mat_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
+  m->clearcoat = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_FACTOR, 0), 0, 1);
+  m->clearcoat_roughness = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
   if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 0))
     log_warning("%s: KHR_materials_clearcoat's textures are not read (its factors are)", where);
 }

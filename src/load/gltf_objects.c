@@ -76,7 +76,8 @@ valo_status gl_check_nodes(gc *g) {
 
 /* Every texture reference inside material value v (a member "...Texture" holding an
  * object, core or extension; not inside "extras", which is the application's): its
- * "index" must name a texture. */
+ * "index" must name a texture. One on another coordinate set than the first (its
+ * KHR_texture_transform's texCoord overrides its own) is warned about: valo reads set 0. */
 static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
   for (uint32_t c = N(g, v)->child; c; c = N(g, c)->next) {
     const char *k = N(g, c)->key;
@@ -84,6 +85,9 @@ static valo_status check_texture_refs(gc *g, uint32_t v, const char *ctx) {
     if (N(g, c)->t == J_OBJ && kl >= 7 && !strcmp(k + kl - 7, "Texture")) {
       uint64_t tc;
       if (gl_index(g, c, "index", g->n[K_TEX], "texture", 1, ctx) < 0 || gl_uint(g, c, "texCoord", 0, 7, 0, &tc, ctx)) return g->err->status;
+      uint32_t tt = json_get(&g->d, json_get(&g->d, c, "extensions"), "KHR_texture_transform");
+      if (tt && N(g, tt)->t == J_OBJ && gl_uint(g, tt, "texCoord", tc, 7, 0, &tc, ctx)) return g->err->status;
+      if (tc) log_warning("%s: %s: a texture reads texture coordinate set %llu; valo reads set 0 only", g->path, ctx, (unsigned long long)tc);
     }
     if (N(g, c)->t == J_OBJ && k && !strcmp(k, "KHR_texture_transform")) { /* Assimp indexes these without looking */
       static const char *vec2[] = {"offset", "scale"};
@@ -212,21 +216,6 @@ static double elem_or(gc *g, uint32_t v, const char *key, int k, double def) {
   return x && N(g, x)->t == J_NUM ? N(g, x)->num : def;
 }
 
-/* A texture on another coordinate set than the first is warned about: valo reads set 0. */
-static void check_sets(gc *g, uint32_t v, const char *ctx) {
-  for (uint32_t c = N(g, v)->child; c; c = N(g, c)->next) {
-    const char *k = N(g, c)->key;
-    size_t kl = k ? strlen(k) : 0;
-    if (N(g, c)->t == J_OBJ && kl >= 7 && !strcmp(k + kl - 7, "Texture")) {
-      uint32_t tt = json_get(&g->d, json_get(&g->d, c, "extensions"), "KHR_texture_transform");
-      double set = num_or(g, tt, "texCoord", num_or(g, c, "texCoord", 0));
-      if (set != 0) log_warning("%s: %s: a texture reads texture coordinate set %g; valo reads set 0 only", g->path, ctx, set);
-    } else if (N(g, c)->t == J_OBJ && !(k && !strcmp(k, "extras"))) {
-      check_sets(g, c, ctx);
-    }
-  }
-}
-
 /* Material i's signature and its KHR_materials_specular factors (its textures are not
  * read: a warning says so), for the loader (obj_check.h, gltf_mat). */
 static valo_status record_material(gc *g, uint32_t o, uint32_t i, const char *ctx) {
@@ -248,7 +237,6 @@ static valo_status record_material(gc *g, uint32_t o, uint32_t i, const char *ct
     if (!(m->specular[k] >= 0 && m->specular[k] < 1e6)) return gl_bad(g, "%s: KHR_materials_specular factors must be numbers from 0", ctx);
   if (sp && (json_get(&g->d, sp, "specularTexture") || json_get(&g->d, sp, "specularColorTexture")))
     log_warning("%s: %s: KHR_materials_specular's textures are not read (its factors are)", g->path, ctx);
-  check_sets(g, o, ctx);
   return VALO_OK;
 }
 

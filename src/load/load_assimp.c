@@ -19,6 +19,7 @@
 #include <assimp/ObjMaterial.h>
 #include "image/texture.h"
 #include "load/gltf_check.h"
+#include "load/assimp_material.h"
 #include "load/gltf_material.h"
 #include "load/import_probe.h"
 #include "load/obj_check.h"
@@ -45,12 +46,6 @@ static rgb ai_color(const struct aiMaterial *m, const char *key, unsigned type, 
     return c3(c.r, c.g, c.b);
   }
   if (found) *found = 0;
-  return def;
-}
-static float ai_float(const struct aiMaterial *m, const char *key, unsigned type, unsigned idx, float def) {
-  ai_real v;
-  unsigned int n = 1;
-  if (aiGetMaterialFloatArray(m, key, type, idx, &v, &n) == aiReturn_SUCCESS && n == 1) return (float)v;
   return def;
 }
 
