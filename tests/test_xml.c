@@ -1,7 +1,7 @@
 /* test_xml.c — Mitsuba scene files (.xml): the XML reader (entities, comments, errors with
  * line and column), the translation into valo's scene (an XML scene renders as the JSON
  * scene it means), Mitsuba 0.6's camelCase names, <default> values and --define, the
- * warning for properties valo does not read, Mitsuba's unit shapes, <include>, and instancing. Against
+ * warning for properties valo does not read, Mitsuba's unit shapes, <include>, <path>, and instancing. Against
  * Mitsuba itself: test_mitsuba from_xml and veach_mis_xml. */
 #include "harness.h"
 #include "load/load.h"
@@ -630,6 +630,71 @@ static int includes(void) {
   return 0;
 }
 
+/* <path>: the folders it names are where later relative file names are looked for, the
+ * last first, before the main file's folder (as Mitsuba 3.9.1 finds them: of three tri.obj,
+ * beside the scene, in the first and in the second <path> folder, it loads the second's).
+ * A scene whose mesh, texture and <include> are found on two <path>s renders bit for bit
+ * as the scene naming them with their folders; without the <path>s it draws the other
+ * triangle beside the scene. A missing folder, a file, and a <path> inside a shape are
+ * refused with their line. */
+static int search_paths(void) {
+  char dir[1100];
+  const char *sub[] = {"sp", "sp/meshes", "sp/parts"};
+  for (int i = 0; i < 3; i++) {
+    snprintf(dir, sizeof dir, "%s/%s", scratch_dir(), sub[i]);
+    mkdir(dir, 0755);
+  }
+  scratch_file("sp/tri.obj", "v -1 0 0\nv 1 0 0\nv 0 1.5 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nf 1/1 2/2 3/3\n");
+  scratch_file("sp/meshes/tri.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nf 1/1 2/2 3/3\n");
+  scratch_file("sp/parts/tri.obj", "v -1.5 -1 0\nv 1.5 -1 0\nv 0 0.5 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nf 1/1 2/2 3/3\n");
+  scratch_file("sp/parts/lamp.xml", "<scene version=\"3.0.0\"><emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.9\"/></emitter></scene>\n");
+  unsigned char tex[4 * 3] = {250, 20, 20, 20, 250, 20, 20, 20, 250, 240, 240, 240};
+  char tp[1200];
+  snprintf(tp, sizeof tp, "%s/sp/meshes/quad.png", scratch_dir());
+  CHECK(stbi_write_png(tp, 2, 2, 3, tex, 6), "write %s", tp);
+  static const char *fmt =
+      "<scene version=\"3.0.0\">\n%s"
+      "  <sensor type=\"perspective\"><float name=\"fov\" value=\"60\"/>\n"
+      "    <transform name=\"to_world\"><lookat origin=\"0, 0, 3\" target=\"0, 0, 0\" up=\"0, 1, 0\"/></transform>\n"
+      "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"4\"/></sampler>\n"
+      "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"32\"/><integer name=\"height\" value=\"32\"/></film></sensor>\n"
+      "  <include filename=\"%s\"/>\n"
+      "  <shape type=\"obj\"><string name=\"filename\" value=\"%s\"/>\n"
+      "    <bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"%s\"/></texture></bsdf></shape>\n"
+      "</scene>\n";
+  char xml[2048];
+  snprintf(xml, sizeof xml, fmt, "  <path value=\"meshes\"/>\n  <path value=\"parts\"/>\n", "lamp.xml", "tri.obj", "quad.png");
+  int w1 = 0, h1 = 0, w2 = 0, h2 = 0;
+  warnings_capture(1);
+  float *a = render_path(scratch_file("sp/paths.xml", xml), &w1, &h1);
+  int warned = warnings_text()[0] != 0;
+  warnings_capture(0);
+  snprintf(xml, sizeof xml, fmt, "", "parts/lamp.xml", "parts/tri.obj", "meshes/quad.png");
+  float *b = render_path(scratch_file("sp/named.xml", xml), &w2, &h2);
+  CHECK(a && b && !warned, "render (warnings printed above)");
+  CHECK(w1 == w2 && h1 == h2 && !memcmp(a, b, (size_t)w1 * h1 * 3 * sizeof(float)), "the <path> scene renders differently from the named one");
+  /* the test can tell: beside the scene is another triangle */
+  snprintf(xml, sizeof xml, fmt, "", "parts/lamp.xml", "tri.obj", "meshes/quad.png");
+  free(b);
+  b = render_path(scratch_file("sp/beside.xml", xml), &w2, &h2);
+  CHECK(b && memcmp(a, b, (size_t)w1 * h1 * 3 * sizeof(float)), "the triangle beside the scene renders as the <path> one");
+  free(a); free(b);
+  static const struct { const char *body, *want[2]; } bad[] = {
+      {"<path value=\"nowhere\"/>", {"sp/bad.xml:2: <path>", "nowhere is not a folder"}},
+      {"<path value=\"tri.obj\"/>", {"sp/bad.xml:2: <path>", "tri.obj is not a folder"}},
+      {"<path/>", {"sp/bad.xml:2: <path>", "needs a value"}},
+      {"<shape type=\"sphere\">\n<path value=\"meshes\"/></shape>", {"sp/bad.xml:3: <path>", "must be a child of <scene>"}},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    snprintf(xml, sizeof xml, "<scene version=\"3.0.0\">\n%s\n<sensor type=\"perspective\"/>\n</scene>\n", bad[i].body);
+    valo_scene *sc;
+    valo_error err;
+    CHECK(valo_scene_load(scratch_file("sp/bad.xml", xml), &sc, &err) != VALO_OK, "%s: loaded", bad[i].body);
+    CHECK(strstr(err.message, bad[i].want[0]) && strstr(err.message, bad[i].want[1]), "%s: said: %s", bad[i].body, err.message);
+  }
+  return 0;
+}
+
 /* Instancing: a shapegroup of a mesh, a cube and a sphere placed by three instances
  * renders as the nine shapes written out with the instances' to_world after their own;
  * a property the group's shapes do not read is warned about once, not per instance;
@@ -716,6 +781,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"search_paths", search_paths}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

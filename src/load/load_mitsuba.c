@@ -228,6 +228,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     int turn = 1;
     if (!strcmp(type, "obj")) TRY(mi_bool(c, n, "flip_tex_coords", &turn));
     if (!serialized && (!strcmp(type, "ply") || !turn)) cJSON_AddTrueToObject(sh, "flip_v");
+    if (!(file = mi_found(c, file))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     cJSON_AddStringToObject(sh, "file", file);
     int index = 0;
     if (serialized) {
@@ -448,6 +449,10 @@ static void translation_free(mctx *c) {
   free(c->light_at);
   for (int i = 0; i < c->nincluded; i++) free(c->included[i]);
   free(c->included);
+  for (int i = 0; i < c->nsearch; i++) free(c->search[i]);
+  free(c->search);
+  for (int i = 0; i < c->nfound; i++) free(c->found[i]);
+  free(c->found);
   free(c->bsdf_names);
 }
 

@@ -1,6 +1,6 @@
 /* load_mitsuba_doc.c — owns a Mitsuba scene document's structure before its elements are
  * read (load_mitsuba.c): 0.6's camelCase names, <include> (files spliced in, their
- * elements marked with the file they came from), <default> values with the command
+ * elements marked with the file they came from), <path> (folders to find files in), <default> values with the command
  * line's --define, $name substitution, and the check that every <ref> names an element. */
 #include "load/load_json_internal.h"
 #include "load/mitsuba_internal.h"
@@ -48,11 +48,51 @@ static void set_file(xml_node *n, const char *file) {
  * are the meshes and textures they name); at most MI_INCLUDE_DEPTH levels deep and
  * MI_INCLUDE_FILES inclusions in all (Mitsuba has only the first bound; the second keeps
  * a file that includes the next one twice, fifteen times over, from growing without end). */
+/* Mitsuba's <path value="folder"/>, a child of a file's <scene>: relative file names read
+ * after it are looked for in that folder first (mi_resolve). A relative folder is found
+ * from the folder of the file that names it, else as a file name is. */
+static valo_status read_path(mctx *c, const xml_node *parent, const xml_node *n) {
+  if (strcmp(parent->name, "scene") || parent->parent) return mi_bad(c, n, "a <path> must be a child of <scene>");
+  const char *v = xml_attr_get(n, "value");
+  if (!v || !*v) return mi_bad(c, n, "needs a value (a folder)");
+  if (strchr(v, '$')) return mi_bad(c, n, "a $parameter in a <path> is not read");
+  char *cand = NULL, **k;
+  struct stat sb;
+  if (v[0] == '/') {
+    cand = strdup(v);
+  } else {
+    const char *f = mi_file(c, n), *sl = strrchr(f, '/');
+    size_t dl = sl ? (size_t)(sl - f + 1) : 0, len = dl + strlen(v) + 1;
+    if ((cand = malloc(len))) snprintf(cand, len, "%.*s%s", (int)dl, f, v);
+    if (cand && stat(cand, &sb)) { free(cand); cand = mi_resolve(c, v); }
+  }
+  if (!cand) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  char *abs = realpath(cand, NULL);
+  if (!abs || stat(abs, &sb) || !S_ISDIR(sb.st_mode)) {
+    valo_status st = mi_bad(c, n, "%s is not a folder", cand);
+    free(cand);
+    free(abs);
+    return st;
+  }
+  free(cand);
+  if (!(k = realloc(c->search, (size_t)(c->nsearch + 1) * sizeof *k))) { free(abs); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+  c->search = k;
+  c->search[c->nsearch++] = abs;
+  return VALO_OK;
+}
+
 #define MI_INCLUDE_DEPTH 15
 #define MI_INCLUDE_FILES 4096
 static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
   for (xml_node **pp = &parent->child; *pp;) {
     xml_node *n = *pp;
+    if (!strcmp(n->name, "path")) { /* read here, in document order, so that the <include>s after it see it */
+      TRY(read_path(c, parent, n));
+      *pp = n->next;
+      n->next = NULL;
+      xml_free(n);
+      continue;
+    }
     if (strcmp(n->name, "include")) {
       TRY(expand_includes(c, n, depth));
       pp = &n->next;

@@ -95,6 +95,7 @@ valo_status mi_medium(mctx *c, xml_node *med, char *name, size_t n) {
     const char *file = NULL;
     TRY(mi_string(c, grid, "filename", &file));
     if (!file) return mi_bad(c, grid, "needs <string name=\"filename\">");
+    if (!(file = mi_found(c, file))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     cJSON_AddStringToObject(o, "file", file);
     double m[16];
     int given;

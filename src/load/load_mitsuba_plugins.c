@@ -451,6 +451,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
           general = 1;
         }
       }
+      if (!(file = mi_found(c, file))) return NOMEM;
       cJSON_AddStringToObject(env, "type", "map");
       cJSON_AddStringToObject(env, "file", file);
       cJSON_AddNumberToObject(env, "scale", scale);

@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const char *label(const xml_node *n, char *buf, size_t len) {
   const char *type = xml_attr_get(n, "type"), *name = xml_attr_get(n, "name"), *id = xml_attr_get(n, "id");
@@ -40,7 +41,35 @@ static size_t mi_dir_len(const mctx *c) {
   return slash ? (size_t)(slash - c->path + 1) : 0;
 }
 
+/* name found in the last <path> folder that holds it (malloc'd), or NULL (*nomem set when
+ * out of memory) */
+static char *in_search(const mctx *c, const char *name, int *nomem) {
+  *nomem = 0;
+  if (name[0] == '/') return NULL;
+  for (int i = c->nsearch - 1; i >= 0; i--) {
+    size_t len = strlen(c->search[i]) + strlen(name) + 2;
+    char *p = malloc(len);
+    if (!p) { *nomem = 1; return NULL; }
+    snprintf(p, len, "%s/%s", c->search[i], name);
+    if (!access(p, F_OK)) return p;
+    free(p);
+  }
+  return NULL;
+}
+
+const char *mi_found(mctx *c, const char *name) {
+  int nomem;
+  char *p = in_search(c, name, &nomem), **k;
+  if (!p) return nomem ? NULL : name;
+  if (!(k = realloc(c->found, (size_t)(c->nfound + 1) * sizeof *k))) { free(p); return NULL; }
+  c->found = k;
+  return c->found[c->nfound++] = p;
+}
+
 char *mi_resolve(const mctx *c, const char *name) {
+  int nomem;
+  char *found = in_search(c, name, &nomem);
+  if (found || nomem) return found;
   size_t dl = name[0] == '/' ? 0 : mi_dir_len(c), len = dl + strlen(name) + 1;
   char *path = malloc(len);
   if (path) snprintf(path, len, "%.*s%s", (int)dl, c->path, name);
@@ -368,6 +397,7 @@ static valo_status mi_texture(mctx *c, xml_node *k, cJSON **out) {
     const char *file = NULL, *filter = "bilinear", *wrap = "repeat";
     int raw = 0;
     if (!(st = mi_string(c, k, "filename", &file)) && !file) st = mi_bad(c, k, "a bitmap needs <string name=\"filename\">");
+    if (!st && !(file = mi_found(c, file))) st = err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     if (!st) st = mi_string(c, k, "filter_type", &filter);
     if (!st) st = mi_string(c, k, "wrap_mode", &wrap);
     if (!st) st = mi_bool(c, k, "raw", &raw);

@@ -19,6 +19,10 @@ typedef struct mctx {
   int nshape_at, nlight_at;
   char **included; /* the <include>d files' paths (xml_node.file points at them) */
   int nincluded;
+  char **search;   /* the folders <path> elements gave, absolute, in document order */
+  int nsearch;
+  char **found;    /* file names found in those folders (mi_found), absolute */
+  int nfound;
   const double *outer; /* while a shapegroup's shapes are read for an instance: its to_world */
   int quiet;           /* no warnings (an instance after a shapegroup's first) */
   struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
@@ -36,9 +40,15 @@ valo_status mi_bad(mctx *c, const xml_node *n, const char *fmt, ...) __attribute
 void mi_warn(mctx *c, const xml_node *n, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 /* The file n was read from: the scene file's path, or an included file's. */
 const char *mi_file(const mctx *c, const xml_node *n);
-/* A file name as the scene gives it, resolved against the main scene file's folder (where
- * every relative name starts, included files' too): malloc'd, NULL when out of memory. */
+/* A file name as the scene gives it, resolved as Mitsuba's file resolver does: a relative
+ * name in the folders of the <path> elements read so far, the last first, then in the main
+ * scene file's folder (where every relative name starts, included files' too). Malloc'd,
+ * NULL when out of memory. */
 char *mi_resolve(const mctx *c, const char *name);
+/* The name to give the JSON scene for a file the scene names (relative names there start
+ * at the main file's folder): the absolute path when a <path> folder holds it (kept in c),
+ * else the name as given. NULL when out of memory. */
+const char *mi_found(mctx *c, const char *name);
 /* r = a b (4x4, row-major; r may be a or b). */
 void mi_mat_mul(double r[16], const double a[16], const double b[16]);
 /* Where n is, for names of the materials and media made from unnamed elements: "line12",
