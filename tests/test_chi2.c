@@ -1056,9 +1056,18 @@ static int sobol_sampler(void) {
 /* The pixel filters' offsets (pixel_filter_sample) against their density
  * (pixel_filter_pdf): 64 cells over [-radius, radius], each cell's expectation integrated
  * from the density (Simpson, 64 steps); nothing outside. The density integrates to 1, and
- * the tabulated filters stay within 0.2 % of their peak of the continuous ones (Mitsuba's
- * Gaussian; Cycles' Blackman-Harris, filter_func_blackman_harris over twice its width). */
+ * the tabulated filters' |filter| stays within 0.2 % of its peak of the continuous ones
+ * (or within half a bin's rise at the steepest slope, which the cubics pass)
+ * (Mitsuba's Gaussian; Cycles' Blackman-Harris, filter_func_blackman_harris over twice
+ * its width; Mitchell and Netravali's cubics at B = C = 1/3 and B = 0, C = 1/2 written out;
+ * Lanczos' sinc(x) sinc(x/r)). With negative lobes, each sample's weight is the sign of
+ * the continuous filter there (but within a bin of its zeros) times integral |f| /
+ * integral f, and the weights average to 1 (within 4 standard errors). */
 static double continuous_filter(filter_kind kind, double x, double r) {
+  double t = fabs(2 * x / r), sx = M_PI * x;
+  if (kind == FILTER_MITCHELL) return t < 1 ? (7 * t * t * t - 12 * t * t + 16.0 / 3) / 6 : t < 2 ? (-7.0 / 3 * t * t * t + 12 * t * t - 20 * t + 32.0 / 3) / 6 : 0;
+  if (kind == FILTER_CATMULL_ROM) return t < 1 ? 1.5 * t * t * t - 2.5 * t * t + 1 : t < 2 ? -0.5 * t * t * t + 2.5 * t * t - 4 * t + 2 : 0;
+  if (kind == FILTER_LANCZOS) return x == 0 ? 1 : sin(sx) / sx * sin(sx / r) / (sx / r);
   if (kind == FILTER_GAUSSIAN) {
     double sd = r / 4, a = -1 / (2 * sd * sd);
     return exp(a * x * x) - exp(a * r * r);
@@ -1067,17 +1076,31 @@ static double continuous_filter(filter_kind kind, double x, double r) {
   return 0.35875 - 0.48829 * cos(v) + 0.14128 * cos(2 * v) - 0.01168 * cos(3 * v);
 }
 static int pixel_filters(void) {
-  static const struct { const char *name; double radius; } fs[] = {{"box", 0}, {"box", 1.5}, {"tent", 0}, {"gaussian", 0}, {"gaussian", 1.5}, {"blackman-harris", 0}};
+  static const struct { const char *name; double radius; } fs[] = {{"box", 0}, {"box", 1.5}, {"tent", 0}, {"gaussian", 0}, {"gaussian", 1.5}, {"blackman-harris", 0},
+                                                                      {"mitchell", 0}, {"mitchell", 1.5}, {"catmull-rom", 0}, {"lanczos", 0}, {"lanczos", 2}};
   int rc = 0;
   for (size_t k = 0; k < sizeof fs / sizeof fs[0]; k++) {
     pixel_filter f;
     CHECK(pixel_filter_make(&f, fs[k].name, fs[k].radius) == 0, "%s", fs[k].name);
     enum { CELLS = 64 };
     double r = f.radius, obs[CELLS] = {0}, ex[CELLS], total = 0;
-    long n = nsamples(), outside = 0;
+    long n = nsamples(), outside = 0, wrong_sign = 0;
+    double abs_int = 0, signed_int = 0, wsum = 0, wsq = 0;
+    for (int j = 0; j < 20000; j++) {
+      double v = continuous_filter(f.kind, -r + (j + 0.5) * 2 * r / 20000, r);
+      abs_int += fabs(v);
+      signed_int += v;
+    }
+    double want_w = abs_int / signed_int;
     for (long i = 0; i < n; i++) {
       sampler s = sampler_make(9, (uint64_t)i, k);
-      double x = pixel_filter_sample(&f, sampler_1d(&s));
+      float w;
+      double x = pixel_filter_sample(&f, sampler_1d(&s), &w);
+      wsum += w;
+      wsq += (double)w * w;
+      double v = continuous_filter(f.kind, x, r), bin = 2 * r / FILTER_BINS;
+      int near_zero = continuous_filter(f.kind, x - bin, r) * continuous_filter(f.kind, x + bin, r) <= 0;
+      if (!near_zero && fabs(w - (v < 0 ? -want_w : want_w)) > 2e-3 * want_w) wrong_sign++;
       int c = (int)floor((x + r) / (2 * r) * CELLS);
       if (c < 0 || c >= CELLS) { outside++; continue; }
       obs[c] += 1;
@@ -1091,14 +1114,23 @@ static int pixel_filters(void) {
     }
     CHECK(outside == 0, "%s: %ld offsets beyond the radius", fs[k].name, outside);
     CHECK(fabs(total - 1) < 2e-3, "%s: the density integrates to %g", fs[k].name, total);
-    if (f.kind == FILTER_GAUSSIAN || f.kind == FILTER_BLACKMAN_HARRIS) {
+    double mean_w = wsum / n, se = sqrt(fmax(wsq / n - mean_w * mean_w, 0) / n);
+    CHECK(wrong_sign == 0, "%s: %ld samples' weights are not sign(filter) x %g", fs[k].name, wrong_sign, want_w);
+    CHECK(fabs(mean_w - 1) <= 4 * se + 1e-6, "%s: the weights average %g (standard error %g)", fs[k].name, mean_w, se);
+    if (f.kind != FILTER_BOX && f.kind != FILTER_TENT) {
       double norm = 0, worst = 0;
-      for (int j = 0; j < 4096; j++) norm += continuous_filter(f.kind, -r + (j + 0.5) * 2 * r / 4096, r) * 2 * r / 4096;
+      for (int j = 0; j < 4096; j++) norm += fabs(continuous_filter(f.kind, -r + (j + 0.5) * 2 * r / 4096, r)) * 2 * r / 4096;
       for (int j = 0; j < 4096; j++) {
         double x = -r + (j + 0.5) * 2 * r / 4096;
-        worst = fmax(worst, fabs(pixel_filter_pdf(&f, (float)x) - continuous_filter(f.kind, x, r) / norm));
+        worst = fmax(worst, fabs(pixel_filter_pdf(&f, (float)x) - fabs(continuous_filter(f.kind, x, r)) / norm));
       }
-      CHECK(worst < 2e-3 * continuous_filter(f.kind, 0, r) / norm, "%s: the table is %g from the continuous filter", fs[k].name, worst);
+      /* a bin's step is at most half a bin times the steepest slope (the cubics' is 1.4 per pixel) */
+      double slope = 0, bin = 2 * r / FILTER_BINS;
+      for (int j = 0; j < 4096; j++) {
+        double x = -r + (j + 0.5) * 2 * r / 4096;
+        slope = fmax(slope, fabs(continuous_filter(f.kind, x + 1e-4, r) - continuous_filter(f.kind, x - 1e-4, r)) / 2e-4);
+      }
+      CHECK(worst < fmax(2e-3 * continuous_filter(f.kind, 0, r), 0.55 * slope * bin) / norm, "%s: the table is %g from the continuous filter", fs[k].name, worst);
     }
     char what[64];
     snprintf(what, sizeof what, "pixel filter %s, radius %.2f", fs[k].name, r);

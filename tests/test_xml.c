@@ -695,6 +695,44 @@ static int search_paths(void) {
   return 0;
 }
 
+/* Mitsuba's reconstruction filters read as valo's: box, tent (radius), gaussian (stddev s
+ * as radius 4s), mitchell (B = C = 1/3; B = 0, C = 1/2 is Catmull-Rom), catmullrom, lanczos
+ * (radius = lobes); other B and C are warned about; a filter valo lacks is warned about
+ * and Mitsuba's default Gaussian used. */
+static int rfilters(void) {
+  static const struct { const char *rf, *name; double radius; int warns; } cases[] = {
+      {"<rfilter type=\"box\"/>", "box", 0.5, 0},
+      {"<rfilter type=\"tent\"><float name=\"radius\" value=\"1.5\"/></rfilter>", "tent", 1.5, 0},
+      {"<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"0.25\"/></rfilter>", "gaussian", 1, 0},
+      {"<rfilter type=\"mitchell\"/>", "mitchell", 2, 0},
+      {"<rfilter type=\"mitchell\"><float name=\"B\" value=\"0\"/><float name=\"C\" value=\"0.5\"/></rfilter>", "catmull-rom", 2, 0},
+      {"<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.5\"/></rfilter>", "mitchell", 2, 1},
+      {"<rfilter type=\"catmullrom\"/>", "catmull-rom", 2, 0},
+      {"<rfilter type=\"lanczos\"/>", "lanczos", 3, 0},
+      {"<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"2\"/></rfilter>", "lanczos", 2, 0},
+      {"<rfilter type=\"unknown\"/>", "gaussian", 2, 1},
+      {"", "gaussian", 2, 0},
+  };
+  char xml[1024], out[1200], want[128];
+  snprintf(out, sizeof out, "%s/rf.json", scratch_dir());
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    snprintf(xml, sizeof xml, "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/>"
+             "<integer name=\"height\" value=\"8\"/>%s</film></sensor>\n</scene>\n", cases[i].rf);
+    valo_error err;
+    warnings_capture(1);
+    valo_status st = valo_scene_convert(scratch_file("rf.xml", xml), NULL, out, &err);
+    int warned = warnings_text()[0] != 0;
+    warnings_capture(0);
+    CHECK(st == VALO_OK, "%s: %s", cases[i].rf, err.message);
+    CHECK(warned == cases[i].warns, "%s: %s", cases[i].rf, warned ? "warned" : "no warning");
+    char *text = read_text_file(out);
+    snprintf(want, sizeof want, "\"filter\":\t\"%s\",\n\t\t\"filter_radius\":\t%g\n", cases[i].name, cases[i].radius);
+    CHECK(text && strstr(text, want), "%s: the film is not %s of radius %g: %s", cases[i].rf, cases[i].name, cases[i].radius, text ? text : "");
+    free(text);
+  }
+  return 0;
+}
+
 /* Instancing: a shapegroup of a mesh, a cube and a sphere placed by three instances
  * renders as the nine shapes written out with the instances' to_world after their own;
  * a property the group's shapes do not read is warned about once, not per instance;
@@ -781,6 +819,6 @@ static int instances(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"search_paths", search_paths}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"search_paths", search_paths}, {"rfilters", rfilters}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -46,12 +46,13 @@ const option_decl option_table[] = {
     {INFO(NULL, NULL, "film.crop_height", "the crop window's height"), R(crop_height), .type = OPT_INT, .lo = 1, .hi = 16384, .keep_unset = 1,
      .unset = VALO_UNSET, .range_text = "a whole number from 1 to 16384"},
     {INFO("--filter", "NAME", "film.filter",
-          "pixel filter: box (default, one pixel wide), tent, gaussian\n(Mitsuba's windowed Gaussian, standard deviation radius/4)\n"
-          "or blackman-harris (Cycles' default)"),
-     R(filter), .type = OPT_NAME, .names = "box|tent|gaussian|blackman-harris", .def_text = "box",
-     .range_text = "box, tent, gaussian or blackman-harris"},
+          "pixel filter: box (default, one pixel wide), tent, gaussian\n(Mitsuba's windowed Gaussian, standard deviation radius/4),\n"
+          "blackman-harris (Cycles' default), or with negative lobes\nmitchell, catmull-rom or lanczos"),
+     R(filter), .type = OPT_NAME, .names = "box|tent|gaussian|blackman-harris|mitchell|catmull-rom|lanczos", .def_text = "box",
+     .range_text = "box, tent, gaussian, blackman-harris, mitchell, catmull-rom or lanczos"},
     {INFO("--filter-radius", "PIXELS", "film.filter_radius",
-          "the filter's radius (default: box 0.5, tent 1, gaussian 2,\nblackman-harris 1.5 as Cycles' filter width)"),
+          "the filter's radius (default: box 0.5, tent 1, gaussian 2,\nblackman-harris 1.5 as Cycles' filter width, mitchell and\n"
+          "catmull-rom 2, lanczos 3)"),
      R(filter_radius), .type = OPT_REAL, .lo = 0.1, .hi = 16, .keep_unset = 1, .unset = VALO_UNSET, .range_text = "pixels, 0.1..16"},
     {INFO("--integrator", "NAME", "render.integrator", "the integrator (default path; --help-integrators lists them)"), R(integrator),
      .type = OPT_NAME, .def_text = "path", .range_text = "an integrator's name"},

@@ -63,6 +63,8 @@ typedef struct frame_ctx {
   int sequence;         /* 1: frames of a sequence (--frames), shown one by one; 0: the frames of a
                            still, averaged */
   const cam_lens *lens; /* this frame's camera with its lens (camera_ray) */
+  float *wt;            /* out when not NULL (a filter with negative lobes): width*height
+                           filter weights of this frame's samples (camera_ray) */
 } frame_ctx;
 
 /* Per-ray integrators give li() and get the tile loop; image-wide ones give render_frame. */

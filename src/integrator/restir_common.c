@@ -44,12 +44,14 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
   sampler smp = sampler_make_kind(c->seed, pix, (uint64_t)f->frame, (sampler_kind)c->sampler_kind);
   ts->rays++;
   delta_walk w;
-  delta_walk_start(&w, camera_ray(f->lens, x, y, &smp), 0);
+  float fw;
+  delta_walk_start(&w, camera_ray(f->lens, x, y, &smp, &fw), 0);
   if (delta_walk_next(&w, c, &smp, ts)) {
     g->it = w.it; g->fr = w.fr; g->b = w.b; g->wo = w.wo; g->beta = w.beta; g->valid = 1; g->chain = w.depth > 0;
   }
   if (w.hit_any) g->depth = cam_view_depth(&f->lens->view, w.first_p);
   g->Le = w.L;
+  g->fw = fw;
 }
 
 sampler restir_pixel_stream(const render_ctx *c, const frame_ctx *f, size_t pix, uint32_t dim) {
@@ -264,6 +266,7 @@ static void stage_shade(void *user, int64_t row, int thread) {
     }
     float *o = &j->f->rgb[3 * pix];
     o[0] = L.r; o[1] = L.g; o[2] = L.b;
+    if (j->f->wt) j->f->wt[pix] = g->fw;
   }
 }
 

@@ -24,6 +24,7 @@ typedef struct gpix {
   float depth;   /* how far the camera is from the first hit (cam_view_depth) */
   int valid;     /* a surface with a non-delta lobe */
   int chain;     /* reached through a delta bounce: not reprojected */
+  float fw;      /* the camera sample's filter weight (camera_ray) */
 } gpix;
 
 typedef struct restir_state {

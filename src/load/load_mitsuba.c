@@ -66,8 +66,26 @@ static valo_status read_film(mctx *c, xml_node *film, int *w, int *h) {
         }
         if (!(radius >= 0.1 && radius <= 16)) return mi_bad(c, r, "valo's filter radius is 0.1 to 16 pixels");
         mi_warn_unused(c, r);
+      } else if (t && (!strcmp(t, "mitchell") || !strcmp(t, "catmullrom") || !strcmp(t, "lanczos"))) {
+        /* Mitsuba's cubics have radius 2; its Lanczos has radius "lobes" (default 3) */
+        radius = 2;
+        rf = t[0] == 'c' ? "catmull-rom" : t;
+        if (t[0] == 'l') {
+          int lobes = 3;
+          TRY(mi_int(c, r, "lobes", &lobes));
+          if (lobes < 1 || lobes > 16) return mi_bad(c, r, "valo's Lanczos filter has 1 to 16 lobes");
+          radius = lobes;
+        } else if (t[0] == 'm') {
+          double b = 1.0 / 3, cc = 1.0 / 3;
+          TRY(mi_float(c, r, "B", &b));
+          TRY(mi_float(c, r, "C", &cc));
+          if (fabs(b) < 1e-4 && fabs(cc - 0.5) < 1e-4) rf = "catmull-rom";
+          else if (fabs(b - 1.0 / 3) > 1e-4 || fabs(cc - 1.0 / 3) > 1e-4)
+            mi_warn(c, r, "valo's cubic filters are Mitchell's B = C = 1/3 and Catmull-Rom's B = 0, C = 1/2: read as Mitchell's");
+        }
+        mi_warn_unused(c, r);
       } else {
-        mi_warn(c, r, "valo has no such filter (box, tent, gaussian): it uses Mitsuba's default, a Gaussian of standard deviation 0.5");
+        mi_warn(c, r, "valo has no such filter (box, tent, gaussian, mitchell, catmullrom, lanczos): it uses Mitsuba's default, a Gaussian of standard deviation 0.5");
       }
     }
     mi_warn_unused(c, film);

@@ -30,9 +30,10 @@ void film_clear(film *f) {
   memset(f->count, 0, np * sizeof *f->count);
 }
 
-void film_add(film *f, size_t pix, rgb L, thread_stats *ts) {
+void film_add(film *f, size_t pix, rgb L, float w, thread_stats *ts) {
   f->count[pix]++;
   if (!sample_usable(ts, L)) return;
+  if (w != 1) L = c3_scale(L, w);
   double *acc = &f->sum[3 * pix];
   acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
   if (f->sq) {

@@ -32,9 +32,10 @@ int film_init(film *f, int width, int height, int with_sq, int with_aov);
 void film_free(film *f);
 /* Zeroes the radiance sums and counts (a new frame of a sequence). */
 void film_clear(film *f);
-/* Adds one sample's radiance to pixel pix: NaN, infinite and negative ones count as
- * taken but are dropped (counted by cause in ts). */
-void film_add(film *f, size_t pix, rgb L, thread_stats *ts);
+/* Adds one sample's radiance to pixel pix times its filter weight w (camera_ray): NaN,
+ * infinite and negative radiances count as taken but are dropped (counted by cause in
+ * ts); a negative weight (a filter's negative lobe) is not a loss. */
+void film_add(film *f, size_t pix, rgb L, float w, thread_stats *ts);
 /* The mean radiance of every pixel (black where no sample landed), rgb_out w*h*3. */
 void film_resolve(const film *f, float *rgb_out);
 static inline size_t film_pixels(const film *f) { return (size_t)f->width * (size_t)f->height; }

@@ -99,10 +99,14 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   }
   ss->view_prev = ss->lens.view;
   if (pixel_filter_make(&ss->filter, o.filter, o.filter_radius != VALO_UNSET ? o.filter_radius : 0)) {
-    st = err_set(err, VALO_ERR_INVALID, "unknown pixel filter \"%s\" (box, tent, gaussian or blackman-harris)", o.filter);
+    st = err_set(err, VALO_ERR_INVALID, "unknown pixel filter \"%s\" (box, tent, gaussian, blackman-harris, mitchell, catmull-rom or lanczos)", o.filter);
     goto fail;
   }
   ss->lens.filter = ss->filter.kind == FILTER_BOX && ss->filter.radius == 0.5f ? NULL : &ss->filter;
+  if (integ->kind == INTEGRATOR_IMAGE && ss->filter.weight != 1 && !(ss->frame_wt = calloc((size_t)o.width * o.height, sizeof(float)))) {
+    st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
+    goto fail;
+  }
   ss->lens.aperture = o.aperture_radius != VALO_UNSET ? (float)o.aperture_radius : c->aperture_radius;
   if (c->spherical && ss->lens.aperture > 0) {
     st = err_set(err, VALO_ERR_INVALID, "%s: a spherical camera has no lens (aperture %g)", s->path, (double)ss->lens.aperture);
@@ -143,6 +147,7 @@ void session_destroy(session *ss) {
   if (ss->integ && ss->integ->destroy && ss->istate) ss->integ->destroy(ss->istate);
   film_free(&ss->film);
   free(ss->frame_rgb);
+  free(ss->frame_wt);
   free(ss);
 }
 
@@ -160,13 +165,14 @@ void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0)
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
   frame_ctx f = {ss->image_frames, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel,
-                 ss->opt.frames > 0 || ss->stepped, &ss->lens};
+                 ss->opt.frames > 0 || ss->stepped, &ss->lens, ss->frame_wt};
   valo_status st = ss->integ->render_frame(ss->istate, &ss->ctx, &f, err);
   if (st) return st;
   ss->image_frames++;
   ss->view_prev = ss->lens.view;
   size_t np = (size_t)ss->opt.width * ss->opt.height;
-  for (size_t i = 0; i < np; i++) film_add(&ss->film, i, c3(ss->frame_rgb[3 * i], ss->frame_rgb[3 * i + 1], ss->frame_rgb[3 * i + 2]), &ts[0]);
+  for (size_t i = 0; i < np; i++)
+    film_add(&ss->film, i, c3(ss->frame_rgb[3 * i], ss->frame_rgb[3 * i + 1], ss->frame_rgb[3 * i + 2]), ss->frame_wt ? ss->frame_wt[i] : 1, &ts[0]);
   return VALO_OK;
 }
 

@@ -49,6 +49,7 @@ struct session {
   int frames_done;         /* a sequence: frames finished */
   int image_frames;        /* render_frame calls made (the integrator's frame index) */
   float *frame_rgb;        /* render_frame output, width*height*3 */
+  float *frame_wt;         /* and its samples' filter weights when the filter has negative lobes */
   session_frame_fn on_frame;
   void *on_frame_user;
   char ckpt_path[4096];    /* checkpoints to this file ("" for none), at pass boundaries */

@@ -20,10 +20,11 @@ void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats 
   uint64_t frame_pix = (uint64_t)(y + ss->crop_y) * (uint64_t)ss->frame_w + (uint64_t)(x + ss->crop_x);
   for (int si = s0; si < s1; si++) {
     sampler smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
-    ray ry = camera_ray(&ss->lens, x, y, &smp);
+    float w;
+    ray ry = camera_ray(&ss->lens, x, y, &smp, &w);
     ts->rays++;
     if (ss->film.aov) aov_record(ss, ry, &ss->film.aov[AOV_FLOATS * pix], &smp, ts);
-    film_add(&ss->film, pix, ss->integ->li(&ss->ctx, ry, &smp, ts), ts);
+    film_add(&ss->film, pix, ss->integ->li(&ss->ctx, ry, &smp, ts), w, ts);
   }
 }
 

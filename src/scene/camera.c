@@ -18,18 +18,19 @@ int cam_view_make(const camera *c, int width, int height, cam_view *v) {
   return (!v3_finite(v->right) || !(v3_len2(v->right) > 0.5f)) ? -1 : 0;
 }
 
-ray camera_ray(const cam_lens *l, int px, int py, sampler *smp) {
+ray camera_ray(const cam_lens *l, int px, int py, sampler *smp, float *weight) {
   const cam_view *v = &l->view;
   float jx, jy;
   sampler_set_dim(smp, SDIM_FILM);
   sampler_2d(smp, &jx, &jy);
   px += v->x0;
   py += v->y0;
-  float fx = (float)px + jx, fy = (float)py + jy;
+  float fx = (float)px + jx, fy = (float)py + jy, wx = 1, wy = 1;
   if (l->filter) {
-    fx = (float)px + 0.5f + pixel_filter_sample(l->filter, jx);
-    fy = (float)py + 0.5f + pixel_filter_sample(l->filter, jy);
+    fx = (float)px + 0.5f + pixel_filter_sample(l->filter, jx, &wx);
+    fy = (float)py + 0.5f + pixel_filter_sample(l->filter, jy, &wy);
   }
+  *weight = wx * wy;
   ray ry;
   vec3 d;
   cam_view_ray(v, fx, fy, &ry.o, &d);

@@ -96,6 +96,7 @@ static inline float cam_view_depth(const cam_view *v, vec3 p) {
 /* The camera ray of film pixel (px, py) for one sample: the position in the pixel (or
  * around its centre, drawn from the lens's filter) from the sampler's SDIM_FILM
  * dimensions, the point on the lens from SDIM_LENS (drawn for a pinhole too, so streams
- * do not shift); leaves the sampler at SDIM_WAVELENGTH. */
-ray camera_ray(const cam_lens *l, int px, int py, sampler *smp);
+ * do not shift); leaves the sampler at SDIM_WAVELENGTH. *weight gets the sample's filter
+ * weight (pixel_filter_sample's in x times in y: 1 but for a filter's negative lobes). */
+ray camera_ray(const cam_lens *l, int px, int py, sampler *smp, float *weight);
 #endif
