@@ -1152,6 +1152,122 @@ static int gltf_transmission(void) {
   return 0;
 }
 
+/* Integer vertex attributes (glTF's normalized texture coordinates, KHR_mesh_quantization's
+ * positions, normals and tangents; Assimp 5.2 read their bytes as floats: texture
+ * coordinates of NaN): a quad of unsigned-short positions (one replaced by a sparse
+ * part) under a node's scale and translation, byte normals and tangents and
+ * unsigned-short texture coordinates, normalized, loads bit for bit as the same quad given
+ * as the floats glTF's rules make of them (c/65535, max(c/127, -1)), from a .gltf and a
+ * .glb; normalized texture coordinates alone, without the extension, too; a normal of
+ * unsigned shorts and indices of 32-bit floats' kind in a position are refused. */
+static const char *quant_json(const char *attrs, const char *ext, const char *buffer) {
+  static char json[4096];
+  snprintf(json, sizeof json,
+           "{\"asset\": {\"version\": \"2.0\"}, %s \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],\n"
+           " \"nodes\": [{\"mesh\": 0, \"scale\": [0.5, 0.25, 0.25], \"translation\": [-1, -0.5, -0.5]}],\n"
+           " \"meshes\": [{\"primitives\": [{\"attributes\": {%s}, \"indices\": 8}]}],\n"
+           " \"buffers\": [{\"byteLength\": 296%s}],\n"
+           " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 48},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 32}, {\"buffer\": 0, \"byteOffset\": 128, \"byteLength\": 64},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 192, \"byteLength\": 32, \"byteStride\": 8}, {\"buffer\": 0, \"byteOffset\": 224, \"byteLength\": 16, \"byteStride\": 4},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 240, \"byteLength\": 16}, {\"buffer\": 0, \"byteOffset\": 256, \"byteLength\": 16},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 272, \"byteLength\": 12}, {\"buffer\": 0, \"byteOffset\": 284, \"byteLength\": 2},\n"
+           "   {\"buffer\": 0, \"byteOffset\": 288, \"byteLength\": 6}],\n"
+           " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [5, 6, 3]},\n"
+           "   {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\"}, {\"bufferView\": 2, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"},\n"
+           "   {\"bufferView\": 3, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC4\"},\n"
+           "   {\"bufferView\": 4, \"componentType\": 5123, \"count\": 4, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [5, 6, 3],\n"
+           "    \"sparse\": {\"count\": 1, \"indices\": {\"bufferView\": 9, \"componentType\": 5123}, \"values\": {\"bufferView\": 10}}},\n"
+           "   {\"bufferView\": 5, \"componentType\": 5120, \"normalized\": true, \"count\": 4, \"type\": \"VEC3\"},\n"
+           "   {\"bufferView\": 6, \"componentType\": 5123, \"normalized\": true, \"count\": 4, \"type\": \"VEC2\"},\n"
+           "   {\"bufferView\": 7, \"componentType\": 5120, \"normalized\": true, \"count\": 4, \"type\": \"VEC4\"},\n"
+           "   {\"bufferView\": 8, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n",
+           ext, attrs, buffer);
+  return json;
+}
+static int same_arrays(const scene *a, const scene *b, const char *what) {
+  CHECK(a->nverts == b->nverts && a->ntris == b->ntris && a->nverts == 4, "%s: %u and %u vertices", what, a->nverts, b->nverts);
+  CHECK(!memcmp(a->pos, b->pos, 4 * sizeof *a->pos), "%s: positions differ", what);
+  CHECK(!memcmp(a->nrm, b->nrm, 4 * sizeof *a->nrm), "%s: normals differ", what);
+  CHECK(!memcmp(a->uv, b->uv, 8 * sizeof *a->uv), "%s: texture coordinates differ (%g %g against %g %g)", what, a->uv[2], a->uv[3], b->uv[2], b->uv[3]);
+  CHECK((a->tan_file == NULL) == (b->tan_file == NULL) && (!a->tan_file || !memcmp(a->tan_file, b->tan_file, 16 * sizeof(float))), "%s: tangents differ", what);
+  return 0;
+}
+static scene *quant_load(const char *name, const char *text, size_t len, valo_error *err) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/%s", scratch_dir(), name);
+  FILE *f = fopen(path, "wb");
+  if (!f || fwrite(text, 1, len, f) != len || fclose(f)) return NULL;
+  scene *s = scene_new(path);
+  if (load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, err) != VALO_OK) { scene_free(s); return NULL; }
+  return s;
+}
+static int gltf_quantized(void) {
+  unsigned char bin[296] = {0};
+  static const uint16_t qpos[4][4] = {{0, 0, 3}, {5, 0, 3}, {5, 6, 0}, {0, 6, 0}}, sparse_ix = 2, sparse_pos[3] = {4, 6, 1};
+  static const int8_t qn[4][4] = {{0, 76, 102}, {0, -128, 0}, {127, 0, 0}, {-60, 90, 30}}, qt[4][4] = {{127, 0, 0, 127}, {0, 127, 0, -127}, {0, 0, -128, 127}, {90, 90, 0, 127}};
+  static const uint16_t quv[4][2] = {{0, 65535}, {65535, 65535}, {32768, 13107}, {1, 0}}, idx[6] = {0, 1, 2, 0, 2, 3};
+  float fpos[12], fn[12], fuv[8], ft[16];
+  for (int v = 0; v < 4; v++) {
+    for (int k = 0; k < 3; k++) {
+      fpos[3 * v + k] = v == sparse_ix ? sparse_pos[k] : qpos[v][k];
+      fn[3 * v + k] = (float)fmax(qn[v][k] / 127.0, -1.0);
+    }
+    for (int k = 0; k < 4; k++) ft[4 * v + k] = (float)fmax(qt[v][k] / 127.0, -1.0);
+    for (int k = 0; k < 2; k++) fuv[2 * v + k] = (float)(quv[v][k] / 65535.0);
+  }
+  memcpy(bin, fpos, 48); memcpy(bin + 48, fn, 48); memcpy(bin + 96, fuv, 32); memcpy(bin + 128, ft, 64);
+  for (int v = 0; v < 4; v++) {
+    memcpy(bin + 192 + 8 * v, qpos[v], 6);
+    memcpy(bin + 224 + 4 * v, qn[v], 3);
+    memcpy(bin + 240 + 4 * v, quv[v], 4);
+    memcpy(bin + 256 + 4 * v, qt[v], 4);
+  }
+  memcpy(bin + 272, idx, 12); memcpy(bin + 284, &sparse_ix, 2); memcpy(bin + 288, sparse_pos, 6);
+  FILE *f = fopen(scratch_path("quant.bin"), "wb");
+  CHECK(f && fwrite(bin, 1, sizeof bin, f) == sizeof bin && !fclose(f), "write");
+  static const char *const ref_attrs = "\"POSITION\": 0, \"NORMAL\": 1, \"TEXCOORD_0\": 2, \"TANGENT\": 3";
+  static const char *const q_attrs = "\"POSITION\": 4, \"NORMAL\": 5, \"TEXCOORD_0\": 6, \"TANGENT\": 7";
+  static const char *const q_ext = "\"extensionsUsed\": [\"KHR_mesh_quantization\"], \"extensionsRequired\": [\"KHR_mesh_quantization\"],";
+  valo_error err;
+  const char *t = quant_json(ref_attrs, "", ", \"uri\": \"quant.bin\"");
+  scene *ref = quant_load("qref.gltf", t, strlen(t), &err);
+  CHECK(ref, "%s", err.message);
+  t = quant_json(q_attrs, q_ext, ", \"uri\": \"quant.bin\"");
+  scene *q = quant_load("quant.gltf", t, strlen(t), &err);
+  CHECK(q, "%s", err.message);
+  int rc = same_arrays(q, ref, "quant.gltf");
+  scene_free(q);
+  /* the same in a .glb: the JSON chunk, then the buffer as its BIN chunk */
+  t = quant_json(q_attrs, q_ext, "");
+  size_t jl = strlen(t), jp = (jl + 3) & ~(size_t)3, n = 12 + 8 + jp + 8 + sizeof bin;
+  unsigned char *g = calloc(n, 1);
+  CHECK(g, "memory");
+  uint32_t head[5] = {0x46546C67u, 2, (uint32_t)n, (uint32_t)jp, 0x4E4F534Au}, chunk[2] = {(uint32_t)sizeof bin, 0x004E4942u};
+  memcpy(g, head, 20); memcpy(g + 20, t, jl); memset(g + 20 + jl, ' ', jp - jl); memcpy(g + 20 + jp, chunk, 8); memcpy(g + 28 + jp, bin, sizeof bin);
+  q = quant_load("quant.glb", (const char *)g, n, &err);
+  free(g);
+  CHECK(q, "%s", err.message);
+  rc |= same_arrays(q, ref, "quant.glb");
+  scene_free(q);
+  /* normalized texture coordinates alone are core glTF: no extension needed */
+  t = quant_json("\"POSITION\": 0, \"NORMAL\": 1, \"TEXCOORD_0\": 6, \"TANGENT\": 3", "", ", \"uri\": \"quant.bin\"");
+  q = quant_load("quv.gltf", t, strlen(t), &err);
+  CHECK(q, "%s", err.message);
+  rc |= same_arrays(q, ref, "quv.gltf");
+  scene_free(q);
+  scene_free(ref);
+  /* kinds no rule allows: a normal of unsigned shorts, a position of unsigned ints */
+  static const struct { const char *attrs, *said; } bad[] = {{"\"POSITION\": 0, \"NORMAL\": 6", "NORMAL must be 3-component floats, or normalized bytes or shorts"},
+                                                              {"\"POSITION\": 8", "POSITION must be 3-component floats"}};
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+    t = quant_json(bad[k].attrs, q_ext, ", \"uri\": \"quant.bin\"");
+    q = quant_load("qbad.gltf", t, strlen(t), &err);
+    CHECK(!q && strstr(err.message, bad[k].said), "%s: %s", bad[k].attrs, q ? "loaded" : err.message);
+  }
+  return rc;
+}
+
 /* glTF's KHR_texture_transform: a quad with texture coordinates whose base colour,
  * metallic-roughness, normal and emissive textures each carry a transform; looked up at
  * points of the quad, each equals its image looked up where the extension's formula
@@ -1703,7 +1819,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

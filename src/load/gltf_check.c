@@ -238,6 +238,8 @@ static valo_status check_sparse(gc *g, uint32_t sp, gacc *a, const char *acc_ctx
   int64_t k = first_index_past(g->bufs[v->buf].data + v->off + ioff, n, cs, a->count, &x);
   if (k >= 0) return gl_bad(g, "%s: index %lld is %u, past the accessor's %llu elements", ctx, (long long)k, x, (unsigned long long)a->count);
   a->sparse_values = g->bufs[w->buf].data + w->off + voff;
+  a->sparse_index = g->bufs[v->buf].data + v->off + ioff;
+  a->sparse_isize = (int)cs;
   a->sparse_n = n;
   return VALO_OK;
 }
@@ -254,8 +256,9 @@ static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx
   if (!comp_size(a->ctype)) return gl_bad(g, "%s: \"componentType\" %d is not one of glTF's", ctx, a->ctype);
   if (!a->comps) return gl_bad(g, "%s: \"type\" must be SCALAR, VEC2, VEC3, VEC4, MAT2, MAT3 or MAT4", ctx);
   if (a->count == 0) return gl_bad(g, "%s: \"count\" must be at least 1", ctx);
-  uint32_t sp = json_get(&g->d, o, "sparse");
+  uint32_t sp = json_get(&g->d, o, "sparse"), nz = json_get(&g->d, o, "normalized");
   a->sparse = sp != 0;
+  a->normalized = nz && N(g, nz)->t == J_TRUE;
   a->size = (uint64_t)comp_size(a->ctype) * (uint64_t)a->comps;
   a->view = gl_index(g, o, "bufferView", g->n[K_VIEW], "buffer view", 0, ctx);
   if (a->view == -2) return g->err->status;
@@ -280,16 +283,38 @@ int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const 
 
 /* ------------------------------------------------------------------ meshes */
 
+/* A vertex attribute Assimp turns into positions, normals, tangents or texture
+ * coordinates: floats, or the integers glTF (normalized texture coordinates) and
+ * KHR_mesh_quantization allow, which are marked to be given to Assimp as floats. */
+static valo_status check_vertex_attribute(gc *g, const char *name, int64_t i, const char *ctx) {
+  static const struct { const char *name; int comps; unsigned ints, normalized_ints; } rules[] = {
+      /* bit k of a mask: componentType 5120 + k allowed (byte, unsigned byte, short, unsigned short) */
+      {"POSITION", 3, 0xf, 0xf}, {"NORMAL", 3, 0, 0x5}, {"TANGENT", 4, 0, 0x5}, {"TEXCOORD_", 2, 0xf, 0xf}};
+  for (size_t r = 0; r < sizeof rules / sizeof rules[0]; r++) {
+    size_t nl = strlen(rules[r].name);
+    if (rules[r].name[nl - 1] == '_' ? strncmp(name, rules[r].name, nl) : strcmp(name, rules[r].name)) continue;
+    const gacc *a = &g->accs[i];
+    int k = a->ctype - 5120;
+    unsigned mask = a->normalized ? rules[r].normalized_ints : rules[r].ints;
+    if (a->comps != rules[r].comps || (a->ctype != 5126 && !(k >= 0 && k < 4 && ((mask >> k) & 1))))
+      return gl_bad(g, "%s: %s must be %d-component floats%s", ctx, name, rules[r].comps,
+                    r == 0 || r == 3 ? ", or bytes or shorts (normalized or not)" : ", or normalized bytes or shorts");
+    if (a->ctype != 5126 && !g->deq[i]) { g->deq[i] = 1; g->ndeq++; }
+    return VALO_OK;
+  }
+  return VALO_OK;
+}
+
 static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   uint32_t at = json_get(&g->d, p, "attributes");
   if (!at || N(g, at)->t != J_OBJ) return gl_bad(g, "%s has no \"attributes\" object", ctx);
   int64_t pos = gl_accessor_ref(g, at, "POSITION", 1, ctx);
   if (pos < 0) return g->err->status;
   const gacc *pa = &g->accs[pos];
-  if (pa->comps != 3 || pa->ctype != 5126) return gl_bad(g, "%s: POSITION must be an accessor of VEC3 floats", ctx);
   for (uint32_t c = N(g, at)->child; c; c = N(g, c)->next) {
     int64_t a = gl_accessor_ref(g, at, N(g, c)->key, 1, ctx);
     if (a < 0) return g->err->status;
+    if (check_vertex_attribute(g, N(g, c)->key, a, ctx)) return g->err->status;
     if (g->accs[a].count != pa->count) return gl_bad(g, "%s: attribute %s has %llu elements, POSITION %llu", ctx, N(g, c)->key,
                                                  (unsigned long long)g->accs[a].count, (unsigned long long)pa->count);
     if (g->accs[a].comps > 4) return gl_bad(g, "%s: attribute %s must be a scalar or a vector", ctx, N(g, c)->key);
@@ -348,8 +373,6 @@ static valo_status check_mesh(gc *g, uint32_t m, uint32_t i, const char *mesh_ct
   return VALO_OK;
 }
 
-#define GLB_JSON 0x4E4F534Au
-#define GLB_BIN 0x004E4942u
 
 /* ---------------------------------------------------------------- the file */
 
@@ -412,7 +435,8 @@ static valo_status check_json(gc *g, const char *text, size_t len) {
   g->bufs = calloc((size_t)g->n[K_BUF] + 1, sizeof *g->bufs);
   g->views = calloc((size_t)g->n[K_VIEW] + 1, sizeof *g->views);
   g->accs = calloc((size_t)g->n[K_ACC] + 1, sizeof *g->accs);
-  if (!g->bufs || !g->views || !g->accs) return gl_bad(g, "out of memory");
+  g->deq = calloc((size_t)g->n[K_ACC] + 1, 1);
+  if (!g->bufs || !g->views || !g->accs || !g->deq) return gl_bad(g, "out of memory");
   uint32_t i = 0;
   for (uint32_t o = g->arr[K_BUF] ? N(g, g->arr[K_BUF])->child : 0; o; o = N(g, o)->next, i++) {
     valo_status st = read_buffer(g, i, o);
@@ -452,10 +476,12 @@ valo_status gltf_check_file(const char *path, int binary, obj_check *oc, valo_er
     oc->files[0].len = json_len = len - 3;
   }
   if (!st) st = check_json(&g, json, json_len);
+  if (!st && g.ndeq) st = gl_dequantize(&g, json, json_len, binary);
   json_free(&g.d);
   free(g.bufs);
   free(g.views);
   free(g.accs);
+  free(g.deq);
   for (int i = 0; i < g.ndecoded; i++) free(g.decoded[i]);
   if (st) obj_check_free(oc);
   return st;

@@ -1,6 +1,6 @@
-/* gltf_check_internal.h — owns what the glTF check's two files share (gltf_check.c: the
+/* gltf_check_internal.h — owns what the glTF check's files share (gltf_check.c: the
  * container, buffers, views, accessors and meshes; gltf_objects.c: nodes, materials and
- * the other objects): the check's state, the parsed views and accessors, and the helpers
+ * the other objects; gltf_dequant.c: integer attributes given to Assimp as floats): the check's state, the parsed views and accessors, and the helpers
  * that read members as counts and indices with messages naming the object. */
 #ifndef VALO_GLTF_CHECK_INTERNAL_H
 #define VALO_GLTF_CHECK_INTERNAL_H
@@ -8,6 +8,8 @@
 #include "load/gltf_json.h"
 #include <stdint.h>
 
+#define GLB_JSON 0x4E4F534Au /* a .glb's chunk types */
+#define GLB_BIN 0x004E4942u
 #define GLTF_MAX_NODE_DEPTH 1024 /* Assimp and valo walk the node tree recursively */
 
 typedef struct gbuf { const unsigned char *data; uint64_t len; } gbuf; /* a buffer's bytes as read */
@@ -15,9 +17,11 @@ typedef struct gview { uint32_t buf; uint64_t off, len, stride; } gview;
 typedef struct gacc {
   int64_t view;
   uint64_t off, count, size, stride;
-  int ctype, comps, sparse;
+  int ctype, comps, sparse, normalized;
   const unsigned char *sparse_values; /* a sparse part's values (sparse_n elements of size bytes) */
+  const unsigned char *sparse_index;  /* and their indices (sparse_isize bytes each) */
   uint64_t sparse_n;
+  int sparse_isize;
 } gacc;
 
 /* The top-level arrays the check reads, in this order (gltf_check.c, kinds[]). */
@@ -39,6 +43,9 @@ typedef struct gc {
   unsigned char *decoded[64];
   int ndecoded;
   int drop_skins; /* a skin has no inverseBindMatrices: Assimp is given none (gltf_check_file) */
+  unsigned char *deq; /* per accessor: 1 when it is a mesh attribute of integers that Assimp
+                         must be given as floats (gl_dequantize) */
+  int ndeq;
 } gc;
 
 static inline const jnode *N(const gc *g, uint32_t i) { return &g->d.nodes[i]; }
@@ -64,4 +71,11 @@ int64_t gl_data_uri(gc *g, const char *s, const char *ctx);
  * materials, textures, images, cameras, skins, animations and KHR_lights_punctual lights. */
 valo_status gl_check_nodes(gc *g);
 valo_status gl_check_objects(gc *g);
+
+/* gltf_dequant.c: the accessors marked in g->deq (vertex positions, normals, tangents and
+ * texture coordinates stored as integers, normalized or not: glTF's normalized texture
+ * coordinates and KHR_mesh_quantization), which Assimp 5.2 reads as if they were floats,
+ * decoded to floats in a new buffer served beside the file, and the JSON (text, or a .glb
+ * around it) rewritten to point them there: oc->files[0] replaced, the buffer added. */
+valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary);
 #endif

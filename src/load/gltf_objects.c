@@ -245,12 +245,13 @@ static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx
   return st ? st : record_material(g, o, i, ctx);
 }
 
-/* The extensions valo reads (Assimp imports them and valo uses what it imports). A file
+/* The extensions valo reads (Assimp imports them and valo uses what it imports;
+ * KHR_mesh_quantization's integers valo turns into floats for Assimp, gltf_dequant.c). A file
  * that requires any other is refused, as the glTF specification asks of a loader; one
  * that only uses others is read with a warning naming them. */
 static const char *const read_extensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
                                               "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", "KHR_materials_specular",
-                                              "KHR_materials_clearcoat", NULL};
+                                              "KHR_materials_clearcoat", "KHR_mesh_quantization", NULL};
 static int is_read(const char *name) {
   for (int i = 0; read_extensions[i]; i++)
     if (!strcmp(name, read_extensions[i])) return 1;
@@ -267,9 +268,12 @@ static valo_status check_extensions(gc *g) {
       if (N(g, c)->t != J_STR) return gl_bad(g, "\"%s\" must be an array of names", key);
       const char *name = N(g, c)->str;
       if (is_read(name)) continue;
-      if (req) return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s, %s, %s, %s, %s, %s, %s and %s)", name, read_extensions[0],
-                             read_extensions[1], read_extensions[2], read_extensions[3], read_extensions[4], read_extensions[5], read_extensions[6],
-                             read_extensions[7]);
+      if (req) {
+        char all[512] = "";
+        for (int i = 0; read_extensions[i]; i++)
+          snprintf(all + strlen(all), sizeof all - strlen(all), "%s%s", i == 0 ? "" : read_extensions[i + 1] ? ", " : " and ", read_extensions[i]);
+        return gl_bad(g, "requires the extension %s, which valo does not read (it reads %s)", name, all);
+      }
       if (strlen(unread) + strlen(name) + 3 < sizeof unread) snprintf(unread + strlen(unread), sizeof unread - strlen(unread), "%s%s", unread[0] ? ", " : "", name);
     }
   }
