@@ -314,9 +314,9 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   for (uint32_t c = N(g, at)->child; c; c = N(g, c)->next) {
     int64_t a = gl_accessor_ref(g, at, N(g, c)->key, 1, ctx);
     if (a < 0) return g->err->status;
-    if (check_vertex_attribute(g, N(g, c)->key, a, ctx)) return g->err->status;
     if (g->accs[a].count != pa->count) return gl_bad(g, "%s: attribute %s has %llu elements, POSITION %llu", ctx, N(g, c)->key,
                                                  (unsigned long long)g->accs[a].count, (unsigned long long)pa->count);
+    if (check_vertex_attribute(g, N(g, c)->key, a, ctx)) return g->err->status;
     if (g->accs[a].comps > 4) return gl_bad(g, "%s: attribute %s must be a scalar or a vector", ctx, N(g, c)->key);
   }
   uint64_t mode;
