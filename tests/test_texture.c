@@ -1268,6 +1268,58 @@ static int gltf_quantized(void) {
   return rc;
 }
 
+/* KHR_draco_mesh_compression (tests/data/gltf-draco, scripts/gltf-draco.py): a UV sphere
+ * Draco-compressed with 32-bit indices (which Assimp 5.2 loses: valo gives them to it as
+ * 16-bit ones) and with 16-bit ones loads bit for bit as the same sphere in plain float
+ * accessors holding what Draco decodes (DracoPy 2.2); a Draco primitive naming an
+ * attribute it lacks, without its bufferView, with integer texture coordinates, or of
+ * more than 65 536 vertices with 32-bit indices is refused, naming why. */
+static int same_mesh(const scene *a, const scene *b, const char *what) {
+  CHECK(a->nverts == b->nverts && a->ntris == b->ntris && a->ntris == 224, "%s: %u and %u vertices, %u and %u triangles", what, a->nverts, b->nverts, a->ntris, b->ntris);
+  CHECK(!memcmp(a->pos, b->pos, a->nverts * sizeof *a->pos) && !memcmp(a->nrm, b->nrm, a->nverts * sizeof *a->nrm) &&
+        !memcmp(a->uv, b->uv, 2 * a->nverts * sizeof *a->uv) && !memcmp(a->idx, b->idx, 3 * a->ntris * sizeof *a->idx), "%s: the meshes differ", what);
+  return 0;
+}
+static int gltf_draco(void) {
+  valo_error err;
+  scene *s[3];
+  static const char *const names[3] = {"sphere-float", "sphere-draco32", "sphere-draco16"};
+  for (int k = 0; k < 3; k++) {
+    char path[1024];
+    snprintf(path, sizeof path, VALO_SOURCE_DIR "/tests/data/gltf-draco/%s.gltf", names[k]);
+    s[k] = scene_new(path);
+    CHECK(load_mesh(s[k], path, NULL, UINT32_MAX, 0, NULL, &err) == VALO_OK, "%s", err.message);
+  }
+  int rc = same_mesh(s[1], s[0], names[1]) || same_mesh(s[2], s[0], names[2]);
+  for (int k = 0; k < 3; k++) scene_free(s[k]);
+  static const char *const head = "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_draco_mesh_compression\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],"
+                                  " \"nodes\": [{\"mesh\": 0}], \"buffers\": [{\"byteLength\": 4, \"uri\": \"data:application/octet-stream;base64,AAAAAA==\"}],"
+                                  " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 4}],";
+  static const struct { const char *rest, *said; } bad[] = {
+      {"\"accessors\": [{\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0},"
+       " \"extensions\": {\"KHR_draco_mesh_compression\": {\"bufferView\": 0, \"attributes\": {\"POSITION\": 0, \"TEXCOORD_1\": 1}}}}]}]}",
+       "compresses TEXCOORD_1, which the primitive's attributes lack"},
+      {"\"accessors\": [{\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0},"
+       " \"extensions\": {\"KHR_draco_mesh_compression\": {\"attributes\": {\"POSITION\": 0}}}}]}]}",
+       "\"bufferView\""},
+      {"\"accessors\": [{\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}, {\"componentType\": 5123, \"normalized\": true, \"count\": 3, \"type\": \"VEC2\"}],"
+       " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1},"
+       " \"extensions\": {\"KHR_draco_mesh_compression\": {\"bufferView\": 0, \"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}}}}]}]}",
+       "a Draco-compressed TEXCOORD_0 of integers is not read"},
+      {"\"accessors\": [{\"componentType\": 5126, \"count\": 70000, \"type\": \"VEC3\"}, {\"componentType\": 5125, \"count\": 6, \"type\": \"SCALAR\"}],"
+       " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1,"
+       " \"extensions\": {\"KHR_draco_mesh_compression\": {\"bufferView\": 0, \"attributes\": {\"POSITION\": 0}}}}]}]}",
+       "Draco-compressed primitive of 70000 vertices with 32-bit indices is not read"},
+  };
+  for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+    char json[2048];
+    snprintf(json, sizeof json, "%s %s", head, bad[k].rest);
+    scene *q = quant_load("dbad.gltf", json, strlen(json), &err);
+    CHECK(!q && strstr(err.message, bad[k].said), "case %zu: %s", k, q ? "loaded" : err.message);
+  }
+  return rc;
+}
+
 /* glTF's KHR_texture_transform: a quad with texture coordinates whose base colour,
  * metallic-roughness, normal and emissive textures each carry a transform; looked up at
  * points of the quad, each equals its image looked up where the extension's formula
@@ -1819,7 +1871,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_draco", gltf_draco}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

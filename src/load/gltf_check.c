@@ -262,7 +262,10 @@ static valo_status check_accessor(gc *g, uint32_t o, uint32_t i, const char *ctx
   a->size = (uint64_t)comp_size(a->ctype) * (uint64_t)a->comps;
   a->view = gl_index(g, o, "bufferView", g->n[K_VIEW], "buffer view", 0, ctx);
   if (a->view == -2) return g->err->status;
-  if (a->view < 0 && !sp) return gl_bad(g, "%s has no \"bufferView\" and is not sparse (Assimp reads no accessor of zeros)", ctx);
+  if (a->view < 0 && !sp) {
+    if (g->draco[i]) return VALO_OK; /* Assimp fills it from the Draco data */
+    return gl_bad(g, "%s has no \"bufferView\" and is not sparse (Assimp reads no accessor of zeros)", ctx);
+  }
   if (sp) {
     valo_status st = check_sparse(g, sp, a, ctx);
     if (st || a->view < 0) return st;
@@ -286,7 +289,7 @@ int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const 
 /* A vertex attribute Assimp turns into positions, normals, tangents or texture
  * coordinates: floats, or the integers glTF (normalized texture coordinates) and
  * KHR_mesh_quantization allow, which are marked to be given to Assimp as floats. */
-static valo_status check_vertex_attribute(gc *g, const char *name, int64_t i, const char *ctx) {
+static valo_status check_vertex_attribute(gc *g, const char *name, int64_t i, int draco, const char *ctx) {
   static const struct { const char *name; int comps; unsigned ints, normalized_ints; } rules[] = {
       /* bit k of a mask: componentType 5120 + k allowed (byte, unsigned byte, short, unsigned short) */
       {"POSITION", 3, 0xf, 0xf}, {"NORMAL", 3, 0, 0x5}, {"TANGENT", 4, 0, 0x5}, {"TEXCOORD_", 2, 0xf, 0xf}};
@@ -299,6 +302,7 @@ static valo_status check_vertex_attribute(gc *g, const char *name, int64_t i, co
     if (a->comps != rules[r].comps || (a->ctype != 5126 && !(k >= 0 && k < 4 && ((mask >> k) & 1))))
       return gl_bad(g, "%s: %s must be %d-component floats%s", ctx, name, rules[r].comps,
                     r == 0 || r == 3 ? ", or bytes or shorts (normalized or not)" : ", or normalized bytes or shorts");
+    if (a->ctype != 5126 && draco) return gl_bad(g, "%s: a Draco-compressed %s of integers is not read (floats are)", ctx, name);
     if (a->ctype != 5126 && !g->deq[i]) { g->deq[i] = 1; g->ndeq++; }
     return VALO_OK;
   }
@@ -311,12 +315,13 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   int64_t pos = gl_accessor_ref(g, at, "POSITION", 1, ctx);
   if (pos < 0) return g->err->status;
   const gacc *pa = &g->accs[pos];
+  int draco = json_get(&g->d, json_get(&g->d, p, "extensions"), "KHR_draco_mesh_compression") != 0;
   for (uint32_t c = N(g, at)->child; c; c = N(g, c)->next) {
     int64_t a = gl_accessor_ref(g, at, N(g, c)->key, 1, ctx);
     if (a < 0) return g->err->status;
     if (g->accs[a].count != pa->count) return gl_bad(g, "%s: attribute %s has %llu elements, POSITION %llu", ctx, N(g, c)->key,
                                                  (unsigned long long)g->accs[a].count, (unsigned long long)pa->count);
-    if (check_vertex_attribute(g, N(g, c)->key, a, ctx)) return g->err->status;
+    if (check_vertex_attribute(g, N(g, c)->key, a, draco, ctx)) return g->err->status;
     if (g->accs[a].comps > 4) return gl_bad(g, "%s: attribute %s must be a scalar or a vector", ctx, N(g, c)->key);
   }
   uint64_t mode;
@@ -341,6 +346,7 @@ static valo_status check_primitive(gc *g, uint32_t p, const char *ctx) {
   static const uint64_t least[7] = {1, 2, 2, 2, 3, 3, 3};
   uint64_t nv = ix >= 0 ? g->accs[ix].count : pa->count;
   if (nv < least[mode]) return gl_bad(g, "%s: %llu vertices are too few for its mode %llu", ctx, (unsigned long long)nv, (unsigned long long)mode);
+  if (ix >= 0 && draco && gl_draco_indices(g, ix, pa->count, ctx)) return g->err->status;
   if (ix >= 0) { /* every index must name a vertex */
     const gacc *a = &g->accs[ix];
     if (a->comps != 1 || (a->ctype != 5121 && a->ctype != 5123 && a->ctype != 5125))
@@ -436,13 +442,15 @@ static valo_status check_json(gc *g, const char *text, size_t len) {
   g->views = calloc((size_t)g->n[K_VIEW] + 1, sizeof *g->views);
   g->accs = calloc((size_t)g->n[K_ACC] + 1, sizeof *g->accs);
   g->deq = calloc((size_t)g->n[K_ACC] + 1, 1);
-  if (!g->bufs || !g->views || !g->accs || !g->deq) return gl_bad(g, "out of memory");
+  g->draco = calloc((size_t)g->n[K_ACC] + 1, 1);
+  if (!g->bufs || !g->views || !g->accs || !g->deq || !g->draco) return gl_bad(g, "out of memory");
   uint32_t i = 0;
   for (uint32_t o = g->arr[K_BUF] ? N(g, g->arr[K_BUF])->child : 0; o; o = N(g, o)->next, i++) {
     valo_status st = read_buffer(g, i, o);
     if (st) return st;
   }
   valo_status st = gl_each(g, g->arr[K_VIEW], "buffer view", check_view);
+  if (!st) st = gl_draco_mark(g);
   if (!st) st = gl_each(g, g->arr[K_ACC], "accessor", check_accessor);
   if (!st) st = gl_each(g, g->arr[K_MESH], "mesh", check_mesh);
   if (!st) st = gl_check_nodes(g);
@@ -482,6 +490,7 @@ valo_status gltf_check_file(const char *path, int binary, obj_check *oc, valo_er
   free(g.views);
   free(g.accs);
   free(g.deq);
+  free(g.draco);
   for (int i = 0; i < g.ndecoded; i++) free(g.decoded[i]);
   if (st) obj_check_free(oc);
   return st;

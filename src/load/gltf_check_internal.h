@@ -1,6 +1,7 @@
 /* gltf_check_internal.h — owns what the glTF check's files share (gltf_check.c: the
  * container, buffers, views, accessors and meshes; gltf_objects.c: nodes, materials and
- * the other objects; gltf_dequant.c: integer attributes given to Assimp as floats): the check's state, the parsed views and accessors, and the helpers
+ * the other objects; gltf_dequant.c: integer attributes given to Assimp as floats;
+ * gltf_draco.c: Draco-compressed primitives): the check's state, the parsed views and accessors, and the helpers
  * that read members as counts and indices with messages naming the object. */
 #ifndef VALO_GLTF_CHECK_INTERNAL_H
 #define VALO_GLTF_CHECK_INTERNAL_H
@@ -44,8 +45,10 @@ typedef struct gc {
   int ndecoded;
   int drop_skins; /* a skin has no inverseBindMatrices: Assimp is given none (gltf_check_file) */
   unsigned char *deq; /* per accessor: 1 when it is a mesh attribute of integers that Assimp
-                         must be given as floats (gl_dequantize) */
+                         must be given as floats, 2 for Draco indices it must be given as
+                         unsigned shorts (gl_dequantize) */
   int ndeq;
+  unsigned char *draco; /* per accessor: 1 when a KHR_draco_mesh_compression primitive feeds it */
 } gc;
 
 static inline const jnode *N(const gc *g, uint32_t i) { return &g->d.nodes[i]; }
@@ -71,6 +74,13 @@ int64_t gl_data_uri(gc *g, const char *s, const char *ctx);
  * materials, textures, images, cameras, skins, animations and KHR_lights_punctual lights. */
 valo_status gl_check_nodes(gc *g);
 valo_status gl_check_objects(gc *g);
+
+/* gltf_draco.c: KHR_draco_mesh_compression. gl_draco_mark, before the accessors are
+ * checked, checks each primitive's extension object and marks the accessors it feeds;
+ * gl_draco_indices marks a Draco primitive's 32-bit indices for Assimp as 16-bit ones
+ * (nverts of them at most 65 536, else an error). */
+valo_status gl_draco_mark(gc *g);
+valo_status gl_draco_indices(gc *g, int64_t ix, uint64_t nverts, const char *ctx);
 
 /* gltf_dequant.c: the accessors marked in g->deq (vertex positions, normals, tangents and
  * texture coordinates stored as integers, normalized or not: glTF's normalized texture

@@ -1,5 +1,6 @@
-/* gltf_dequant.c — owns giving Assimp, as floats, the vertex attributes a glTF stores as
- * integers: normalized texture coordinates (core glTF) and KHR_mesh_quantization's
+/* gltf_dequant.c — owns rewriting the glTF Assimp reads where Assimp would misread it:
+ * Draco's 32-bit indices given as 16-bit ones (gltf_draco.c), and, as floats, the vertex
+ * attributes a glTF stores as integers: normalized texture coordinates (core glTF) and KHR_mesh_quantization's
  * positions, normals, tangents and texture coordinates. Assimp 5.2 copies their bytes as if
  * they were floats (positions of 1e-42, texture coordinates of NaN), so each marked
  * accessor is decoded here (its stride and sparse part applied; normalized values as glTF
@@ -75,7 +76,11 @@ static char *rewrite(const gc *g, cJSON *root, const float *out, uint64_t total,
   int nb = cJSON_GetArraySize(bufs), nv = cJSON_GetArraySize(views);
   uint64_t off = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++) {
-    if (!g->deq[i]) continue;
+    if (g->deq[i] == 2) { /* Draco's 32-bit indices, as 16-bit ones (gltf_draco.c) */
+      cJSON *acc = cJSON_GetArrayItem(accs, (int)i);
+      if (!acc || set_number(acc, "componentType", 5123)) return NULL;
+    }
+    if (g->deq[i] != 1) continue;
     const gacc *a = &g->accs[i];
     uint64_t bytes = a->count * (uint64_t)a->comps * 4;
     cJSON *acc = cJSON_GetArrayItem(accs, (int)i), *view = cJSON_CreateObject();
@@ -88,6 +93,7 @@ static char *rewrite(const gc *g, cJSON *root, const float *out, uint64_t total,
     cJSON_DeleteItemFromObjectCaseSensitive(acc, "sparse");
     off += bytes;
   }
+  if (!total) return cJSON_PrintUnformatted(root);
   cJSON *buf = cJSON_CreateObject();
   if (!buf || !cJSON_AddItemToArray(bufs, buf)) { cJSON_Delete(buf); return NULL; }
   if (set_number(buf, "byteLength", (double)total) || !cJSON_AddStringToObject(buf, "uri", uri)) return NULL;
@@ -116,17 +122,17 @@ static unsigned char *glb(const gc *g, const char *json, size_t *len) {
 
 valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) {
   obj_check *oc = g->oc;
-  if (oc->nfiles == (int)(sizeof oc->files / sizeof oc->files[0]))
-    return gl_bad(g, "integer vertex attributes need a buffer of floats, and the file has the most buffer files valo reads");
   uint64_t total = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++)
-    if (g->deq[i]) total += g->accs[i].count * (uint64_t)g->accs[i].comps * 4;
+    if (g->deq[i] == 1) total += g->accs[i].count * (uint64_t)g->accs[i].comps * 4;
+  if (total && oc->nfiles == (int)(sizeof oc->files / sizeof oc->files[0]))
+    return gl_bad(g, "integer vertex attributes need a buffer of floats, and the file has the most buffer files valo reads");
   if (total > UINT32_MAX) return gl_bad(g, "its integer vertex attributes are more than 4 GiB as floats");
-  float *out = malloc(total);
+  float *out = malloc(total ? total : 1);
   if (!out) return gl_bad(g, "out of memory");
   uint64_t off = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++)
-    if (g->deq[i]) { decode(g, &g->accs[i], out + off / 4); off += g->accs[i].count * (uint64_t)g->accs[i].comps * 4; }
+    if (g->deq[i] == 1) { decode(g, &g->accs[i], out + off / 4); off += g->accs[i].count * (uint64_t)g->accs[i].comps * 4; }
   /* the new buffer's name: beside the file, where no file it serves already is */
   obj_text *t = &oc->files[oc->nfiles];
   const char *slash = strrchr(g->path, '/');
@@ -152,6 +158,7 @@ valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) 
   free(oc->files[0].text); /* g->bin pointed into it: used above, not after */
   oc->files[0].text = text;
   oc->files[0].len = len;
+  if (!total) { free(out); return VALO_OK; }
   t->text = (char *)out;
   t->len = total;
   oc->nfiles++;
