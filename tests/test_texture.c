@@ -9,6 +9,7 @@
 #include "image/image_io.h"
 #include "material/shading.h"
 #include "material/bsdf.h"
+#include "material/sheen.h"
 #include <stb_image.h>
 #include <stb_image_write.h>
 #include <math.h>
@@ -1130,24 +1131,24 @@ static int gltf_transmission(void) {
   }
   free(px);
   /* extensions: used and not read, a warning; required and not read, refused */
-  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_sheen\"]", 0), "write");
+  CHECK(gltf_quad("trx", 0, 0, NULL, NULL, "[\"KHR_materials_iridescence\"]", 0), "write");
   s = scene_new(scratch_path("trx.gltf"));
   warnings_capture(1);
   valo_status st = load_mesh(s, scratch_path("trx.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
-  int used_said = strstr(warnings_text(), "uses KHR_materials_sheen, which valo does not read") != NULL;
+  int used_said = strstr(warnings_text(), "uses KHR_materials_iridescence, which valo does not read") != NULL;
   warnings_capture(0);
   scene_free(s);
-  CHECK(st == VALO_OK && used_said, "a file using KHR_materials_sheen: %s", st ? err.message : "no warning");
+  CHECK(st == VALO_OK && used_said, "a file using KHR_materials_iridescence: %s", st ? err.message : "no warning");
   char *text = read_text_file(scratch_path("trx.gltf"));
   CHECK(text, "read");
   char req[4096]; /* the same file, requiring what it uses */
-  snprintf(req, sizeof req, "{\"extensionsRequired\": [\"KHR_materials_sheen\"], %s", text + 1);
+  snprintf(req, sizeof req, "{\"extensionsRequired\": [\"KHR_materials_iridescence\"], %s", text + 1);
   free(text);
   scratch_file("trr.gltf", req);
   s = scene_new(scratch_path("trr.gltf"));
   st = load_mesh(s, scratch_path("trr.gltf"), NULL, UINT32_MAX, 0, NULL, &err);
   scene_free(s);
-  CHECK(st != VALO_OK && strstr(err.message, "requires the extension KHR_materials_sheen") && strstr(err.message, "trr.gltf"), "required: %s",
+  CHECK(st != VALO_OK && strstr(err.message, "requires the extension KHR_materials_iridescence") && strstr(err.message, "trr.gltf"), "required: %s",
         st ? err.message : "loaded");
   return 0;
 }
@@ -1400,12 +1401,13 @@ static int gltf_texture_transform(void) {
   return 0;
 }
 
-/* glTF's KHR_materials_ior, KHR_materials_specular and KHR_materials_clearcoat on the
- * opaque model (pbr's "ior", "specular", "specular_color", "clearcoat",
- * "clearcoat_roughness"): F0 = min(((ior - 1) / (ior + 1))^2 colour, 1) factor and
+/* glTF's KHR_materials_ior, KHR_materials_specular, KHR_materials_clearcoat and
+ * KHR_materials_sheen on the opaque model (pbr's "ior", "specular", "specular_color",
+ * "clearcoat", "clearcoat_roughness", "sheen_color", "sheen_roughness"): F0 = min(((ior - 1) / (ior + 1))^2 colour, 1) factor and
  * F90 = factor; the specular lobe at normal incidence scales by F0 / 0.04 against the
- * default material, at grazing the dielectric's Fresnel reaches F90; a glTF quad with both
- * extensions gets those values and renders as the JSON pbr material with the same keys;
+ * default material, at grazing the dielectric's Fresnel reaches F90; the sheen alone is
+ * colour D V as the extension's formulas give it; a glTF quad with the extensions gets
+ * those values and renders as the JSON pbr material with the same keys;
  * KHR_materials_specular is no longer warned about. */
 static int gltf_pbr_extensions(void) {
   material d = material_default(), m = material_default();
@@ -1434,14 +1436,38 @@ static int gltf_pbr_extensions(void) {
   rgb ec = bsdf_eval(&bc, v3(0, 0, 1), v3(0, 0, 1));
   double ac = 0.09, coat = ed.r * (1 - 0.8 * 0.04) + 0.8 * 0.04 / (4 * M_PI * ac * ac);
   CHECK(fabs(ec.r - coat) < 1e-4 * coat, "the clearcoat at normal incidence: %g, expected %g", ec.r, coat);
+  /* the sheen alone (a black base of specular 0): colour D(h) V(o, i), the glTF spec's formulas */
+  material sm = d;
+  material_pbr_specular(&sm, 1.5f, 0, c3(1, 1, 1));
+  sm.sheen_color = c3(0.9f, 0.6f, 0.3f);
+  sm.sheen_roughness = 0.4f;
+  sheen_prepare(&sm);
+  bsdf bs = bsdf_from_material(&sm);
+  vec3 so = v3(sinf(1.2f), 0, cosf(1.2f)), si = v3(-sinf(0.5f) * 0.6f, sinf(0.5f) * 0.8f, cosf(0.5f));
+  vec3 sh = v3_norm(v3_add(so, si));
+  double inv = 1 / 0.4, D = (2 + inv) * pow(1 - sh.z * sh.z, inv / 2) / (2 * M_PI), lam[2], mu[2] = {so.z, si.z};
+  for (int k = 0; k < 2; k++) {
+    double t = 0.36, x = mu[k] < 0.5 ? mu[k] : 0.5, l[2];
+    for (int q = 0; q < 2; q++) {
+      double xx = q ? 1 - mu[k] : x;
+      l[q] = (21.5473 + 3.7772 * t) / (1 + (3.82987 - 0.50552 * t) * pow(xx, 0.19823 - 0.03022 * t)) + (-1.97760 + 0.70367 * t) * xx + (-4.32054 - 0.53913 * t);
+    }
+    double lhalf = (21.5473 + 3.7772 * t) / (1 + (3.82987 - 0.50552 * t) * pow(0.5, 0.19823 - 0.03022 * t)) + (-1.97760 + 0.70367 * t) * 0.5 + (-4.32054 - 0.53913 * t);
+    lam[k] = mu[k] < 0.5 ? exp(l[0]) : exp(2 * lhalf - l[1]);
+  }
+  double V = 1 / ((1 + lam[0] + lam[1]) * 4 * mu[0] * mu[1]);
+  rgb es = bsdf_eval(&bs, so, si);
+  CHECK(fabs(es.r - 0.9 * D * V) < 1e-4 * 0.9 * D * V && fabs(es.b - 0.3 * D * V) < 1e-4 * 0.3 * D * V, "the sheen alone: %g %g %g, expected %g", es.r, es.g, es.b,
+        0.9 * D * V);
   /* the same through a glTF file and a JSON material */
   /* the second of two materials, which Assimp, meeting it first, numbers 0 */
   static const char *const mat =
       "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.3, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}},\n"
       "   {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.6, 0.4, 0.2, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.3}, \"extensions\": {"
       "\"KHR_materials_ior\": {\"ior\": 1.33}, \"KHR_materials_specular\": {\"specularFactor\": 0.5, \"specularColorFactor\": [1, 0.5, 0.25]},"
-      " \"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8, \"clearcoatRoughnessFactor\": 0.3}}}";
-  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\", \"KHR_materials_clearcoat\"]", 1), "write");
+      " \"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8, \"clearcoatRoughnessFactor\": 0.3},"
+      " \"KHR_materials_sheen\": {\"sheenColorFactor\": [0.9, 0.6, 0.3], \"sheenRoughnessFactor\": 0.4}}}";
+  CHECK(gltf_quad("spec", 0, 0, NULL, mat, "[\"KHR_materials_ior\", \"KHR_materials_specular\", \"KHR_materials_clearcoat\", \"KHR_materials_sheen\"]", 1), "write");
   scene *s = scene_new(scratch_path("spec.gltf"));
   valo_error err;
   warnings_capture(1);
@@ -1451,9 +1477,9 @@ static int gltf_pbr_extensions(void) {
   CHECK(st == VALO_OK, "%s", err.message);
   const material *g = &s->mats[s->tri_mat[0]];
   CHECK(!warned && g->type == MAT_PBR && fabs(g->f0.r - want[0]) < 1e-7 && fabs(g->f0.b - want[2]) < 1e-7 && g->f90 == 0.5f && g->clearcoat == 0.8f &&
-            g->clearcoat_roughness == 0.3f,
-        "glTF: F0 (%g %g %g), F90 %g, clearcoat %g of roughness %g%s", g->f0.r, g->f0.g, g->f0.b, g->f90, g->clearcoat, g->clearcoat_roughness,
-        warned ? ", warned" : "");
+            g->clearcoat_roughness == 0.3f && g->sheen_color.g == 0.6f && g->sheen_roughness == 0.4f && g->sheen_E[SHEEN_RES - 1] == sm.sheen_E[SHEEN_RES - 1],
+        "glTF: F0 (%g %g %g), F90 %g, clearcoat %g of roughness %g, sheen %g of roughness %g%s", g->f0.r, g->f0.g, g->f0.b, g->f90, g->clearcoat,
+        g->clearcoat_roughness, g->sheen_color.g, g->sheen_roughness, warned ? ", warned" : "");
   scene_free(s);
   double mean[2];
   for (int k = 0; k < 2; k++) {
@@ -1463,7 +1489,8 @@ static int gltf_pbr_extensions(void) {
              "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
              "  \"environment\": {\"type\": \"constant\", \"radiance\": 0.5},\n"
              "  \"materials\": {\"p\": {\"type\": \"pbr\", \"base_color\": [0.6, 0.4, 0.2], \"metallic\": 0, \"roughness\": 0.3, \"ior\": 1.33,\n"
-             "    \"specular\": 0.5, \"specular_color\": [1, 0.5, 0.25], \"clearcoat\": 0.8, \"clearcoat_roughness\": 0.3}},\n"
+             "    \"specular\": 0.5, \"specular_color\": [1, 0.5, 0.25], \"clearcoat\": 0.8, \"clearcoat_roughness\": 0.3,\n"
+             "    \"sheen_color\": [0.9, 0.6, 0.3], \"sheen_roughness\": 0.4}},\n"
              "  \"shapes\": [{\"file\": \"spec.gltf\"%s}],\n"
              "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
              k ? ", \"material\": \"p\"" : "");

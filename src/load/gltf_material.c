@@ -1,8 +1,8 @@
 /* gltf_material.c — owns the glTF material meanings valo reads beyond the core
  * metallic-roughness model (load_assimp.c): KHR_texture_transform on a texture, COLOR_0
  * (and a PLY's colours) as vertex colours, KHR_materials_ior and KHR_materials_specular
- * as the pbr model's Fresnel, KHR_materials_clearcoat as its coat,
- * KHR_materials_transmission with KHR_materials_volume. The
+ * as the pbr model's Fresnel, KHR_materials_clearcoat as its coat, KHR_materials_sheen
+ * as its sheen, KHR_materials_transmission with KHR_materials_volume. The
  * glTF BSDF is
  *   mix(metal, fresnel_mix(ior, mix(diffuse, specular BTDF, t), specular BRDF), metallic)
  * so with w = t (1 - metallic) it is exactly the blend of valo's pbr material at metallic
@@ -15,6 +15,7 @@
 #include "load/assimp_material.h"
 #include "core/error.h"
 #include "image/texture.h"
+#include "material/sheen.h"
 #include <assimp/material.h>
 #include <assimp/scene.h>
 #include <math.h>
@@ -168,4 +169,13 @@ void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char 
   m->clearcoat_roughness = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
   if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 0))
     log_warning("%s: KHR_materials_clearcoat's textures are not read (its factors are)", where);
+  /* KHR_materials_sheen, which Assimp reads: its factors (its textures are not read) */
+  struct aiColor4D sc;
+  if (aiGetMaterialColor(am, AI_MATKEY_SHEEN_COLOR_FACTOR, &sc) == aiReturn_SUCCESS)
+    m->sheen_color = c3(clampf(sc.r, 0, 1), clampf(sc.g, 0, 1), clampf(sc.b, 0, 1));
+  m->sheen_roughness = clampf(ai_float(am, AI_MATKEY_SHEEN_ROUGHNESS_FACTOR, 0), 0, 1);
+  if (c3_max(m->sheen_color) > 0) {
+    sheen_prepare(m);
+    if (aiGetMaterialTextureCount(am, aiTextureType_SHEEN) > 0) log_warning("%s: KHR_materials_sheen's textures are not read (its factors are)", where);
+  }
 }

@@ -251,7 +251,7 @@ static valo_status check_material(gc *g, uint32_t o, uint32_t i, const char *ctx
  * that only uses others is read with a warning naming them. */
 static const char *const read_extensions[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
                                               "KHR_materials_ior", "KHR_materials_volume", "KHR_texture_transform", "KHR_materials_specular",
-                                              "KHR_materials_clearcoat", "KHR_mesh_quantization", "KHR_draco_mesh_compression", NULL};
+                                              "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_mesh_quantization", "KHR_draco_mesh_compression", NULL};
 static int is_read(const char *name) {
   for (int i = 0; read_extensions[i]; i++)
     if (!strcmp(name, read_extensions[i])) return 1;

@@ -6,6 +6,7 @@
 #include "core/spectrum.h"
 #include "scene/volume.h"
 #include "material/plastic.h"
+#include "material/sheen.h"
 #include "image/texture.h"
 #include <errno.h>
 #include <math.h>
@@ -206,7 +207,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "sheen_color", "sheen_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -236,6 +237,12 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_num(c, o, "clearcoat_roughness", where, 0, 1, &ccr));
     m->clearcoat = (float)cc;
     m->clearcoat_roughness = (float)ccr;
+    double shr = 0; /* glTF's KHR_materials_sheen */
+    TRY(json_get_rgb(c, o, "sheen_color", where, &m->sheen_color));
+    TRY(json_get_num(c, o, "sheen_roughness", where, 0, 1, &shr));
+    if (m->sheen_color.r > 1 || m->sheen_color.g > 1 || m->sheen_color.b > 1) return json_bad(c, where, "sheen_color must be at most 1");
+    m->sheen_roughness = (float)shr;
+    if (c3_max(m->sheen_color) > 0) sheen_prepare(m);
   } else if (!strcmp(type, "diffuse")) {
     TRY(json_check_keys(c, o, where, k_diffuse));
     m->type = MAT_DIFFUSE;

@@ -8,14 +8,15 @@
  * metallic-roughness model (glTF spec, appendix B): mix(dielectric, metal, metallic)
  * where the dielectric is fresnel_mix(F0 = 0.04; Lambertian base colour, GGX specular)
  * and the metal is the GGX specular with Schlick Fresnel of F0 = base colour; lobes
- * chosen by a fixed mixture probability, specular by visible normals; Mitsuba's plastics
- * (plastic.c). */
+ * chosen by a fixed mixture probability, specular by visible normals, with glTF's sheen
+ * (sheen.h) and clearcoat layers over it; Mitsuba's plastics (plastic.c). */
 #include "material/bsdf.h"
 #include "material/fresnel.h"
 #include "core/sampling.h"
 #include "material/microfacet.h"
 #include "material/plastic.h"
 #include "material/principled.h"
+#include "material/sheen.h"
 
 static float lobe_prob(rgb a, rgb b) {
   float wa = c3_avg(a), wb = c3_avg(b);
@@ -76,6 +77,12 @@ bsdf bsdf_from_material(const material *m) {
     b.p_first = wd + ws > 0 ? wd / (wd + ws) : 0;
     /* alpha >= 1e-3: GGX is used down to a near-mirror (roughness 0 is not a delta). */
     b.alpha = fmaxf(m->roughness * m->roughness, 1e-3f);
+    b.sh_max = fmaxf(m->sheen_color.r, fmaxf(m->sheen_color.g, m->sheen_color.b));
+    if (b.sh_max > 0) {
+      b.sh_E = m->sheen_E;
+      b.sh_color = m->sheen_color;
+      b.sh_alpha = sheen_alpha(m->sheen_roughness);
+    }
     return b;
   }
   }
@@ -122,20 +129,27 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   rgb diel = c3(b->kd.r * ((1 - Fo[0]) * INV_PI_F) + Fd[0] * spec, b->kd.g * ((1 - Fo[1]) * INV_PI_F) + Fd[1] * spec,
                 b->kd.b * ((1 - Fo[2]) * INV_PI_F) + Fd[2] * spec);
   rgb f = c3_add(c3_scale(diel, 1 - b->metallic), c3_scale(Fm, b->metallic * spec));
+  if (b->sh_E) { /* KHR_materials_sheen over it, the base scaled by what the sheen leaves (sheen.h) */
+    float keep = fminf(1 - b->sh_max * sheen_albedo(b->sh_E, wo.z), 1 - b->sh_max * sheen_albedo(b->sh_E, wi.z));
+    f = c3_add(c3_scale(f, keep), c3_scale(b->sh_color, sheen_eval(b->sh_alpha, wo.z, wi.z, wm.z)));
+  }
   if (b->clearcoat > 0) { /* KHR_materials_clearcoat: mix(f, coat, clearcoat F(n.v)), F0 = 0.04 */
     float fc = b->clearcoat * (0.04f + 0.96f * so), coat = ggx_D(b->cc_alpha, wm) * ggx_G(b->cc_alpha, wo, wi) / (4 * wo.z * wi.z);
     f = c3_add(c3_scale(f, 1 - fc), c3(fc * coat, fc * coat, fc * coat));
   }
   return f;
 }
-/* The probability of sampling the clearcoat's lobe, from wo. */
+/* The probability of sampling the clearcoat's lobe, from wo, and, below it, the sheen's
+ * (cosine-weighted: its share of wo's light, max(colour) E(n.v)). */
 static float pbr_coat_prob(const bsdf *b, vec3 wo) { return b->clearcoat > 0 ? b->clearcoat * (0.25f + 0.5f * schlick_weight(wo.z)) : 0; }
+static float pbr_sheen_prob(const bsdf *b, vec3 wo) { return b->sh_E ? b->sh_max * sheen_albedo(b->sh_E, wo.z) : 0; }
 static float pbr_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   vec3 wm = v3_add(wo, wi);
   if (!(v3_len2(wm) > 0)) return 0;
   wm = v3_norm(wm);
   float ps = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
-  float pdf = b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps, pc = pbr_coat_prob(b, wo);
+  float pdf = b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps, pc = pbr_coat_prob(b, wo), psh = pbr_sheen_prob(b, wo);
+  if (psh > 0) pdf = (1 - psh) * pdf + psh * cosine_hemisphere_pdf(wi.z);
   if (pc > 0) pdf = (1 - pc) * pdf + pc * ggx_D_visible(b->cc_alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
   return pdf;
 }
@@ -319,8 +333,13 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     if (pc > 0 && ulobe < pc) s->wi = v3_reflect(wo, ggx_sample_visible(b->cc_alpha, wo, u1, u2)); /* the clearcoat */
     else {
       if (pc > 0) ulobe = (ulobe - pc) / (1 - pc);
-      if (ulobe < b->p_first) s->wi = sample_cosine_hemisphere(u1, u2);
-      else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
+      float psh = pbr_sheen_prob(b, wo);
+      if (psh > 0 && ulobe < psh) s->wi = sample_cosine_hemisphere(u1, u2); /* the sheen */
+      else {
+        if (psh > 0) ulobe = (ulobe - psh) / (1 - psh);
+        if (ulobe < b->p_first) s->wi = sample_cosine_hemisphere(u1, u2);
+        else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
+      }
     }
     if (s->wi.z <= 0) return 0;
     s->pdf = pbr_pdf(b, wo, s->wi);

@@ -29,6 +29,9 @@ typedef enum mat_type {
 /* MAT_PLASTIC's coat, tabulated by plastic_prepare: its transmittance at cos theta =
  * i / (PLASTIC_RES - 1), and the reflectance it shows to diffuse light from inside. */
 #define PLASTIC_RES 64
+/* MAT_PBR's sheen (glTF's KHR_materials_sheen): its directional albedo E(cos) at
+ * SHEEN_RES cosines i / (SHEEN_RES - 1), filled by sheen_prepare (material/sheen.h). */
+#define SHEEN_RES 32
 
 struct tex_sampling; /* image/texture.h */
 typedef struct material {
@@ -83,6 +86,9 @@ typedef struct material {
   int tex_weight;    /* MAT_BLEND: a map multiplying weight (its first channel), -1 = none */
   int nonlinear;     /* MAT_PLASTIC: the base's internal scattering tints (Mitsuba's nonlinear) */
   float coat_t[PLASTIC_RES], coat_ri; /* MAT_PLASTIC: filled by plastic_prepare */
+  rgb sheen_color;   /* MAT_PBR: KHR_materials_sheen's colour (black: no sheen) and roughness */
+  float sheen_roughness;
+  float sheen_E[SHEEN_RES]; /* MAT_PBR with a sheen: filled by sheen_prepare */
   int nk;            /* MAT_CONDUCTOR: 1 + index into scene.nk (eta and k per wavelength,
                         which --spectral evaluates per wavelength), 0 = RGB eta, k only */
   char name[64];
