@@ -1502,6 +1502,71 @@ static int gltf_pbr_extensions(void) {
   return 0;
 }
 
+/* KHR_materials_clearcoat's textures (pbr's "clearcoat_map", R times clearcoat, and
+ * "clearcoat_roughness_map", G times clearcoat_roughness): a black glTF quad of specular 0
+ * (only its coat reflects), filling the view, whose coat and its
+ * roughness come from a 1 x 1 image (128, 64, 0) loads both slots without a warning and
+ * renders bit for bit as the JSON pbr with the two maps, within 1e-5 of the uniform coat
+ * 0.8 x 128/255 of roughness 0.6 x 64/255, and more than 1 % from the coat without them. */
+static int gltf_clearcoat_maps(void) {
+  unsigned char px[3] = {128, 64, 0};
+  CHECK(scratch_png("cc.png", 1, 1, 3, px), "write");
+  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1}, uv[8] = {0, 0, 0, 1, 1, 1, 1, 0};
+  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char buf[92];
+  memcpy(buf, pos, 48); memcpy(buf + 48, uv, 32); memcpy(buf + 80, idx, 12);
+  FILE *f = fopen(scratch_path("ccq.bin"), "wb");
+  CHECK(f && fwrite(buf, 1, 92, f) == 92 && !fclose(f), "write");
+  const char *path = scratch_file("ccq.gltf",
+      "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_materials_clearcoat\", \"KHR_materials_specular\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+      " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
+      " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.5},\n"
+      "   \"extensions\": {\"KHR_materials_specular\": {\"specularFactor\": 0}, \"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8, \"clearcoatTexture\": {\"index\": 0},\n"
+      "     \"clearcoatRoughnessFactor\": 0.6, \"clearcoatRoughnessTexture\": {\"index\": 0}}}}],\n"
+      " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"cc.png\"}],\n"
+      " \"buffers\": [{\"byteLength\": 92, \"uri\": \"ccq.bin\"}],\n"
+      " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},\n"
+      "   {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}],\n"
+      " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [-1, 0, -1], \"max\": [1, 0, 1]},\n"
+      "   {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"}, {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n");
+  CHECK(path, "write");
+  scene *s = scene_new(path);
+  valo_error err;
+  warnings_capture(1);
+  valo_status st = load_mesh(s, path, NULL, UINT32_MAX, 0, NULL, &err);
+  int warned = warnings_text()[0] != 0;
+  warnings_capture(0);
+  CHECK(st == VALO_OK, "%s", err.message);
+  const material *g = &s->mats[s->tri_mat[0]];
+  CHECK(!warned && g->tex_cc >= 0 && g->tex_ccr >= 0 && g->clearcoat == 0.8f && g->clearcoat_roughness == 0.6f, "glTF: slots %d %d, clearcoat %g of roughness %g%s",
+        g->tex_cc, g->tex_ccr, g->clearcoat, g->clearcoat_roughness, warned ? ", warned" : "");
+  scene_free(s);
+  char cc[64], ccr[64];
+  snprintf(cc, sizeof cc, "%.9g", 0.8 * 128 / 255.0);
+  snprintf(ccr, sizeof ccr, "%.9g", 0.6 * 64 / 255.0);
+  const char *mats[4][2] = {{NULL, NULL}, {"0.8, \"clearcoat_map\": \"cc.png\"", "0.6, \"clearcoat_roughness_map\": \"cc.png\""}, {cc, ccr}, {"0.8", "0.6"}};
+  double mean[4];
+  for (int k = 0; k < 4; k++) {
+    char scn[1400];
+    snprintf(scn, sizeof scn,
+             "{ \"camera\": {\"position\": [0, 2, 0.5], \"look_at\": [0,0,0], \"fov\": 40},\n"
+             "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
+             "  \"environment\": {\"type\": \"constant\", \"radiance\": 1},\n"
+             "  \"materials\": {\"p\": {\"type\": \"pbr\", \"base_color\": 0, \"specular\": 0, \"metallic\": 0, \"roughness\": 0.5,\n"
+             "    \"clearcoat\": %s, \"clearcoat_roughness\": %s}},\n"
+             "  \"shapes\": [{\"file\": \"ccq.gltf\"%s}],\n"
+             "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
+             k ? mats[k][0] : "0", k ? mats[k][1] : "0", k ? ", \"material\": \"p\"" : "");
+    mean[k] = render_json_mean_green(scn);
+    CHECK(mean[k] > 0, "render %d failed", k);
+  }
+  fprintf(stderr, "glTF %.7f, JSON maps %.7f, JSON uniform %.7f, without maps %.7f\n", mean[0], mean[1], mean[2], mean[3]);
+  CHECK(mean[0] == mean[1], "glTF %g against the JSON maps' %g", mean[0], mean[1]);
+  CHECK(fabs(mean[1] - mean[2]) < 1e-5 * mean[2], "the maps %g against the uniform coat %g", mean[1], mean[2]);
+  CHECK(fabs(mean[3] - mean[1]) > 0.01 * mean[1], "the maps make no difference (%g, %g)", mean[1], mean[3]);
+  return 0;
+}
+
 /* Texture objects (docs/scene-format.md, "Textures"): nearest and bilinear lookups, a map
  * of the texture coordinates, the checkerboard; one image sampled two ways is two
  * textures sharing its pixels, the same way twice is one; bad objects are refused,
@@ -1898,7 +1963,7 @@ int main(int argc, char **argv) {
                                     {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
-                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_draco", gltf_draco}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
+                                    {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_draco", gltf_draco}, {"gltf_clearcoat_maps", gltf_clearcoat_maps}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},
                                     {"normal_map_shading", normal_map_shading}, {"brdf_closed_form", brdf_closed_form}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

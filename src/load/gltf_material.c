@@ -102,10 +102,12 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   return VALO_OK;
 }
 
-int gltf_transformed(scene *s, const struct aiMaterial *am, int type, int t) {
+int gltf_transformed(scene *s, const struct aiMaterial *am, int type, int t) { return gltf_slot_transformed(s, am, type, 0, t); }
+
+int gltf_slot_transformed(scene *s, const struct aiMaterial *am, int type, unsigned idx, int t) {
   struct aiUVTransform x;
   unsigned int n = sizeof x / sizeof(ai_real);
-  if (t < 0 || aiGetMaterialFloatArray(am, _AI_MATKEY_UVTRANSFORM_BASE, (unsigned)type, 0, (ai_real *)&x, &n) != aiReturn_SUCCESS ||
+  if (t < 0 || aiGetMaterialFloatArray(am, _AI_MATKEY_UVTRANSFORM_BASE, (unsigned)type, idx, (ai_real *)&x, &n) != aiReturn_SUCCESS ||
       n != sizeof x / sizeof(ai_real))
     return t;
   /* Assimp 5.2 stores glTF's transform turned about the image's centre, v turned over:
@@ -164,11 +166,12 @@ void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char 
   }
   const float *sp = specular_of(oc, am, where);
   material_pbr_specular(m, m->ior, sp ? sp[0] : 1, sp ? c3(sp[1], sp[2], sp[3]) : c3(1, 1, 1));
-  /* KHR_materials_clearcoat, which Assimp reads: its factors (its textures are not read) */
+  /* KHR_materials_clearcoat, which Assimp reads: its factors, and its textures but the
+   * normal map (load_assimp.c reads them) */
   m->clearcoat = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_FACTOR, 0), 0, 1);
   m->clearcoat_roughness = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
-  if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 0))
-    log_warning("%s: KHR_materials_clearcoat's textures are not read (its factors are)", where);
+  if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 2))
+    log_warning("%s: KHR_materials_clearcoat's normal texture is not read (the coat follows the base's normal)", where);
   /* KHR_materials_sheen, which Assimp reads: its factors (its textures are not read) */
   struct aiColor4D sc;
   if (aiGetMaterialColor(am, AI_MATKEY_SHEEN_COLOR_FACTOR, &sc) == aiReturn_SUCCESS)

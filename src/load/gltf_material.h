@@ -11,6 +11,9 @@ struct aiScene;
  * KHR_texture_transform samples it (Assimp keeps it per slot): a texture sharing t's
  * pixels; t itself when there is none (or t < 0). */
 int gltf_transformed(scene *s, const struct aiMaterial *am, int type, int t);
+/* The same for the idx-th texture of that slot type (KHR_materials_clearcoat's second,
+ * its roughness, say). */
+int gltf_slot_transformed(scene *s, const struct aiMaterial *am, int type, unsigned idx, int t);
 /* The materials (from mat_base, the file's first) of ai's meshes that have vertex colours
  * take vertex_colors, a blend's two parts too: glTF's COLOR_0 multiplies the base colour,
  * and a PLY (no materials: Assimp's default one) is seen in its colours. */

@@ -59,14 +59,14 @@ static int texture_in(scene *s, const char *dir, const char *p, int srgb) {
   return scene_texture_file(s, full, srgb, NULL);
 }
 
-/* Loads texture slot `type` of am into the scene: a file beside the mesh, or an image
- * embedded in the file ("*N"). Returns the texture index or -1. */
-static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type,
+/* Loads texture slot `type` (its idx-th) of am into the scene: a file beside the mesh, or
+ * an image embedded in the file ("*N"). Returns the texture index or -1. */
+static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type, unsigned idx,
                            const char *dir, int srgb, int *wrap_mode) {
-  if (aiGetMaterialTextureCount(am, type) == 0) return -1;
+  if (aiGetMaterialTextureCount(am, type) <= idx) return -1;
   struct aiString path;
   enum aiTextureMapMode mode[2] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
-  if (aiGetMaterialTexture(am, type, 0, &path, NULL, NULL, NULL, NULL, mode, NULL) != aiReturn_SUCCESS) return -1;
+  if (aiGetMaterialTexture(am, type, idx, &path, NULL, NULL, NULL, NULL, mode, NULL) != aiReturn_SUCCESS) return -1;
   if (wrap_mode) *wrap_mode = mode[0];
   const char *p = path.data;
   if (p[0] == '*') {
@@ -89,10 +89,10 @@ static int load_slot_image(scene *s, const struct aiScene *ai, const struct aiMa
 
 /* The texture of a material slot (-1 if none or unreadable), with the slot's wrap mode
  * (glTF sampler wrapS; Assimp reports one mode per slot). */
-static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type, const char *dir, int srgb,
+static int load_slot(scene *s, const struct aiScene *ai, const struct aiMaterial *am, enum aiTextureType type, unsigned idx, const char *dir, int srgb,
                      int *wrap_out) {
   int wrap = aiTextureMapMode_Wrap;
-  int t = load_slot_image(s, ai, am, type, dir, srgb, &wrap);
+  int t = load_slot_image(s, ai, am, type, idx, dir, srgb, &wrap);
   if (t >= 0) { /* the image sampled with this slot's wrap (another slot's may differ: a texture sharing its pixels) */
     tex_sampling smp = s->tex[t].smp;
     smp.wrap = wrap == aiTextureMapMode_Clamp ? TEX_CLAMP : wrap == aiTextureMapMode_Mirror ? TEX_MIRROR : TEX_REPEAT;
@@ -167,13 +167,13 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   if (pb && pb->map_pr[0]) m->tex_rough = texture_in(s, dir, pb->map_pr, 0);
   m->rough_is_alpha = 1;
   if (pb && pb->map_pm[0]) m->tex_metal = texture_in(s, dir, pb->map_pm, 0);
-  m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, dir, 1, &wrap);
-  if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, dir, 1, &wrap);
-  m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, dir, 1, NULL);
-  m->tex_ns = load_slot(s, ai, am, aiTextureType_SHININESS, dir, 0, NULL);
-  m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, dir, 0, NULL);
+  m->tex_kd = load_slot(s, ai, am, aiTextureType_BASE_COLOR, 0, dir, 1, &wrap);
+  if (m->tex_kd < 0) m->tex_kd = load_slot(s, ai, am, aiTextureType_DIFFUSE, 0, dir, 1, &wrap);
+  m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, 0, dir, 1, NULL);
+  m->tex_ns = load_slot(s, ai, am, aiTextureType_SHININESS, 0, dir, 0, NULL);
+  m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, 0, dir, 0, NULL);
   /* MTL bump / map_bump (Assimp's HEIGHT slot) with its -bm multiplier. */
-  int height = load_slot(s, ai, am, aiTextureType_HEIGHT, dir, 0, NULL);
+  int height = load_slot(s, ai, am, aiTextureType_HEIGHT, 0, dir, 0, NULL);
   if (height >= 0) {
     if (m->tex_normal < 0 && looks_like_normal_map(&s->tex[height])) m->tex_normal = height;
     else {
@@ -183,7 +183,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
       if (aiGetMaterialFloatArray(am, AI_MATKEY_OBJ_BUMPMULT_HEIGHT(0), &bm, &one) == aiReturn_SUCCESS && isfinite(bm)) m->bump_scale = bm;
     }
   }
-  m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, dir, 1, NULL);
+  m->tex_ke = load_slot(s, ai, am, aiTextureType_EMISSIVE, 0, dir, 1, NULL);
   if (m->tex_ke >= 0 && c3_black(m->emission)) m->emission = c3(1, 1, 1);
   /* Cutout: an opacity map (MTL map_d), or glTF alphaMode MASK on the base colour; BLEND: below. */
   /* glTF 2.0 metallic-roughness (docs/scene-format.md): MAT_PBR with the factors (glTF
@@ -193,14 +193,14 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
     m->type = MAT_PBR;
     m->metallic = clampf(ai_float(am, AI_MATKEY_METALLIC_FACTOR, 1), 0, 1);
     m->roughness = clampf(ai_float(am, AI_MATKEY_ROUGHNESS_FACTOR, 1), 0, 1);
-    m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, dir, 0, NULL);
-    if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, dir, 0, NULL);
+    m->tex_mr = load_slot(s, ai, am, aiTextureType_METALNESS, 0, dir, 0, NULL);
+    if (m->tex_mr < 0) m->tex_mr = load_slot(s, ai, am, aiTextureType_UNKNOWN, 0, dir, 0, NULL);
     m->tex_kd = gltf_transformed(s, am, aiGetMaterialTextureCount(am, aiTextureType_BASE_COLOR) ? aiTextureType_BASE_COLOR : aiTextureType_DIFFUSE, m->tex_kd);
     m->tex_mr = gltf_transformed(s, am, aiGetMaterialTextureCount(am, aiTextureType_METALNESS) ? aiTextureType_METALNESS : aiTextureType_UNKNOWN, m->tex_mr);
     m->tex_normal = gltf_transformed(s, am, aiTextureType_NORMALS, m->tex_normal);
     m->tex_ke = gltf_transformed(s, am, aiTextureType_EMISSIVE, m->tex_ke);
   }
-  int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, dir, 0, NULL);
+  int opacity = load_slot(s, ai, am, aiTextureType_OPACITY, 0, dir, 0, NULL);
   if (opacity >= 0) { m->tex_alpha = opacity; m->alpha_channel = s->tex[opacity].has_alpha; }
   struct aiString mode;
   if (aiGetMaterialString(am, AI_MATKEY_GLTF_ALPHAMODE, &mode) != aiReturn_SUCCESS || !strcmp(mode.data, "OPAQUE")) return;
@@ -526,7 +526,9 @@ static valo_status place_with(load_ctx *cp, imported *im, const char *path, cons
       convert_textures(s, ai, ai->mMaterials[i], &m, dir, c.gltf, oc);
       if (c.gltf) { /* KHR_materials_ior and _specular; _transmission: a glass, or a blend with one (gltf_material.c) */
         gltf_specular(oc, ai->mMaterials[i], s->tex_user, &m);
-        int tt = gltf_transformed(s, ai->mMaterials[i], aiTextureType_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, dir, 0, NULL));
+        for (unsigned k = 0; k < 2; k++) /* KHR_materials_clearcoat's textures: the coat's weight (R), its roughness (G) */
+          *(k ? &m.tex_ccr : &m.tex_cc) = gltf_slot_transformed(s, ai->mMaterials[i], aiTextureType_CLEARCOAT, k, load_slot(s, ai, ai->mMaterials[i], aiTextureType_CLEARCOAT, k, dir, 0, NULL));
+        int tt = gltf_transformed(s, ai->mMaterials[i], aiTextureType_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, 0, dir, 0, NULL));
         st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, &c.mat_medium[i], err);
         if (st) return st;
       }

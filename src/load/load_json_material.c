@@ -207,7 +207,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "sheen_color", "sheen_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "clearcoat_map", "clearcoat_roughness_map", "sheen_color", "sheen_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -237,6 +237,8 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_num(c, o, "clearcoat_roughness", where, 0, 1, &ccr));
     m->clearcoat = (float)cc;
     m->clearcoat_roughness = (float)ccr;
+    TRY(get_data_map(c, o, "clearcoat_map", where, "clearcoat map", &m->tex_cc));
+    TRY(get_data_map(c, o, "clearcoat_roughness_map", where, "clearcoat roughness map", &m->tex_ccr));
     double shr = 0; /* glTF's KHR_materials_sheen */
     TRY(json_get_rgb(c, o, "sheen_color", where, &m->sheen_color));
     TRY(json_get_num(c, o, "sheen_roughness", where, 0, 1, &shr));

@@ -128,7 +128,8 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
 bsdf bsdf_at(const scene *s, const isect *it) {
   const material *m = it->m;
   int vc = m->vertex_colors && s->col;
-  if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0) return bsdf_from_material(m);
+  if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0 && m->tex_cc < 0 && m->tex_ccr < 0)
+    return bsdf_from_material(m);
   material mm = *m;
   float px[4];
   if (vc) mm.kd = c3_mul(mm.kd, scene_tri_color(s, it->tri, it->b1, it->b2));
@@ -144,6 +145,8 @@ bsdf bsdf_at(const scene *s, const isect *it) {
     mm.roughness_v *= f;
   }
   if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
+  if (m->tex_cc >= 0) { texture_lookup(&s->tex[m->tex_cc], it->u, it->v, px); mm.clearcoat *= px[0]; }
+  if (m->tex_ccr >= 0) { texture_lookup(&s->tex[m->tex_ccr], it->u, it->v, px); mm.clearcoat_roughness *= px[1]; }
   return bsdf_from_material(&mm);
 }
 

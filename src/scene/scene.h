@@ -54,6 +54,8 @@ typedef struct material {
                         KHR_materials_ior and _specular set it) */
   float f90;         /* MAT_PBR: ... and at grazing incidence (1; KHR_materials_specular's factor) */
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
+  int tex_cc, tex_ccr; /* MAT_PBR: clearcoat map (linear; R multiplies clearcoat) and clearcoat
+                          roughness map (linear; G multiplies clearcoat_roughness), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
