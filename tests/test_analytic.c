@@ -884,31 +884,40 @@ static int pixel_filter_edge(void) {
   return 0;
 }
 
+/* The edge through each of n filters (names, radii) at spp against the renderer's images
+ * of the same filters (tests/data/filters/PREFIX-NAME.exr): worst[k * n + j] is the largest
+ * pixel difference of valo's filter k from the reference's filter j. 0, or 1 (said). */
+static int edge_against(const char *prefix, const char *const *names, const double *radii, int n, int spp, double *worst) {
+  image ref[3];
+  valo_error err;
+  for (int k = 0; k < n; k++) {
+    char path[1024];
+    snprintf(path, sizeof path, VALO_SOURCE_DIR "/tests/data/filters/%s-edge-%s.exr", prefix, names[k]);
+    CHECK(image_read(path, &ref[k], &err) == VALO_OK && ref[k].w == 16 && ref[k].h == 16, "%s", err.message);
+  }
+  for (int k = 0; k < n; k++) {
+    int w, h;
+    float *px = edge_render(names[k], radii[k], spp, &w, &h);
+    CHECK(px && w == 16 && h == 16, "%s: render failed", names[k]);
+    for (int j = 0; j < n; j++) {
+      worst[k * n + j] = 0;
+      for (int i = 0; i < 16 * 16 * 3; i++) worst[k * n + j] = fmax(worst[k * n + j], fabs(px[i] - ref[j].rgb[i]));
+    }
+    free(px);
+  }
+  for (int k = 0; k < n; k++) image_free(&ref[k]);
+  return 0;
+}
+
 /* The same edge against Blender Cycles (scripts/cycles-filter-edge.py: Cycles 3.4 at 4096
  * samples through its Blackman-Harris filter of width 1.5 and its box of width 1): valo's
  * blackman-harris and box at their defaults must each be within 0.005 of Cycles' image of
  * the same filter in every pixel, where the two filters differ by 0.027 at the edge. */
 static int pixel_filter_cycles(void) {
   static const char *const names[2] = {"blackman-harris", "box"};
-  image ref[2];
-  valo_error err;
-  for (int k = 0; k < 2; k++) {
-    char path[1024];
-    snprintf(path, sizeof path, VALO_SOURCE_DIR "/tests/data/filters/cycles-edge-%s.exr", names[k]);
-    CHECK(image_read(path, &ref[k], &err) == VALO_OK && ref[k].w == 16 && ref[k].h == 16, "%s", err.message);
-  }
+  static const double radii[2] = {1.5, 0.5};
   double worst[2][2];
-  for (int k = 0; k < 2; k++) {
-    int w, h;
-    float *px = edge_render(names[k], k ? 0.5 : 1.5, 1024, &w, &h);
-    CHECK(px && w == 16 && h == 16, "%s: render failed", names[k]);
-    for (int j = 0; j < 2; j++) {
-      worst[k][j] = 0;
-      for (int i = 0; i < 16 * 16 * 3; i++) worst[k][j] = fmax(worst[k][j], fabs(px[i] - ref[j].rgb[i]));
-    }
-    free(px);
-  }
-  for (int k = 0; k < 2; k++) image_free(&ref[k]);
+  if (edge_against("cycles", names, radii, 2, 1024, &worst[0][0])) return 1;
   fprintf(stderr, "against Cycles, largest pixel difference: blackman-harris %.4f (against Cycles' box %.4f), box %.4f (against Cycles' "
           "blackman-harris %.4f)\n", worst[0][0], worst[0][1], worst[1][1], worst[1][0]);
   CHECK(worst[0][0] < 0.005 && worst[1][1] < 0.005, "valo's filters differ from Cycles' by %.4f (blackman-harris) and %.4f (box)", worst[0][0], worst[1][1]);
@@ -925,25 +934,9 @@ static int pixel_filter_cycles(void) {
  * same camera samples, gives path's image bit for bit. */
 static int pixel_filter_mitsuba(void) {
   static const char *const names[3] = {"mitchell", "catmull-rom", "lanczos"};
-  image ref[3];
-  valo_error err;
-  for (int k = 0; k < 3; k++) {
-    char path[1024];
-    snprintf(path, sizeof path, VALO_SOURCE_DIR "/tests/data/filters/mitsuba-edge-%s.exr", names[k]);
-    CHECK(image_read(path, &ref[k], &err) == VALO_OK && ref[k].w == 16 && ref[k].h == 16, "%s", err.message);
-  }
+  static const double radii[3] = {2, 2, 3}; /* the defaults */
   double worst[3][3];
-  for (int k = 0; k < 3; k++) {
-    int w, h;
-    float *px = edge_render(names[k], k == 2 ? 3 : 2, 16384, &w, &h); /* the defaults */
-    CHECK(px && w == 16 && h == 16, "%s: render failed", names[k]);
-    for (int j = 0; j < 3; j++) {
-      worst[k][j] = 0;
-      for (int i = 0; i < 16 * 16 * 3; i++) worst[k][j] = fmax(worst[k][j], fabs(px[i] - ref[j].rgb[i]));
-    }
-    free(px);
-  }
-  for (int k = 0; k < 3; k++) image_free(&ref[k]);
+  if (edge_against("mitsuba", names, radii, 3, 16384, &worst[0][0])) return 1;
   /* ReSTIR's frames take the same camera samples and their weights: the same image */
   int w, h;
   float *a = edge_render("lanczos", 3, 64, &w, &h), *b = edge_render_by("lanczos", 3, 64, "restir-di", &w, &h);

@@ -1321,6 +1321,17 @@ static int gltf_draco(void) {
   return rc;
 }
 
+/* The quad y = 0, x and z in [-1, 1], with texture coordinates over [0, 1]^2 and two
+ * triangles (positions, coordinates, 16-bit indices: 92 bytes) as the scratch file name. */
+static int uv_quad_bin(const char *name) {
+  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1}, uv[8] = {0, 0, 0, 1, 1, 1, 1, 0};
+  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+  unsigned char buf[92];
+  memcpy(buf, pos, 48); memcpy(buf + 48, uv, 32); memcpy(buf + 80, idx, 12);
+  FILE *f = fopen(scratch_path(name), "wb");
+  return f && fwrite(buf, 1, 92, f) == 92 && !fclose(f);
+}
+
 /* glTF's KHR_texture_transform: a quad with texture coordinates whose base colour,
  * metallic-roughness, normal and emissive textures each carry a transform; looked up at
  * points of the quad, each equals its image looked up where the extension's formula
@@ -1333,12 +1344,7 @@ static int gltf_texture_transform(void) {
   for (int y = 0; y < 16; y++)
     for (int x = 0; x < 16; x++) { unsigned char *p = &ramp[3 * (16 * y + x)]; p[0] = (unsigned char)(16 * x + 8); p[1] = (unsigned char)(16 * y + 8); p[2] = 128; }
   CHECK(scratch_png("uvramp.png", 16, 16, 3, ramp), "write");
-  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1}, uv[8] = {0, 0, 0, 1, 1, 1, 1, 0};
-  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-  unsigned char buf[96];
-  memcpy(buf, pos, 48); memcpy(buf + 48, uv, 32); memcpy(buf + 80, idx, 12);
-  FILE *f = fopen(scratch_path("uvt.bin"), "wb");
-  CHECK(f && fwrite(buf, 1, 92, f) == 92 && !fclose(f), "write");
+  CHECK(uv_quad_bin("uvt.bin"), "write");
   static const struct { double off[2], rot, scale[2]; } tf[4] = {{{0.25, 0.1}, 0, {1, 1}}, {{0, 1}, M_PI / 2, {0.5, 0.5}}, {{0.3, -0.2}, 0.4, {0.7, 1.3}}, {{0.1, 0.2}, -1.1, {-0.6, 0.8}}};
   char ext[4][200];
   for (int k = 0; k < 4; k++)
@@ -1511,12 +1517,7 @@ static int gltf_pbr_extensions(void) {
 static int gltf_clearcoat_maps(void) {
   unsigned char px[3] = {128, 64, 0};
   CHECK(scratch_png("cc.png", 1, 1, 3, px), "write");
-  static const float pos[12] = {-1, 0, -1, -1, 0, 1, 1, 0, 1, 1, 0, -1}, uv[8] = {0, 0, 0, 1, 1, 1, 1, 0};
-  static const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-  unsigned char buf[92];
-  memcpy(buf, pos, 48); memcpy(buf + 48, uv, 32); memcpy(buf + 80, idx, 12);
-  FILE *f = fopen(scratch_path("ccq.bin"), "wb");
-  CHECK(f && fwrite(buf, 1, 92, f) == 92 && !fclose(f), "write");
+  CHECK(uv_quad_bin("ccq.bin"), "write");
   const char *path = scratch_file("ccq.gltf",
       "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_materials_clearcoat\", \"KHR_materials_specular\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
       " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
