@@ -24,17 +24,22 @@ float sheen_eval(float alpha, float cos_o, float cos_i, float cos_h) {
 }
 
 void sheen_prepare(material *m) {
-  float a = sheen_alpha(m->sheen_roughness);
+  double a = sheen_alpha(m->sheen_roughness), inv = 1 / a, norm = (2 + inv) / (2 * M_PI);
   enum { NT = 64, NP = 128 };
+  double cp[NP], sp[NP];
+  for (int j = 0; j < NP; j++) { /* phi in [0, pi], doubled by symmetry */
+    cp[j] = cos(M_PI * (j + 0.5) / NP);
+    sp[j] = sin(M_PI * (j + 0.5) / NP);
+  }
   for (int k = 0; k < SHEEN_RES; k++) {
-    double mu = fmax((double)k / (SHEEN_RES - 1), 1e-4), so = sqrt(1 - mu * mu), sum = 0;
+    double mu = fmax((double)k / (SHEEN_RES - 1), 1e-4), so = sqrt(1 - mu * mu), lo = lambda(mu, a), sum = 0;
     for (int i = 0; i < NT; i++) { /* cos_i uniform: d(omega) cos_i = d(cos_i) d(phi) cos_i */
-      double ci = (i + 0.5) / NT, si = sqrt(1 - ci * ci);
+      double ci = (i + 0.5) / NT, si = sqrt(1 - ci * ci), d = 0;
       for (int j = 0; j < NP; j++) {
-        double ph = M_PI * (j + 0.5) / NP; /* [0, pi], doubled by symmetry */
-        double hx = si * cos(ph) + so, hy = si * sin(ph), hz = ci + mu, hl = sqrt(hx * hx + hy * hy + hz * hz);
-        sum += sheen_eval(a, (float)mu, (float)ci, (float)(hz / hl)) * ci;
+        double hx = si * cp[j] + so, hy = si * sp[j], hz = ci + mu, h2 = hx * hx + hy * hy + hz * hz;
+        d += pow(fmax(0.0, 1 - hz * hz / h2), 0.5 * inv); /* D's sin(h)^(1/a), as sheen_eval */
       }
+      sum += norm * d / ((1 + lo + lambda(ci, a)) * 4 * mu * ci) * ci;
     }
     m->sheen_E[k] = (float)fmin(sum * (1.0 / NT) * (2 * M_PI / NP), 1.0);
   }
