@@ -1509,21 +1509,24 @@ static int gltf_pbr_extensions(void) {
 }
 
 /* KHR_materials_clearcoat's textures (pbr's "clearcoat_map", R times clearcoat, and
- * "clearcoat_roughness_map", G times clearcoat_roughness): a black glTF quad of specular 0
- * (only its coat reflects), filling the view, whose coat and its
- * roughness come from a 1 x 1 image (128, 64, 0) loads both slots without a warning and
- * renders bit for bit as the JSON pbr with the two maps, within 1e-5 of the uniform coat
- * 0.8 x 128/255 of roughness 0.6 x 64/255, and more than 1 % from the coat without them. */
+ * "clearcoat_roughness_map", G times clearcoat_roughness) and KHR_materials_sheen's colour
+ * texture ("sheen_map", sRGB, times sheen_color): a black glTF quad of specular 0 (only
+ * its coat and sheen reflect), filling the view, whose coat, the coat's roughness and the
+ * sheen colour come from a 1 x 1 image (128, 64, 0) loads the three slots without a
+ * warning and renders bit for bit as the JSON pbr with the three maps, within 1e-5 of the
+ * uniform coat 0.8 x 128/255 of roughness 0.6 x 64/255 and sheen 0.8 x the image's
+ * decoded colour, and more than 1 % from the material without the maps. */
 static int gltf_clearcoat_maps(void) {
   unsigned char px[3] = {128, 64, 0};
   CHECK(scratch_png("cc.png", 1, 1, 3, px), "write");
   CHECK(uv_quad_bin("ccq.bin"), "write");
   const char *path = scratch_file("ccq.gltf",
-      "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_materials_clearcoat\", \"KHR_materials_specular\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
+      "{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_materials_clearcoat\", \"KHR_materials_specular\", \"KHR_materials_sheen\"], \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}],\n"
       " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1}, \"indices\": 2, \"material\": 0}]}],\n"
       " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1], \"metallicFactor\": 0, \"roughnessFactor\": 0.5},\n"
       "   \"extensions\": {\"KHR_materials_specular\": {\"specularFactor\": 0}, \"KHR_materials_clearcoat\": {\"clearcoatFactor\": 0.8, \"clearcoatTexture\": {\"index\": 0},\n"
-      "     \"clearcoatRoughnessFactor\": 0.6, \"clearcoatRoughnessTexture\": {\"index\": 0}}}}],\n"
+      "     \"clearcoatRoughnessFactor\": 0.6, \"clearcoatRoughnessTexture\": {\"index\": 0}},\n"
+      "     \"KHR_materials_sheen\": {\"sheenColorFactor\": [0.8, 0.8, 0.8], \"sheenRoughnessFactor\": 0.5, \"sheenColorTexture\": {\"index\": 0}}}}],\n"
       " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"cc.png\"}],\n"
       " \"buffers\": [{\"byteLength\": 92, \"uri\": \"ccq.bin\"}],\n"
       " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},\n"
@@ -1539,13 +1542,15 @@ static int gltf_clearcoat_maps(void) {
   warnings_capture(0);
   CHECK(st == VALO_OK, "%s", err.message);
   const material *g = &s->mats[s->tri_mat[0]];
-  CHECK(!warned && g->tex_cc >= 0 && g->tex_ccr >= 0 && g->clearcoat == 0.8f && g->clearcoat_roughness == 0.6f, "glTF: slots %d %d, clearcoat %g of roughness %g%s",
-        g->tex_cc, g->tex_ccr, g->clearcoat, g->clearcoat_roughness, warned ? ", warned" : "");
+  CHECK(!warned && g->tex_cc >= 0 && g->tex_ccr >= 0 && g->tex_sheen >= 0 && g->clearcoat == 0.8f && g->clearcoat_roughness == 0.6f,
+        "glTF: slots %d %d %d, clearcoat %g of roughness %g%s", g->tex_cc, g->tex_ccr, g->tex_sheen, g->clearcoat, g->clearcoat_roughness, warned ? ", warned" : "");
   scene_free(s);
-  char cc[64], ccr[64];
+  char cc[64], ccr[160];
   snprintf(cc, sizeof cc, "%.9g", 0.8 * 128 / 255.0);
-  snprintf(ccr, sizeof ccr, "%.9g", 0.6 * 64 / 255.0);
-  const char *mats[4][2] = {{NULL, NULL}, {"0.8, \"clearcoat_map\": \"cc.png\"", "0.6, \"clearcoat_roughness_map\": \"cc.png\""}, {cc, ccr}, {"0.8", "0.6"}};
+  snprintf(ccr, sizeof ccr, "%.9g, \"sheen_color\": [%.9g, %.9g, 0]", 0.6 * 64 / 255.0, 0.8 * pow((128 / 255.0 + 0.055) / 1.055, 2.4),
+           0.8 * pow((64 / 255.0 + 0.055) / 1.055, 2.4));
+  const char *mats[4][2] = {{NULL, NULL}, {"0.8, \"clearcoat_map\": \"cc.png\"", "0.6, \"clearcoat_roughness_map\": \"cc.png\", \"sheen_color\": 0.8, \"sheen_map\": \"cc.png\""},
+                            {cc, ccr}, {"0.8", "0.6, \"sheen_color\": 0.8"}};
   double mean[4];
   for (int k = 0; k < 4; k++) {
     char scn[1400];
@@ -1554,7 +1559,7 @@ static int gltf_clearcoat_maps(void) {
              "  \"film\": {\"width\": 16, \"height\": 16}, \"render\": {\"spp\": 16},\n"
              "  \"environment\": {\"type\": \"constant\", \"radiance\": 1},\n"
              "  \"materials\": {\"p\": {\"type\": \"pbr\", \"base_color\": 0, \"specular\": 0, \"metallic\": 0, \"roughness\": 0.5,\n"
-             "    \"clearcoat\": %s, \"clearcoat_roughness\": %s}},\n"
+             "    \"sheen_roughness\": 0.5, \"clearcoat\": %s, \"clearcoat_roughness\": %s}},\n"
              "  \"shapes\": [{\"file\": \"ccq.gltf\"%s}],\n"
              "  \"lights\": [{\"type\": \"point\", \"position\": [0, 3, 0], \"intensity\": 10}] }\n",
              k ? mats[k][0] : "0", k ? mats[k][1] : "0", k ? ", \"material\": \"p\"" : "");

@@ -172,13 +172,14 @@ void gltf_specular(const obj_check *oc, const struct aiMaterial *am, const char 
   m->clearcoat_roughness = clampf(ai_float(am, AI_MATKEY_CLEARCOAT_ROUGHNESS_FACTOR, 0), 0, 1);
   if (m->clearcoat > 0 && (aiGetMaterialTextureCount(am, aiTextureType_CLEARCOAT) > 2))
     log_warning("%s: KHR_materials_clearcoat's normal texture is not read (the coat follows the base's normal)", where);
-  /* KHR_materials_sheen, which Assimp reads: its factors (its textures are not read) */
+  /* KHR_materials_sheen, which Assimp reads: its factors and its colour texture (load_assimp.c);
+   * its roughness texture is not read (the sheen's albedo table is made for one roughness) */
   struct aiColor4D sc;
   if (aiGetMaterialColor(am, AI_MATKEY_SHEEN_COLOR_FACTOR, &sc) == aiReturn_SUCCESS)
     m->sheen_color = c3(clampf(sc.r, 0, 1), clampf(sc.g, 0, 1), clampf(sc.b, 0, 1));
   m->sheen_roughness = clampf(ai_float(am, AI_MATKEY_SHEEN_ROUGHNESS_FACTOR, 0), 0, 1);
   if (c3_max(m->sheen_color) > 0) {
     sheen_prepare(m);
-    if (aiGetMaterialTextureCount(am, aiTextureType_SHEEN) > 0) log_warning("%s: KHR_materials_sheen's textures are not read (its factors are)", where);
+    if (aiGetMaterialTextureCount(am, aiTextureType_SHEEN) > 1) log_warning("%s: KHR_materials_sheen's roughness texture is not read (its factor is)", where);
   }
 }

@@ -528,6 +528,7 @@ static valo_status place_with(load_ctx *cp, imported *im, const char *path, cons
         gltf_specular(oc, ai->mMaterials[i], s->tex_user, &m);
         for (unsigned k = 0; k < 2; k++) /* KHR_materials_clearcoat's textures: the coat's weight (R), its roughness (G) */
           *(k ? &m.tex_ccr : &m.tex_cc) = gltf_slot_transformed(s, ai->mMaterials[i], aiTextureType_CLEARCOAT, k, load_slot(s, ai, ai->mMaterials[i], aiTextureType_CLEARCOAT, k, dir, 0, NULL));
+        m.tex_sheen = gltf_transformed(s, ai->mMaterials[i], aiTextureType_SHEEN, load_slot(s, ai, ai->mMaterials[i], aiTextureType_SHEEN, 0, dir, 1, NULL));
         int tt = gltf_transformed(s, ai->mMaterials[i], aiTextureType_TRANSMISSION, load_slot(s, ai, ai->mMaterials[i], aiTextureType_TRANSMISSION, 0, dir, 0, NULL));
         st = gltf_transmission(s, ai->mMaterials[i], tt, s->tex_user, &m, &c.mat_medium[i], err);
         if (st) return st;

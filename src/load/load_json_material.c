@@ -29,6 +29,16 @@ static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const 
   return get_float_map(c, v, 1, w, what, tex);
 }
 
+/* An optional colour map (sRGB-decoded unless the texture object says "raw") named by `key`:
+ * *tex stays -1 when absent. */
+static valo_status get_color_map(jctx *c, const cJSON *o, const char *key, const char *where, int *tex) {
+  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+  if (!v) return VALO_OK;
+  char w[300];
+  snprintf(w, sizeof w, "%s.%s", where, key);
+  return json_get_texture(c, v, 1, w, "colour map", tex);
+}
+
 /* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
  * pbrt's bitmaps are, unless "opacity_raw"): a hit counts with that probability. */
 static valo_status get_opacity(jctx *c, const cJSON *o, const char *where, material *m) {
@@ -207,7 +217,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
                                              "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
-  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "clearcoat_map", "clearcoat_roughness_map", "sheen_color", "sheen_roughness", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
+  static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "clearcoat_map", "clearcoat_roughness_map", "sheen_color", "sheen_roughness", "sheen_map", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
                                       "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
@@ -244,6 +254,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_num(c, o, "sheen_roughness", where, 0, 1, &shr));
     if (m->sheen_color.r > 1 || m->sheen_color.g > 1 || m->sheen_color.b > 1) return json_bad(c, where, "sheen_color must be at most 1");
     m->sheen_roughness = (float)shr;
+    TRY(get_color_map(c, o, "sheen_map", where, &m->tex_sheen));
     if (c3_max(m->sheen_color) > 0) sheen_prepare(m);
   } else if (!strcmp(type, "diffuse")) {
     TRY(json_check_keys(c, o, where, k_diffuse));

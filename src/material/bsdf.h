@@ -36,7 +36,8 @@ typedef struct bsdf {
   float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */
   float coat_ri, coat_t[PLASTIC_RES]; /* plastics: the material's coat tables */
   float roughness, spec_tint, sheen, sheen_tint, flatness, clearcoat, cc_alpha, spec_trans; /* BSDF_PRINCIPLED (kd, metallic, alpha, eta too) */
-  const float *sh_E;  /* BSDF_PBR with a sheen (material/sheen.h): the material's albedo table, else NULL */
+  const float *sh_E;  /* BSDF_PBR with a sheen (material/sheen.h): the material's albedo table, else NULL
+                         (it points into the material given to bsdf_from_material, which must outlive it) */
   rgb sh_color;       /* and its colour, alpha and max(colour) */
   float sh_alpha, sh_max;
 } bsdf;

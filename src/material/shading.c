@@ -128,7 +128,8 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
 bsdf bsdf_at(const scene *s, const isect *it) {
   const material *m = it->m;
   int vc = m->vertex_colors && s->col;
-  if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0 && m->tex_cc < 0 && m->tex_ccr < 0)
+  if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0 && m->tex_cc < 0 && m->tex_ccr < 0 &&
+      m->tex_sheen < 0)
     return bsdf_from_material(m);
   material mm = *m;
   float px[4];
@@ -147,7 +148,10 @@ bsdf bsdf_at(const scene *s, const isect *it) {
   if (m->tex_metal >= 0) { texture_lookup(&s->tex[m->tex_metal], it->u, it->v, px); mm.metallic *= (px[0] + px[1] + px[2]) / 3; }
   if (m->tex_cc >= 0) { texture_lookup(&s->tex[m->tex_cc], it->u, it->v, px); mm.clearcoat *= px[0]; }
   if (m->tex_ccr >= 0) { texture_lookup(&s->tex[m->tex_ccr], it->u, it->v, px); mm.clearcoat_roughness *= px[1]; }
-  return bsdf_from_material(&mm);
+  if (m->tex_sheen >= 0) { texture_lookup(&s->tex[m->tex_sheen], it->u, it->v, px); mm.sheen_color = c3_mul(mm.sheen_color, c3(px[0], px[1], px[2])); }
+  bsdf b = bsdf_from_material(&mm);
+  if (b.sh_E) b.sh_E = m->sheen_E; /* the material's table, not this copy's, which goes out of scope */
+  return b;
 }
 
 static int material_has_smooth(const scene *s, const material *m, int depth) {

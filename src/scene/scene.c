@@ -82,7 +82,7 @@ material material_default(void) {
   m.f90 = 1;
   m.bump_scale = 1;
   m.tint = c3(1, 1, 1);
-  m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = m.tex_cc = m.tex_ccr = -1;
+  m.tex_mr = m.tex_ns = m.tex_rough = m.tex_metal = m.tex_cc = m.tex_ccr = m.tex_sheen = -1;
   m.alpha_cutoff = 0.5f;
   m.opacity = 1;
   m.tex_weight = -1;
@@ -255,7 +255,7 @@ rgb scene_tri_color(const scene *s, uint32_t t, float b1, float b2) {
 int material_has_maps(const material *m) {
   return m->tex_kd >= 0 || m->tex_ks >= 0 || m->tex_ke >= 0 || m->tex_alpha >= 0 || m->tex_normal >= 0 || m->tex_ns >= 0 || m->tex_bump >= 0 ||
          m->tex_rough >= 0 || m->tex_metal >= 0 || m->tex_mr >= 0 || m->tex_weight >= 0 ||
-         m->tex_cc >= 0 || m->tex_ccr >= 0;
+         m->tex_cc >= 0 || m->tex_ccr >= 0 || m->tex_sheen >= 0;
 }
 
 int scene_alpha_pass(const scene *s, uint32_t t, float b1, float b2, uint64_t key) {

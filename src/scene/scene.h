@@ -56,6 +56,7 @@ typedef struct material {
   int tex_mr;        /* MAT_PBR: metallic-roughness map (linear; G roughness, B metallic), -1 = none */
   int tex_cc, tex_ccr; /* MAT_PBR: clearcoat map (linear; R multiplies clearcoat) and clearcoat
                           roughness map (linear; G multiplies clearcoat_roughness), -1 = none */
+  int tex_sheen;     /* MAT_PBR: sheen colour map (sRGB; RGB multiplies sheen_color), -1 = none */
   int dispersion;    /* dielectric: a core/spectrum.h dispersion preset, 0 = none */
   rgb emission;      /* emitted radiance (front side unless two_sided) */
   int two_sided;     /* emission on both sides */
