@@ -133,12 +133,13 @@ valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) 
   uint64_t off = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++)
     if (g->deq[i] == 1) { decode(g, &g->accs[i], out + off / 4); off += g->accs[i].count * (uint64_t)g->accs[i].comps * 4; }
-  /* the new buffer's name: beside the file, where no file it serves already is */
-  obj_text *t = &oc->files[oc->nfiles];
+  /* the new buffer's name: beside the file, where no file it serves already is (a slot
+   * is free when there are floats: checked above) */
+  obj_text *t = total ? &oc->files[oc->nfiles] : NULL;
   const char *slash = strrchr(g->path, '/');
   int dl = slash ? (int)(slash - g->path + 1) : 0;
-  char uri[64];
-  for (int k = 0;; k++) {
+  char uri[64] = "";
+  for (int k = 0; t; k++) {
     snprintf(uri, sizeof uri, "valo-dequantized-%d.bin", k);
     snprintf(t->path, sizeof t->path, "%.*s%s", dl, g->path, uri);
     int taken = 0;
@@ -158,7 +159,7 @@ valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) 
   free(oc->files[0].text); /* g->bin pointed into it: used above, not after */
   oc->files[0].text = text;
   oc->files[0].len = len;
-  if (!total) { free(out); return VALO_OK; }
+  if (!t) { free(out); return VALO_OK; }
   t->text = (char *)out;
   t->len = total;
   oc->nfiles++;
