@@ -171,8 +171,7 @@ static valo_status read_buffer(gc *g, uint32_t i, uint32_t o) {
   return VALO_OK;
 }
 
-/* The little-endian unsigned integer of `bytes` bytes (1, 2 or 4) at p. */
-static uint32_t le_uint(const unsigned char *p, uint64_t bytes) {
+uint32_t gl_le_uint(const unsigned char *p, uint64_t bytes) {
   uint32_t x = 0;
   for (uint64_t b = bytes; b-- > 0;) x = x << 8 | p[b];
   return x;
@@ -181,7 +180,7 @@ static uint32_t le_uint(const unsigned char *p, uint64_t bytes) {
 /* The first of n indices of `bytes` bytes at d that is limit or more (its value in *x), or -1. */
 static int64_t first_index_past(const unsigned char *d, uint64_t n, uint64_t bytes, uint64_t limit, uint32_t *x) {
   for (uint64_t k = 0; k < n; k++)
-    if ((*x = le_uint(d + k * bytes, bytes)) >= limit) return (int64_t)k;
+    if ((*x = gl_le_uint(d + k * bytes, bytes)) >= limit) return (int64_t)k;
   return -1;
 }
 
@@ -386,7 +385,7 @@ static valo_status check_mesh(gc *g, uint32_t m, uint32_t i, const char *mesh_ct
 static valo_status glb_chunks(gc *g, const unsigned char *b, size_t len, const char **json, size_t *json_len) {
   uint32_t w[5];
   if (len < 20) return gl_bad(g, "a .glb shorter than its header");
-  for (int i = 0; i < 5; i++) w[i] = le_uint(b + 4 * i, 4);
+  for (int i = 0; i < 5; i++) w[i] = gl_le_uint(b + 4 * i, 4);
   if (memcmp(b, "glTF", 4)) return gl_bad(g, "a .glb must start with \"glTF\"");
   if (w[1] != 2) return gl_bad(g, "binary glTF version %u is not read (valo reads version 2)", w[1]);
   if (w[2] != len) return gl_bad(g, "the header gives the length %u, the file has %zu bytes", w[2], len);
@@ -396,7 +395,7 @@ static valo_status glb_chunks(gc *g, const unsigned char *b, size_t len, const c
   size_t at = 20 + (size_t)w[3];
   at += (4 - at % 4) % 4;
   if (at + 8 <= len) {
-    uint32_t cl = le_uint(b + at, 4), ct = le_uint(b + at + 4, 4);
+    uint32_t cl = gl_le_uint(b + at, 4), ct = gl_le_uint(b + at + 4, 4);
     if (ct != GLB_BIN || cl > len - at - 8) return gl_bad(g, "the second chunk must be BIN and fit in the file");
     g->bin = b + at + 8;
     g->bin_len = cl;

@@ -67,6 +67,8 @@ int64_t gl_index(gc *g, uint32_t o, const char *key, uint32_t count, const char 
 /* Every element of array member key of o such an index: 0, or -1 (error set). */
 int gl_index_array(gc *g, uint32_t o, const char *key, uint32_t count, const char *of, const char *ctx);
 int64_t gl_accessor_ref(gc *g, uint32_t o, const char *key, int required, const char *ctx);
+/* The little-endian unsigned integer of `bytes` bytes (1, 2 or 4) at p. */
+uint32_t gl_le_uint(const unsigned char *p, uint64_t bytes);
 /* A data URI "data:TYPE/SUBTYPE;base64,DATA" decoded into g->decoded: its length, or -1. */
 int64_t gl_data_uri(gc *g, const char *s, const char *ctx);
 

@@ -20,11 +20,14 @@ static float component(const unsigned char *p, int ct, int normalized) {
   switch (ct) {
     case 5120: { double v = (int8_t)p[0]; return (float)(normalized ? fmax(v / 127.0, -1.0) : v); }
     case 5121: return (float)(normalized ? p[0] / 255.0 : p[0]);
-    case 5122: { double v = (int16_t)(uint16_t)(p[0] | p[1] << 8); return (float)(normalized ? fmax(v / 32767.0, -1.0) : v); }
-    case 5123: { double v = (uint16_t)(p[0] | p[1] << 8); return (float)(normalized ? v / 65535.0 : v); }
+    case 5122: { double v = (int16_t)gl_le_uint(p, 2); return (float)(normalized ? fmax(v / 32767.0, -1.0) : v); }
+    case 5123: { double v = gl_le_uint(p, 2); return (float)(normalized ? v / 65535.0 : v); }
     default: { float f; memcpy(&f, p, 4); return f; }
   }
 }
+
+/* The bytes of accessor a as floats. */
+static uint64_t float_bytes(const gacc *a) { return a->count * (uint64_t)a->comps * sizeof(float); }
 
 /* Accessor a's count x comps values into out. */
 static void decode(const gc *g, const gacc *a, float *out) {
@@ -38,8 +41,7 @@ static void decode(const gc *g, const gacc *a, float *out) {
     memset(out, 0, a->count * a->comps * sizeof *out); /* a sparse accessor over zeros */
   }
   for (uint64_t s = 0; s < (a->sparse ? a->sparse_n : 0); s++) { /* indices checked to lie inside (check_sparse) */
-    const unsigned char *ip = a->sparse_index + s * a->sparse_isize;
-    uint64_t e = a->sparse_isize == 1 ? ip[0] : a->sparse_isize == 2 ? (uint64_t)(ip[0] | ip[1] << 8) : (uint64_t)ip[0] | (uint64_t)ip[1] << 8 | (uint64_t)ip[2] << 16 | (uint64_t)ip[3] << 24;
+    uint64_t e = gl_le_uint(a->sparse_index + s * a->sparse_isize, (uint64_t)a->sparse_isize);
     for (int k = 0; k < a->comps; k++) out[e * a->comps + k] = component(a->sparse_values + s * a->size + (uint64_t)k * cs, a->ctype, a->normalized);
   }
 }
@@ -82,7 +84,7 @@ static char *rewrite(const gc *g, cJSON *root, const float *out, uint64_t total,
     }
     if (g->deq[i] != 1) continue;
     const gacc *a = &g->accs[i];
-    uint64_t bytes = a->count * (uint64_t)a->comps * 4;
+    uint64_t bytes = float_bytes(a);
     cJSON *acc = cJSON_GetArrayItem(accs, (int)i), *view = cJSON_CreateObject();
     if (!acc || !view || !cJSON_AddItemToArray(views, view)) { cJSON_Delete(view); return NULL; }
     if (set_number(view, "buffer", nb) || set_number(view, "byteOffset", (double)off) || set_number(view, "byteLength", (double)bytes) ||
@@ -124,7 +126,7 @@ valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) 
   obj_check *oc = g->oc;
   uint64_t total = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++)
-    if (g->deq[i] == 1) total += g->accs[i].count * (uint64_t)g->accs[i].comps * 4;
+    if (g->deq[i] == 1) total += float_bytes(&g->accs[i]);
   if (total && oc->nfiles == (int)(sizeof oc->files / sizeof oc->files[0]))
     return gl_bad(g, "integer vertex attributes need a buffer of floats, and the file has the most buffer files valo reads");
   if (total > UINT32_MAX) return gl_bad(g, "its integer vertex attributes are more than 4 GiB as floats");
@@ -132,7 +134,7 @@ valo_status gl_dequantize(gc *g, const char *json, size_t json_len, int binary) 
   if (!out) return gl_bad(g, "out of memory");
   uint64_t off = 0;
   for (uint32_t i = 0; i < g->n[K_ACC]; i++)
-    if (g->deq[i] == 1) { decode(g, &g->accs[i], out + off / 4); off += g->accs[i].count * (uint64_t)g->accs[i].comps * 4; }
+    if (g->deq[i] == 1) { decode(g, &g->accs[i], out + off / 4); off += float_bytes(&g->accs[i]); }
   /* the new buffer's name: beside the file, where no file it serves already is (a slot
    * is free when there are floats: checked above) */
   obj_text *t = total ? &oc->files[oc->nfiles] : NULL;
