@@ -20,23 +20,17 @@ static valo_status get_float_map(jctx *c, const cJSON *v, int raw, const char *w
   return json_get_texture(c, v, !raw, w, what, tex);
 }
 
-/* An optional data map (linear, not sRGB) named by `key`: *tex stays -1 when absent. */
-static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
+/* An optional map named by `key` (decoded from sRGB unless raw): *tex stays -1 when absent. */
+static valo_status get_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int raw, int *tex) {
   const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
   if (!v) return VALO_OK;
   char w[300];
   snprintf(w, sizeof w, "%s.%s", where, key);
-  return get_float_map(c, v, 1, w, what, tex);
+  return get_float_map(c, v, raw, w, what, tex);
 }
-
-/* An optional colour map (sRGB-decoded unless the texture object says "raw") named by `key`:
- * *tex stays -1 when absent. */
-static valo_status get_color_map(jctx *c, const cJSON *o, const char *key, const char *where, int *tex) {
-  const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
-  if (!v) return VALO_OK;
-  char w[300];
-  snprintf(w, sizeof w, "%s.%s", where, key);
-  return json_get_texture(c, v, 1, w, "colour map", tex);
+/* An optional data map (linear, not sRGB). */
+static valo_status get_data_map(jctx *c, const cJSON *o, const char *key, const char *where, const char *what, int *tex) {
+  return get_map(c, o, key, where, what, 1, tex);
 }
 
 /* "opacity": a number in [0, 1] or a map (8-bit decoded from sRGB, as Mitsuba's and
@@ -254,7 +248,7 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
     TRY(json_get_num(c, o, "sheen_roughness", where, 0, 1, &shr));
     if (m->sheen_color.r > 1 || m->sheen_color.g > 1 || m->sheen_color.b > 1) return json_bad(c, where, "sheen_color must be at most 1");
     m->sheen_roughness = (float)shr;
-    TRY(get_color_map(c, o, "sheen_map", where, &m->tex_sheen));
+    TRY(get_map(c, o, "sheen_map", where, "colour map", 0, &m->tex_sheen));
     if (c3_max(m->sheen_color) > 0) sheen_prepare(m);
   } else if (!strcmp(type, "diffuse")) {
     TRY(json_check_keys(c, o, where, k_diffuse));
