@@ -77,7 +77,7 @@ bsdf bsdf_from_material(const material *m) {
     b.p_first = wd + ws > 0 ? wd / (wd + ws) : 0;
     /* alpha >= 1e-3: GGX is used down to a near-mirror (roughness 0 is not a delta). */
     b.alpha = fmaxf(m->roughness * m->roughness, 1e-3f);
-    b.sh_max = fmaxf(m->sheen_color.r, fmaxf(m->sheen_color.g, m->sheen_color.b));
+    b.sh_max = c3_max(m->sheen_color);
     if (b.sh_max > 0) {
       b.sh_E = m->sheen_E;
       b.sh_color = m->sheen_color;
@@ -139,17 +139,20 @@ static rgb pbr_eval(const bsdf *b, vec3 wo, vec3 wi) {
   }
   return f;
 }
-/* The probability of sampling the clearcoat's lobe, from wo, and, below it, the sheen's
- * (cosine-weighted: its share of wo's light, max(colour) E(n.v)). */
+/* The probability of sampling the clearcoat's lobe, from wo, and, below it, of sampling
+ * the cosine lobe: the sheen's share of wo's light, max(colour) E(n.v), and of the rest
+ * the diffuse lobe's p_first (the specular lobe takes what is left). */
 static float pbr_coat_prob(const bsdf *b, vec3 wo) { return b->clearcoat > 0 ? b->clearcoat * (0.25f + 0.5f * schlick_weight(wo.z)) : 0; }
-static float pbr_sheen_prob(const bsdf *b, vec3 wo) { return b->sh_E ? b->sh_max * sheen_albedo(b->sh_E, wo.z) : 0; }
+static float pbr_cos_prob(const bsdf *b, vec3 wo) {
+  float psh = b->sh_E ? b->sh_max * sheen_albedo(b->sh_E, wo.z) : 0;
+  return psh + (1 - psh) * b->p_first;
+}
 static float pbr_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   vec3 wm = v3_add(wo, wi);
   if (!(v3_len2(wm) > 0)) return 0;
   wm = v3_norm(wm);
   float ps = ggx_D_visible(b->alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
-  float pdf = b->p_first * cosine_hemisphere_pdf(wi.z) + (1 - b->p_first) * ps, pc = pbr_coat_prob(b, wo), psh = pbr_sheen_prob(b, wo);
-  if (psh > 0) pdf = (1 - psh) * pdf + psh * cosine_hemisphere_pdf(wi.z);
+  float pcos = pbr_cos_prob(b, wo), pdf = pcos * cosine_hemisphere_pdf(wi.z) + (1 - pcos) * ps, pc = pbr_coat_prob(b, wo);
   if (pc > 0) pdf = (1 - pc) * pdf + pc * ggx_D_visible(b->cc_alpha, wo, wm) / (4 * fabsf(v3_dot(wo, wm)));
   return pdf;
 }
@@ -333,13 +336,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     if (pc > 0 && ulobe < pc) s->wi = v3_reflect(wo, ggx_sample_visible(b->cc_alpha, wo, u1, u2)); /* the clearcoat */
     else {
       if (pc > 0) ulobe = (ulobe - pc) / (1 - pc);
-      float psh = pbr_sheen_prob(b, wo);
-      if (psh > 0 && ulobe < psh) s->wi = sample_cosine_hemisphere(u1, u2); /* the sheen */
-      else {
-        if (psh > 0) ulobe = (ulobe - psh) / (1 - psh);
-        if (ulobe < b->p_first) s->wi = sample_cosine_hemisphere(u1, u2);
-        else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
-      }
+      if (ulobe < pbr_cos_prob(b, wo)) s->wi = sample_cosine_hemisphere(u1, u2); /* the sheen or the diffuse lobe */
+      else s->wi = v3_reflect(wo, ggx_sample_visible(b->alpha, wo, u1, u2));
     }
     if (s->wi.z <= 0) return 0;
     s->pdf = pbr_pdf(b, wo, s->wi);
