@@ -56,16 +56,9 @@ static valo_status read_path(mctx *c, const xml_node *parent, const xml_node *n)
   const char *v = xml_attr_get(n, "value");
   if (!v || !*v) return mi_bad(c, n, "needs a value (a folder)");
   if (strchr(v, '$')) return mi_bad(c, n, "a $parameter in a <path> is not read");
-  char *cand = NULL, **k;
+  char *cand = mi_beside(mi_file(c, n), v), **k;
   struct stat sb;
-  if (v[0] == '/') {
-    cand = strdup(v);
-  } else {
-    const char *f = mi_file(c, n), *sl = strrchr(f, '/');
-    size_t dl = sl ? (size_t)(sl - f + 1) : 0, len = dl + strlen(v) + 1;
-    if ((cand = malloc(len))) snprintf(cand, len, "%.*s%s", (int)dl, f, v);
-    if (cand && stat(cand, &sb)) { free(cand); cand = mi_resolve(c, v); }
-  }
+  if (cand && v[0] != '/' && stat(cand, &sb)) { free(cand); cand = mi_resolve(c, v); }
   if (!cand) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   char *abs = realpath(cand, NULL);
   if (!abs || stat(abs, &sb) || !S_ISDIR(sb.st_mode)) {

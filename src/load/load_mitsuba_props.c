@@ -66,14 +66,19 @@ const char *mi_found(mctx *c, const char *name) {
   return c->found[c->nfound++] = p;
 }
 
+char *mi_beside(const char *file, const char *name) {
+  const char *slash = strrchr(file, '/');
+  size_t dl = name[0] == '/' || !slash ? 0 : (size_t)(slash - file + 1), len = dl + strlen(name) + 1;
+  char *path = malloc(len);
+  if (path) snprintf(path, len, "%.*s%s", (int)dl, file, name);
+  return path;
+}
+
 char *mi_resolve(const mctx *c, const char *name) {
   int nomem;
   char *found = in_search(c, name, &nomem);
   if (found || nomem) return found;
-  size_t dl = name[0] == '/' ? 0 : mi_dir_len(c), len = dl + strlen(name) + 1;
-  char *path = malloc(len);
-  if (path) snprintf(path, len, "%.*s%s", (int)dl, c->path, name);
-  return path;
+  return mi_beside(c->path, name);
 }
 
 const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len) {

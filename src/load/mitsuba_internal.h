@@ -45,6 +45,9 @@ const char *mi_file(const mctx *c, const xml_node *n);
  * scene file's folder (where every relative name starts, included files' too). Malloc'd,
  * NULL when out of memory. */
 char *mi_resolve(const mctx *c, const char *name);
+/* name (relative, or absolute: as it is) from the folder of file: malloc'd, NULL when out
+ * of memory. */
+char *mi_beside(const char *file, const char *name);
 /* The name to give the JSON scene for a file the scene names (relative names there start
  * at the main file's folder): the absolute path when a <path> folder holds it (kept in c),
  * else the name as given. NULL when out of memory. */
