@@ -231,6 +231,54 @@ static int bad_files(void) {
   return 0;
 }
 
+/* A small file whose table lists one shape many times (a 1 MB file listing a 20 000-
+ * triangle shape 100 000 times once made 5 GB before failing): refused at once, naming the
+ * two entries, through the Mitsuba reader and as a file of its own; every listed shape
+ * read, and each decoded once, when they are apart. */
+static int repeated_table(void) {
+  enum { NT = 2000, REPEAT = 100000 };
+  double *p = malloc(9 * NT * sizeof *p);
+  uint32_t *idx = malloc(3 * NT * sizeof *idx);
+  CHECK(p && idx, "memory");
+  for (int t = 0; t < NT; t++) {
+    for (int k = 0; k < 9; k++) p[9 * t + k] = (k % 3 == 2 ? 0 : t % 7) + (k == 3 || k == 7);
+    for (int k = 0; k < 3; k++) idx[3 * t + k] = (uint32_t)(3 * t + k);
+  }
+  shape sh = {0, "many", 3 * NT, NT, p, NULL, NULL, NULL, idx, 0, 0};
+  const char *one = write_file("repeat-one.serialized", 4, &sh, 1);
+  /* the same file with its one-entry table replaced by REPEAT entries of offset 0 */
+  FILE *in = fopen(one, "rb");
+  CHECK(in, "%s", one);
+  fseek(in, 0, SEEK_END);
+  long n = ftell(in) - 12;
+  fseek(in, 0, SEEK_SET);
+  unsigned char *b = malloc((size_t)n);
+  CHECK(b && fread(b, 1, (size_t)n, in) == (size_t)n, "read");
+  fclose(in);
+  const char *many = scratch_path("repeat-many.serialized");
+  FILE *out = fopen(many, "wb");
+  CHECK(out, "%s", many);
+  fwrite(b, 1, (size_t)n, out);
+  uint64_t zero = 0;
+  for (int i = 0; i < REPEAT; i++) fwrite(&zero, 8, 1, out);
+  uint32_t cnt = REPEAT;
+  fwrite(&cnt, 4, 1, out);
+  fclose(out);
+  free(b); free(p); free(idx);
+  valo_error err;
+  valo_scene *sc;
+  CHECK(valo_scene_load(many, &sc, &err) != VALO_OK, "a table repeating one shape %d times loaded", REPEAT);
+  CHECK(strstr(err.message, "repeat-many.serialized") && strstr(err.message, "shapes 0 and 1 both start at offset 0"), "said: %s", err.message);
+  char xml[2048];
+  snprintf(xml, sizeof xml, "<scene version=\"3.0.0\"><sensor type=\"perspective\"/>\n<shape type=\"serialized\">"
+                            "<string name=\"filename\" value=\"repeat-many.serialized\"/><integer name=\"shape_index\" value=\"7\"/></shape>\n</scene>\n");
+  CHECK(valo_scene_load(scratch_file("repeat.xml", xml), &sc, &err) != VALO_OK, "the Mitsuba scene loaded");
+  CHECK(strstr(err.message, "both start at offset 0") && strstr(err.message, "line 2"), "said: %s", err.message);
+  CHECK(valo_scene_load(one, &sc, &err) == VALO_OK, "%s", err.message);
+  valo_scene_destroy(sc);
+  return 0;
+}
+
 /* The cube [-1, 1]^3, each face split along a diagonal, so that a corner meets one
  * triangle of one face and two of another. */
 static const double CP[] = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
@@ -340,6 +388,6 @@ static int torus_matches_obj(void) {
 }
 
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"reads_shapes", reads_shapes}, {"bad_files", bad_files}, {"computed_normals", computed_normals}, {"torus_matches_obj", torus_matches_obj}, {NULL, NULL}};
+  static const test_case cases[] = {{"reads_shapes", reads_shapes}, {"bad_files", bad_files}, {"computed_normals", computed_normals}, {"torus_matches_obj", torus_matches_obj}, {"repeated_table", repeated_table}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -816,9 +816,96 @@ static int instances(void) {
   return 0;
 }
 
+/* Text of n repeats of fmt (one %d: the repeat's number) between head and tail; malloc'd. */
+static char *repeated(const char *head, const char *fmt, int n, const char *tail) {
+  size_t cap = strlen(head) + strlen(tail) + (size_t)n * (strlen(fmt) + 24) + 1, len = 0;
+  char *t = malloc(cap);
+  if (!t) return NULL;
+  len += (size_t)snprintf(t, cap, "%s", head);
+  for (int i = 0; i < n; i++) len += (size_t)snprintf(t + len, cap - len, fmt, i, i + 1, i + 1);
+  snprintf(t + len, cap - len, "%s", tail);
+  return t;
+}
+
+/* Mitsuba files that recurse or expand: each refused at once naming its file, line and
+ * bound (a self-referring BSDF once overflowed the stack; a 4 096-fold include of a 1 MB
+ * part, or $name substitution to 6 GB, ran for minutes or out of memory), and large flat
+ * files read in time linear in their size (200 000 elements, 30 000 shapes naming 30 000
+ * BSDFs: once quadratic, 15 minutes and 12 s). The case's ctest time limit (60 s, under
+ * ASan too) is what a quadratic reader would cross. */
+static int expansion_bounds(void) {
+  static const char *SCENE = "<scene version=\"3.0.0\">\n<sensor type=\"perspective\"/>\n";
+  static const struct { const char *file, *body, *want[2]; } bad[] = {
+      {"self.xml", "<bsdf type=\"twosided\" id=\"a\"><ref id=\"a\"/></bsdf>\n<shape type=\"sphere\"><ref id=\"a\"/></shape>\n",
+       {"self.xml:3: <bsdf type=\"twosided\" id=\"a\">", "a cycle (a -> a)"}},
+      {"mask.xml", "<bsdf type=\"mask\" id=\"m\"><float name=\"opacity\" value=\"0.5\"/><ref id=\"m\"/></bsdf>\n<shape type=\"sphere\"><ref id=\"m\"/></shape>\n",
+       {"mask.xml:3:", "a cycle (m -> m)"}},
+      {"mutual.xml", "<bsdf type=\"twosided\" id=\"a\"><ref id=\"b\"/></bsdf>\n<bsdf type=\"bumpmap\" id=\"b\"><texture type=\"bitmap\" name=\"arbitrary\">"
+                     "<string name=\"filename\" value=\"none.png\"/></texture><ref id=\"a\"/></bsdf>\n<shape type=\"sphere\"><ref id=\"a\"/></shape>\n",
+       {"mutual.xml:3:", "a cycle (a -> b -> a)"}},
+  };
+  valo_error err;
+  valo_scene *sc;
+  char buf[2048];
+  for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+    snprintf(buf, sizeof buf, "%s%s</scene>\n", SCENE, bad[i].body);
+    CHECK(valo_scene_load(scratch_file(bad[i].file, buf), &sc, &err) != VALO_OK, "%s loaded", bad[i].file);
+    CHECK(strstr(err.message, bad[i].want[0]) && strstr(err.message, bad[i].want[1]), "%s said: %s", bad[i].file, err.message);
+  }
+  /* a chain of 40 000 BSDFs, each wrapping the next; a chain of 30 each holding the next twice (2^30) */
+  char *t = repeated(SCENE, "<bsdf type=\"twosided\" id=\"b%d\"><ref id=\"b%d\"/></bsdf>\n", 40000,
+                     "<bsdf type=\"diffuse\" id=\"b40000\"/>\n<shape type=\"sphere\"><ref id=\"b0\"/></shape>\n</scene>\n");
+  CHECK(t && valo_scene_load(scratch_file("chain.xml", t), &sc, &err) != VALO_OK, "the chain loaded");
+  CHECK(strstr(err.message, "chain.xml:35:") && strstr(err.message, "nested more than 32 deep"), "said: %s", err.message);
+  free(t);
+  t = repeated(SCENE, "<bsdf type=\"twosided\" id=\"b%d\"><ref id=\"b%d\"/><ref id=\"b%d\"/></bsdf>\n", 30,
+               "<bsdf type=\"diffuse\" id=\"b30\"/>\n<shape type=\"sphere\"><ref id=\"b0\"/></shape>\n</scene>\n");
+  CHECK(t && valo_scene_load(scratch_file("doubling.xml", t), &sc, &err) != VALO_OK, "the doubling chain loaded");
+  CHECK(strstr(err.message, "doubling.xml:") && strstr(err.message, "more than 200000 translations"), "said: %s", err.message);
+  free(t);
+  /* a 1 MB part included 4 096 times */
+  size_t part_len = (1u << 20) + 64;
+  char *part = malloc(part_len);
+  CHECK(part, "memory");
+  int k = snprintf(part, part_len, "<scene version=\"3.0.0\">\n<!-- ");
+  memset(part + k, 'x', (1u << 20));
+  snprintf(part + k + (1u << 20), part_len - (size_t)k - (1u << 20), " -->\n</scene>\n");
+  scratch_file("part.xml", part);
+  free(part);
+  t = repeated(SCENE, "<include filename=\"part.xml\"/>\n", 4096, "<shape type=\"sphere\"/>\n</scene>\n");
+  CHECK(t && valo_scene_load(scratch_file("includes.xml", t), &sc, &err) != VALO_OK, "4096 includes of 1 MB loaded");
+  CHECK(strstr(err.message, "includes.xml:66: <include>") && strstr(err.message, "more than 64 MiB in all"), "said: %s", err.message);
+  free(t);
+  /* 12 000 attributes of $a x 8 over a 65 KB default */
+  char *dflt = malloc(65200);
+  CHECK(dflt, "memory");
+  k = snprintf(dflt, 65200, "<scene version=\"3.0.0\">\n<default name=\"a\" value=\"");
+  memset(dflt + k, '1', 65000);
+  snprintf(dflt + k + 65000, 65200 - (size_t)k - 65000, "\"/>\n<sensor type=\"perspective\"/>\n<shape type=\"sphere\">\n");
+  t = repeated(dflt, "<string name=\"s%d\" value=\"$a$a$a$a$a$a$a$a\"/>\n", 12000, "</shape>\n</scene>\n");
+  free(dflt);
+  CHECK(t && valo_scene_load(scratch_file("subst.xml", t), &sc, &err) != VALO_OK, "6 GB of substitution loaded");
+  CHECK(strstr(err.message, "subst.xml:37: <string name=\"s32\">") && strstr(err.message, "more than 16 MiB of attribute text in all"), "said: %s", err.message);
+  free(t);
+  /* large flat files load: 200 000 elements (7 MB), and 30 000 shapes naming 30 000 BSDFs */
+  t = repeated(SCENE, "<bsdf type=\"diffuse\" id=\"unused%d\"><rgb name=\"reflectance\" value=\"0.5\"/></bsdf>\n", 100000,
+               "<shape type=\"sphere\"/><emitter type=\"constant\"/>\n</scene>\n");
+  CHECK(t && strlen(t) > (6u << 20), "the flat file");
+  CHECK(valo_scene_load(scratch_file("flat.xml", t), &sc, &err) == VALO_OK, "%s", err.message);
+  valo_scene_destroy(sc);
+  free(t);
+  char *shapes = repeated("", "<shape type=\"rectangle\"><ref id=\"m%d\"/></shape>\n", 30000, "<emitter type=\"constant\"/>\n</scene>\n");
+  t = shapes ? repeated(SCENE, "<bsdf type=\"diffuse\" id=\"m%d\"><rgb name=\"reflectance\" value=\"0.5\"/></bsdf>\n", 30000, shapes) : NULL;
+  CHECK(t, "memory");
+  CHECK(valo_scene_load(scratch_file("named.xml", t), &sc, &err) == VALO_OK, "%s", err.message);
+  valo_scene_destroy(sc);
+  free(t); free(shapes);
+  return 0;
+}
+
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"parser", parser}, {"xml_equals_json", xml_equals_json}, {"mitsuba_06_names", mitsuba_06_names},
                                     {"defaults_and_defines", defaults_and_defines}, {"unread_is_said", unread_is_said},
-                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"search_paths", search_paths}, {"rfilters", rfilters}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {NULL, NULL}};
+                                    {"unit_shapes", unit_shapes}, {"focal_length", focal_length}, {"convert_to_json", convert_to_json}, {"includes", includes}, {"search_paths", search_paths}, {"rfilters", rfilters}, {"instances", instances}, {"mesh_v_as_mitsuba", mesh_v_as_mitsuba}, {"mask_opacity", mask_opacity}, {"scalar_bitmaps", scalar_bitmaps}, {"black_backs", black_backs}, {"spectrum_lists", spectrum_lists}, {"one_line_materials", one_line_materials}, {"expansion_bounds", expansion_bounds}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -8,6 +8,7 @@
 #include "core/options.h"
 #include "core/strutil.h"
 #include "load/serialized.h"
+#include "core/strmap.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <limits.h>
@@ -242,15 +243,15 @@ valo_status json_parse_transform(jctx *c, const cJSON *o, const char *where, flo
   return VALO_OK;
 }
 
-static uint32_t find_material(const scene *s, const char *name, uint32_t first_named, uint32_t end_named) {
-  for (uint32_t i = first_named; i < end_named; i++)
-    if (!strcmp(s->mats[i].name, name)) return i;
-  return UINT32_MAX;
+/* The material named name in the file's "materials" (the first of that name), or UINT32_MAX. */
+static uint32_t find_material(const jctx *c, const char *name) {
+  long i = strmap_get(&c->mat_names, name);
+  return i < 0 ? UINT32_MAX : (uint32_t)i;
 }
 
 
-static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend);
-static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfirst, uint32_t mend) {
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where);
+static valo_status parse_shape(jctx *c, const cJSON *o, int index) {
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
   static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "p0", "p1", "subdivisions", "flip_normals", "smooth",
@@ -260,7 +261,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index, uint32_t mfir
   int32_t inside = MEDIUM_KEEP, outside = MEDIUM_KEEP;
   TRY(json_get_medium(c, o, "interior", where, &inside));
   TRY(json_get_medium(c, o, "exterior", where, &outside));
-  valo_status st = parse_shape_geometry(c, o, where, mfirst, mend);
+  valo_status st = parse_shape_geometry(c, o, where);
   if (st) return st;
   if (inside != MEDIUM_KEEP || outside != MEDIUM_KEEP) {
     /* A medium boundary: the side not named is vacuum. */
@@ -297,14 +298,14 @@ static valo_status shape_transform(jctx *c, const cJSON *o, const char *where, f
   return json_parse_transform(c, t, w2, xf);
 }
 
-static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where, uint32_t mfirst, uint32_t mend) {
+static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *where) {
   const char *type = "mesh", *file = NULL, *mname = NULL;
   TRY(json_get_str(c, o, "type", where, &type));
   TRY(json_get_str(c, o, "file", where, &file));
   TRY(json_get_str(c, o, "material", where, &mname));
   uint32_t mat = UINT32_MAX;
   if (mname) {
-    mat = find_material(c->s, mname, mfirst, mend);
+    mat = find_material(c, mname);
     if (mat == UINT32_MAX) {
       char msg[200];
       snprintf(msg, sizeof msg, "material \"%.100s\" is not defined in \"materials\"", mname);
@@ -516,24 +517,24 @@ valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_o
   }
   const cJSON *render = cJSON_GetObjectItemCaseSensitive(root, "render");
   if (render) TRY(parse_render(&c, render));
-  uint32_t mfirst = c.mfirst = s->nmats;
+  c.mfirst = s->nmats;
   const cJSON *mats = c.mats = cJSON_GetObjectItemCaseSensitive(root, "materials");
   if (mats) {
     if (!cJSON_IsObject(mats)) { st = json_bad(&c, "materials", "must be an object of named materials"); goto done; }
     for (const cJSON *m = mats->child; m; m = m->next) {
       material mm;
       TRY(json_parse_material(&c, m, m->string, &mm));
-      if (scene_add_material(s, &mm) == UINT32_MAX) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
+      uint32_t k = scene_add_material(s, &mm);
+      if (k == UINT32_MAX || strmap_put(&c.mat_names, m->string, k)) { st = err_set(err, VALO_ERR_NOMEM, "out of memory"); goto done; }
     }
   }
-  uint32_t mend = s->nmats;
   const cJSON *shapes = cJSON_GetObjectItemCaseSensitive(root, "shapes");
   if (shapes) {
     if (!cJSON_IsArray(shapes)) { st = json_bad(&c, "shapes", "must be an array"); goto done; }
     int i = 0;
     for (const cJSON *sh = shapes->child; sh; sh = sh->next, i++) {
       if (at) at[0] = i;
-      TRY(parse_shape(&c, sh, i, mfirst, mend));
+      TRY(parse_shape(&c, sh, i));
     }
     if (at) at[0] = -1;
   }
@@ -565,6 +566,7 @@ valo_status load_json_tree(scene *s, const char *path, const cJSON *root, valo_o
   if (env) TRY(json_parse_environment(&c, env));
 done:
   mesh_cache_free(c.meshes);
+  strmap_free(&c.mat_names);
   return st;
 }
 

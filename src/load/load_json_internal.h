@@ -3,6 +3,7 @@
 #ifndef VALO_LOAD_JSON_INTERNAL_H
 #define VALO_LOAD_JSON_INTERNAL_H
 #include "load/load.h"
+#include "core/strmap.h"
 #include <cjson/cJSON.h>
 
 typedef struct jctx {
@@ -14,6 +15,7 @@ typedef struct jctx {
   mesh_cache *meshes;          /* the mesh files imported so far (load_mesh_cached) */
   const cJSON *mats;           /* the "materials" object, whose k-th material is mfirst + k */
   uint32_t mfirst;
+  strmap mat_names;            /* their names (the "materials" keys) -> scene material index */
 } jctx;
 
 /* The getters: a missing key leaves *out as it is; a present one of the wrong type or

@@ -472,6 +472,10 @@ static void translation_free(mctx *c) {
   for (int i = 0; i < c->nfound; i++) free(c->found[i]);
   free(c->found);
   free(c->bsdf_names);
+  free(c->ids);
+  free(c->bsdf_stack);
+  strmap_free(&c->bsdf_ids);
+  strmap_free(&c->material_names);
 }
 
 valo_status load_mitsuba(scene *s, const char *path, const char *defines, valo_options *settings, valo_error *err) {

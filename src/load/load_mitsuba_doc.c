@@ -106,6 +106,11 @@ static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
     size_t tl;
     xml_node *r = NULL;
     valo_status st = scene_text_read(path, &text, &tl, c->err);
+    if (!st && (c->included_bytes += tl) > MI_INCLUDE_BYTES) {
+      free(text);
+      return mi_bad(c, n, "the files included come to more than %u MiB in all (at %s, included %d times so far)", MI_INCLUDE_BYTES >> 20, path,
+                    c->nincluded);
+    }
     if (!st) {
       st = xml_parse(path, text, tl, &r, c->err);
       free(text);
@@ -155,52 +160,56 @@ static const char *define_of(const char *defines, const char *name, size_t n, si
 
 typedef struct { const char *name, *value; } mdef;
 
-/* Replaces $name in every attribute with its <default>'s value. */
+/* Replaces $name in every attribute of n and of the elements inside it (not its next
+ * siblings) with its <default>'s value. */
 static valo_status substitute(mctx *c, xml_node *n, const mdef *d, int nd) {
-  for (; n; n = n->next) {
-    for (int i = 0; i < n->nattrs; i++) {
-      char *v = n->attrs[i].value;
-      if (!strchr(v, '$')) continue;
-      size_t cap = strlen(v) + 1, len = 0;
-      char *o = malloc(cap);
-      if (!o) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
-      for (const char *p = v; *p;) {
-        const char *add = p;
-        size_t alen = 1;
-        if (*p == '$') {
-          const char *e = p + 1;
-          while (isalnum((unsigned char)*e) || *e == '_') e++;
-          int k;
-          for (k = 0; k < nd; k++)
-            if (strlen(d[k].name) == (size_t)(e - p - 1) && !strncmp(d[k].name, p + 1, (size_t)(e - p - 1))) break;
-          if (k < nd) {
-            add = d[k].value;
-            alen = strlen(add);
-          } else if (!(add = define_of(c->defines, p + 1, (size_t)(e - p - 1), &alen))) {
-            free(o);
-            int nl = (int)(e - p - 1 > 60 ? 60 : e - p - 1);
-            return mi_bad(c, n, "$%.*s has no <default name=\"%.*s\"> (or --define %.*s=VALUE)", nl, p + 1, nl, p + 1, nl, p + 1);
-          }
-          p = e;
-        } else {
-          p++;
+  for (int i = 0; i < n->nattrs; i++) {
+    char *v = n->attrs[i].value;
+    if (!strchr(v, '$')) continue;
+    size_t cap = strlen(v) + 1, len = 0;
+    char *o = malloc(cap);
+    if (!o) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+    for (const char *p = v; *p;) {
+      const char *add = p;
+      size_t alen = 1;
+      int made = *p == '$'; /* text made by substitution, counted against MI_SUBST_BYTES */
+      if (made) {
+        const char *e = p + 1;
+        while (isalnum((unsigned char)*e) || *e == '_') e++;
+        int k;
+        for (k = 0; k < nd; k++)
+          if (strlen(d[k].name) == (size_t)(e - p - 1) && !strncmp(d[k].name, p + 1, (size_t)(e - p - 1))) break;
+        if (k < nd) {
+          add = d[k].value;
+          alen = strlen(add);
+        } else if (!(add = define_of(c->defines, p + 1, (size_t)(e - p - 1), &alen))) {
+          free(o);
+          int nl = (int)(e - p - 1 > 60 ? 60 : e - p - 1);
+          return mi_bad(c, n, "$%.*s has no <default name=\"%.*s\"> (or --define %.*s=VALUE)", nl, p + 1, nl, p + 1, nl, p + 1);
         }
-        if (len + alen + 1 > cap) {
-          cap = 2 * (len + alen + 1);
-          if (cap > (1u << 20)) { free(o); return mi_bad(c, n, "an attribute grows past 1 MiB by substitution"); }
-          char *t = realloc(o, cap);
-          if (!t) { free(o); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
-          o = t;
-        }
-        memcpy(o + len, add, alen);
-        len += alen;
+        p = e;
+      } else {
+        p++;
       }
-      o[len] = 0;
-      free(v);
-      n->attrs[i].value = o;
+      if (made && (c->substituted_bytes += alen) > MI_SUBST_BYTES) {
+        free(o);
+        return mi_bad(c, n, "$name substitution makes more than %u MiB of attribute text in all", MI_SUBST_BYTES >> 20);
+      }
+      if (len + alen + 1 > cap) {
+        cap = 2 * (len + alen + 1);
+        if (cap > (1u << 20)) { free(o); return mi_bad(c, n, "an attribute grows past 1 MiB by substitution"); }
+        char *t = realloc(o, cap);
+        if (!t) { free(o); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+        o = t;
+      }
+      memcpy(o + len, add, alen);
+      len += alen;
     }
-    TRY(substitute(c, n->child, d, nd));
+    o[len] = 0;
+    free(v);
+    n->attrs[i].value = o;
   }
+  for (xml_node *k = n->child; k; k = k->next) TRY(substitute(c, k, d, nd));
   return VALO_OK;
 }
 
@@ -249,6 +258,7 @@ valo_status mi_document_prepare(mctx *c) {
    * default's own value is not expanded, as in Mitsuba). */
   for (xml_node *k = r->child; k; k = k->next)
     if (strcmp(k->name, "default")) TRY(substitute(c, k, defs, nd));
+  TRY(mi_index_ids(c));
   TRY(check_refs(c, r->child));
   return VALO_OK;
 }

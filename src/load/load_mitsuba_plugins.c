@@ -136,7 +136,38 @@ static valo_status wrapped(mctx *c, xml_node *b, cJSON *m, const char *what) {
   return translate_bsdf(c, in, m);
 }
 
+static valo_status translate_one(mctx *c, xml_node *b, cJSON *m);
+
+/* translate_one within the bounds of mitsuba_internal.h: a BSDF inside itself through
+ * <ref>s is a cycle, refused naming the chain's ids. */
 static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
+  for (int i = 0; i < c->nbsdf_stack; i++) {
+    if (c->bsdf_stack[i] != b) continue;
+    char chain[400] = "";
+    size_t at = 0;
+    for (int j = i; j <= c->nbsdf_stack && at + 1 < sizeof chain; j++) {
+      const xml_node *k = j < c->nbsdf_stack ? c->bsdf_stack[j] : b;
+      const char *id = xml_attr_get(k, "id");
+      int w = snprintf(chain + at, sizeof chain - at, "%s%.60s", j > i ? " -> " : "", id ? id : "(no id)");
+      at += w > 0 ? (size_t)w : 0;
+    }
+    return mi_bad(c, b, "BSDFs that refer to each other in a cycle (%s)", chain);
+  }
+  if (c->nbsdf_stack >= MI_BSDF_DEPTH) return mi_bad(c, b, "BSDFs nested more than %d deep through <ref>s", MI_BSDF_DEPTH);
+  if (++c->bsdf_work > MI_BSDF_WORK)
+    return mi_bad(c, b, "BSDFs that refer to others expand to more than %d translations (a chain whose links refer to the next twice?)", MI_BSDF_WORK);
+  if (!(c->nbsdf_stack & (c->nbsdf_stack - 1))) { /* grown at 0, 1, 2, 4, ... */
+    const xml_node **k = realloc(c->bsdf_stack, (size_t)(c->nbsdf_stack ? 2 * c->nbsdf_stack : 1) * sizeof *k);
+    if (!k) return NOMEM;
+    c->bsdf_stack = k;
+  }
+  c->bsdf_stack[c->nbsdf_stack++] = b;
+  valo_status st = translate_one(c, b, m);
+  c->nbsdf_stack--;
+  return st;
+}
+
+static valo_status translate_one(mctx *c, xml_node *b, cJSON *m) {
   const char *type = xml_attr_get(b, "type");
   if (!type) return mi_bad(c, b, "needs a type");
   b->used = 1;
@@ -344,16 +375,16 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
 }
 
 static valo_status add_material(mctx *c, cJSON *m, const char *name) {
-  if (cJSON_GetObjectItemCaseSensitive(c->materials, name)) { cJSON_Delete(m); return VALO_OK; }
-  cJSON_AddItemToObject(c->materials, name, m);
-  return VALO_OK;
+  if (strmap_get(&c->material_names, name) >= 0) { cJSON_Delete(m); return VALO_OK; }
+  if (!cJSON_AddItemToObject(c->materials, name, m)) { cJSON_Delete(m); return NOMEM; }
+  return strmap_put(&c->material_names, m->string, 1) ? NOMEM : VALO_OK; /* the item's own copy of the name */
 }
 
 valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, char *name, size_t n) {
   const char *id = b ? xml_attr_get(b, "id") : NULL;
   if (b && id && !emit && !c->twosided) {
-    for (int i = 0; i < c->nbsdf_names; i++)
-      if (!strcmp(c->bsdf_names[i].id, id)) { snprintf(name, n, "%s", c->bsdf_names[i].name); return VALO_OK; }
+    long i = strmap_get(&c->bsdf_ids, id);
+    if (i >= 0) { snprintf(name, n, "%s", c->bsdf_names[i].name); return VALO_OK; }
   }
   cJSON *m = cJSON_CreateObject();
   if (!m) return NOMEM;
@@ -393,7 +424,7 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
     c->bsdf_names = q;
     c->bsdf_names[c->nbsdf_names].id = id;
     snprintf(c->bsdf_names[c->nbsdf_names].name, sizeof c->bsdf_names[0].name, "%s", name);
-    c->nbsdf_names++;
+    if (strmap_put(&c->bsdf_ids, id, c->nbsdf_names++)) return NOMEM;
   }
   return VALO_OK;
 }

@@ -119,7 +119,43 @@ static xml_node *find_id(xml_node *n, const char *id) {
   }
   return NULL;
 }
-xml_node *mi_find_id(mctx *c, const char *id) { return find_id(c->root->child, id); }
+struct mi_id { const char *id; xml_node *n; int order; };
+
+static int count_ids(const xml_node *n) {
+  int k = 0;
+  for (; n; n = n->next) k += (xml_attr_get(n, "id") && strcmp(n->name, "ref")) + count_ids(n->child);
+  return k;
+}
+static void list_ids(xml_node *n, struct mi_id *v, int *k) {
+  for (; n; n = n->next) {
+    const char *id = xml_attr_get(n, "id");
+    if (id && strcmp(n->name, "ref")) { v[*k] = (struct mi_id){id, n, *k}; (*k)++; }
+    list_ids(n->child, v, k);
+  }
+}
+static int id_cmp(const void *a, const void *b) {
+  const struct mi_id *x = a, *y = b;
+  int d = strcmp(x->id, y->id);
+  return d ? d : (x->order > y->order) - (x->order < y->order);
+}
+static int id_key(const void *key, const void *b) { return strcmp(key, ((const struct mi_id *)b)->id); }
+
+valo_status mi_index_ids(mctx *c) {
+  int n = count_ids(c->root->child), k = 0;
+  if (!(c->ids = malloc((size_t)n * sizeof *c->ids + 1))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  list_ids(c->root->child, c->ids, &k);
+  qsort(c->ids, (size_t)n, sizeof *c->ids, id_cmp);
+  c->nids = n;
+  return VALO_OK;
+}
+
+xml_node *mi_find_id(mctx *c, const char *id) {
+  if (!id) return NULL;
+  if (!c->ids) return find_id(c->root->child, id);
+  struct mi_id *e = bsearch(id, c->ids, (size_t)c->nids, sizeof *c->ids, id_key);
+  while (e && e > c->ids && !strcmp(e[-1].id, id)) e--; /* the first in document order */
+  return e ? e->n : NULL;
+}
 
 static int is_property(const xml_node *n) {
   static const char *const t[] = {"float", "integer", "boolean", "string", "rgb", "srgb", "spectrum", "point", "vector", "transform", NULL};

@@ -6,6 +6,7 @@
 #define VALO_MITSUBA_INTERNAL_H
 #include "load/xml.h"
 #include "core/vec.h"
+#include "core/strmap.h"
 #include <cjson/cJSON.h>
 
 typedef struct mctx {
@@ -19,6 +20,13 @@ typedef struct mctx {
   int nshape_at, nlight_at;
   char **included; /* the <include>d files' paths (xml_node.file points at them) */
   int nincluded;
+  size_t included_bytes;    /* read through <include>s so far (MI_INCLUDE_BYTES) */
+  size_t substituted_bytes; /* attribute text made by $name substitution (MI_SUBST_BYTES) */
+  struct mi_id *ids;        /* every element with an id, sorted by id (mi_find_id) */
+  int nids;
+  const xml_node **bsdf_stack; /* the BSDFs being translated, outermost first (cycles) */
+  int nbsdf_stack;
+  long bsdf_work;              /* BSDF translations so far (MI_BSDF_WORK) */
   char **search;   /* the folders <path> elements gave, absolute, in document order */
   int nsearch;
   char **found;    /* file names found in those folders (mi_found), absolute */
@@ -27,9 +35,21 @@ typedef struct mctx {
   int quiet;           /* no warnings (an instance after a shapegroup's first) */
   struct { const char *id; char name[192]; } *bsdf_names; /* materials made from bsdfs with an id */
   int nbsdf_names;
+  strmap bsdf_ids;       /* their ids -> index in bsdf_names */
+  strmap material_names; /* the names in "materials" (keys borrowed from its items) */
   int twosided;      /* > 0 inside a twosided BSDF: what is translated there scatters from both sides */
   int vertex_color;  /* set by mi_color (MI_VERTEX) when a colour is the mesh's vertex colours */
 } mctx;
+
+/* Bounds that keep a small file from expanding without end, each refused with the line
+ * that crosses it: bytes read through <include>s in all (a file included many times
+ * counts each time), attribute bytes made by $name substitution in all, BSDFs nested
+ * through <ref>s, and BSDF translations in all (a chain of twosided or blend BSDFs that
+ * refer to the same next one twice doubles at each link). */
+#define MI_INCLUDE_BYTES (64u << 20)
+#define MI_SUBST_BYTES (16u << 20)
+#define MI_BSDF_DEPTH 32
+#define MI_BSDF_WORK 200000
 
 /* The document before its elements are read (load_mitsuba_doc.c): the root is <scene>,
  * 0.6 names upgraded, <include>s spliced in, <default>s (and --define) substituted for
@@ -60,8 +80,10 @@ const char *mi_where(const mctx *c, const xml_node *n, char *buf, size_t len);
 /* mi_where and the column: a name no other element of the files shares (an anonymous
  * material's, a medium's). */
 const char *mi_place(const mctx *c, const xml_node *n, char *buf, size_t len);
-/* The node with id (any tag), or NULL. */
+/* The node with id (any tag but <ref>), the first in document order, or NULL; from the
+ * index that mi_index_ids makes of the prepared document (a walk of the tree before). */
 xml_node *mi_find_id(mctx *c, const char *id);
+valo_status mi_index_ids(mctx *c);
 /* The property child named `name` of plugin p (marked used), following a <ref name=..>
  * to its target; NULL when absent. */
 xml_node *mi_prop(mctx *c, xml_node *p, const char *name);

@@ -31,10 +31,44 @@ typedef struct ser_file {
   int version;
   uint32_t count;
   size_t table; /* where the offset table starts: every shape's stream ends before it */
+  uint64_t *end; /* each shape's stream ends where the next shape in the file starts */
 } ser_file;
 
 static uint32_t rd32(const unsigned char *p) { uint32_t v; memcpy(&v, p, 4); return v; }
 static uint64_t rd64(const unsigned char *p) { uint64_t v; memcpy(&v, p, 8); return v; }
+
+static uint64_t ser_offset(const ser_file *f, uint32_t i) {
+  size_t at = f->table + (f->version == 4 ? 8 : 4) * (size_t)i;
+  return f->version == 4 ? rd64(f->b + at) : rd32(f->b + at);
+}
+
+typedef struct { uint64_t off; uint32_t i; } ser_entry;
+static int entry_cmp(const void *a, const void *b) {
+  const ser_entry *x = a, *y = b;
+  return x->off != y->off ? (x->off > y->off) - (x->off < y->off) : (x->i > y->i) - (x->i < y->i);
+}
+
+/* f->end from the table sorted by offset. Two entries at one offset are refused: a file
+ * lists each shape once, and a table that repeats one would have it decoded again for
+ * every entry (a small file expanding without end). Every shape's data thus lies in a part
+ * of the file of its own, and all of them together decode to at most deflate's ratio
+ * (1032) times the file's size. */
+static valo_status ser_ends(ser_file *f, valo_error *err) {
+  ser_entry *e = malloc((size_t)f->count * sizeof *e);
+  f->end = malloc((size_t)f->count * sizeof *f->end);
+  if (!e || !f->end) { free(e); return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", f->path); }
+  for (uint32_t i = 0; i < f->count; i++) e[i] = (ser_entry){ser_offset(f, i), i};
+  qsort(e, f->count, sizeof *e, entry_cmp);
+  valo_status st = VALO_OK;
+  for (uint32_t k = 0; k < f->count && !st; k++) {
+    if (k + 1 < f->count && e[k + 1].off == e[k].off)
+      st = err_set(err, VALO_ERR_PARSE, "%s: its table of shapes is damaged: shapes %u and %u both start at offset %llu (each shape is listed once)",
+                   f->path, e[k].i, e[k + 1].i, (unsigned long long)e[k].off);
+    f->end[e[k].i] = k + 1 < f->count && e[k + 1].off < f->table ? e[k + 1].off : f->table;
+  }
+  free(e);
+  return st;
+}
 
 static valo_status ser_open(ser_file *f, const char *path, valo_error *err) {
   memset(f, 0, sizeof *f);
@@ -63,7 +97,7 @@ static valo_status ser_open(ser_file *f, const char *path, valo_error *err) {
   if (f->count == 0 || f->count > (f->len - 8) / entry)
     return err_set(err, VALO_ERR_PARSE, "%s: its table of shapes is damaged (it claims %u shapes in %zu bytes)", path, f->count, f->len);
   f->table = f->len - 4 - entry * f->count;
-  return VALO_OK;
+  return ser_ends(f, err);
 }
 
 /* Decompresses shape i into *out (*out_len bytes), checked against the size its header
@@ -71,12 +105,11 @@ static valo_status ser_open(ser_file *f, const char *path, valo_error *err) {
  * expands past what its counts need (nor past deflate's ratio of 1032). */
 static valo_status ser_inflate(const ser_file *f, uint32_t i, unsigned char **out, size_t *out_len, valo_error *err) {
   *out = NULL;
-  size_t entry = f->version == 4 ? 8 : 4, at = f->table + entry * i;
-  uint64_t off = f->version == 4 ? rd64(f->b + at) : rd32(f->b + at);
-  if (off >= f->table || f->table - off <= 4 || f->b[off] + 256 * f->b[off + 1] != SER_MAGIC || f->b[off + 2] + 256 * f->b[off + 3] != f->version)
+  uint64_t off = ser_offset(f, i);
+  if (off >= f->table || f->end[i] - off <= 4 || f->b[off] + 256 * f->b[off + 1] != SER_MAGIC || f->b[off + 2] + 256 * f->b[off + 3] != f->version)
     return err_set(err, VALO_ERR_PARSE, "%s: shape %u: its offset (%llu) does not lead to a shape's header", f->path, i, (unsigned long long)off);
   const char *z = (const char *)f->b + off + 4;
-  size_t zlen = f->table - off - 4;
+  size_t zlen = f->end[i] - off - 4;
   if (zlen > INT_MAX) zlen = INT_MAX;
   /* The header, from a bounded first decode (zeroed: stb leaves its failure reason as it
    * was on a few paths). */
@@ -193,6 +226,7 @@ uint32_t serialized_count(const char *path, valo_error *err) {
   ser_file f;
   valo_status st = ser_open(&f, path, err);
   free(f.b);
+  free(f.end);
   return st ? 0 : f.count;
 }
 
@@ -208,5 +242,6 @@ valo_status load_serialized(scene *s, const char *path, int shape_index, const f
   for (uint32_t i = shape_index < 0 ? 0 : (uint32_t)shape_index; !st && i < (shape_index < 0 ? f.count : (uint32_t)shape_index + 1); i++)
     st = ser_shape(s, &f, i, xf, mat, mesh_flags, err);
   free(f.b);
+  free(f.end);
   return st;
 }

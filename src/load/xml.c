@@ -7,17 +7,23 @@
 #include <string.h>
 
 #define XML_MAX_DEPTH 64
+#define XML_MAX_ATTRS 256 /* per element (the check for a repeated name is quadratic in it) */
 
 typedef struct {
   const char *path, *text, *p, *end;
   valo_error *err;
+  const char *mark; /* line_col's last position, with its line and column: the reader */
+  int mark_line, mark_col; /* moves forward, so counting goes on from there (linear time) */
 } xml_in;
 
-static void line_col(const xml_in *x, const char *at, int *line, int *col) {
-  *line = 1; *col = 1;
-  for (const char *q = x->text; q < at && q < x->end; q++) {
-    if (*q == '\n') { (*line)++; *col = 1; } else (*col)++;
+static void line_col(xml_in *x, const char *at, int *line, int *col) {
+  if (at < x->mark) { x->mark = x->text; x->mark_line = x->mark_col = 1; } /* behind the mark: count again */
+  int l = x->mark_line, c = x->mark_col;
+  const char *q = x->mark;
+  for (; q < at && q < x->end; q++) {
+    if (*q == '\n') { l++; c = 1; } else c++;
   }
+  x->mark = q; x->mark_line = *line = l; x->mark_col = *col = c;
 }
 
 static valo_status bad(xml_in *x, const char *at, const char *what) {
@@ -153,9 +159,12 @@ static valo_status read_element(xml_in *x, xml_node *parent, int depth, xml_node
     if (!an) return bad(x, x->p, "expected an attribute name, '>' or '/>'");
     for (int i = 0; i < n->nattrs; i++)
       if (!strcmp(n->attrs[i].name, an)) { free(an); return bad(x, at, "attribute given twice"); }
-    xml_attr *a = realloc(n->attrs, (size_t)(n->nattrs + 1) * sizeof *a);
-    if (!a) { free(an); return err_set(x->err, VALO_ERR_NOMEM, "out of memory"); }
-    n->attrs = a;
+    if (n->nattrs == XML_MAX_ATTRS) { free(an); return bad(x, at, "more than 256 attributes on one element"); }
+    xml_attr *a = n->attrs;
+    if (!(n->nattrs & (n->nattrs - 1))) { /* grown at 0, 1, 2, 4, ... */
+      if (!(a = realloc(n->attrs, (size_t)(n->nattrs ? 2 * n->nattrs : 1) * sizeof *a))) { free(an); return err_set(x->err, VALO_ERR_NOMEM, "out of memory"); }
+      n->attrs = a;
+    }
     a[n->nattrs].name = an;
     a[n->nattrs].value = NULL;
     n->nattrs++;
@@ -196,7 +205,7 @@ static valo_status read_element(xml_in *x, xml_node *parent, int depth, xml_node
 
 valo_status xml_parse(const char *path, const char *text, size_t len, xml_node **root, valo_error *err) {
   *root = NULL;
-  xml_in x = {path, text, text, text + len, err};
+  xml_in x = {path, text, text, text + len, err, text, 1, 1};
   if (len >= 3 && (unsigned char)text[0] == 0xef && (unsigned char)text[1] == 0xbb && (unsigned char)text[2] == 0xbf) x.p += 3;
   if (strlen(text) != len) return err_set(err, VALO_ERR_PARSE, "%s: contains a NUL byte: not an XML text file", path);
   valo_status st = skip_misc(&x, 1);
