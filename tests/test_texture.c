@@ -1810,8 +1810,10 @@ static int anisotropic_roughness(void) {
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
  * from 30 degrees off towards where the normal should tilt: 0.5 * 2 / pi (60 degrees
- * off if it tilted the other way: half that). T is +x for plain UVs, -x for mirrored UVs
- * (u -> 1 - u) and +y for the glTF quad, whose TANGENT attribute says +y. Within 1e-3. */
+ * off if it tilted the other way: half that), under Mitsuba's conventions times the
+ * shadowing term (0.99655 there). T is +x for plain UVs, -x for mirrored UVs (u -> 1 - u),
+ * and +y for the glTF quad read with map_style "tangents", whose TANGENT attribute says +y.
+ * Within 1e-3. */
 static int normal_map_shading(void) {
   allow_shading_loss(TILT_LOSS);
   unsigned char bytes[4 * 4 * 3];
@@ -1834,7 +1836,8 @@ static int normal_map_shading(void) {
   snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
   CHECK(stbi_write_png(dp, 4, 4, 4, dummy, 16), "png");
   CHECK(write_gltf_quad("nq_tangent.gltf", NULL, 0, "", 0) == 0, "write glTF");
-  const struct { const char *file; double tx, ty; } quads[3] = {{"nq_plain.obj", 1, 0}, {"nq_mirror.obj", -1, 0}, {"nq_tangent.gltf", 0, 1}};
+  const struct { const char *file; double tx, ty; const char *style; } quads[3] = {
+      {"nq_plain.obj", 1, 0, "mitsuba"}, {"nq_mirror.obj", -1, 0, "mitsuba"}, {"nq_tangent.gltf", 0, 1, "tangents"}};
   for (int q = 0; q < 3; q++)
     for (int tilted = 0; tilted < 2; tilted++) {
       /* light travelling down -z, or from 30 degrees towards the expected tilt */
@@ -1843,10 +1846,10 @@ static int normal_map_shading(void) {
       snprintf(json, sizeof json,
                "{ \"camera\": {\"position\": [0,0,4], \"look_at\": [0,0,0], \"up\": [0,1,0], \"fov\": 10}, \"film\": {\"width\": 8, \"height\": 8},\n"
                "  \"render\": {\"spp\": 1, \"max_depth\": 1},\n"
-               "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"normal_map\": \"tilt30.png\"}},\n"
+               "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, \"normal_map\": \"tilt30.png\", \"map_style\": \"%s\"}},\n"
                "  \"shapes\": [{\"file\": \"%s\", \"material\": \"m\"}],\n"
                "  \"lights\": [{\"type\": \"directional\", \"direction\": [%.9f, %.9f, %.9f], \"irradiance\": 2}] }\n",
-               quads[q].file, d[0], d[1], d[2]);
+               quads[q].style, quads[q].file, d[0], d[1], d[2]);
       int w, h;
       float *px = render_json_text(json, NULL, &w, &h);
       CHECK(px, "%s: render failed", quads[q].file);
@@ -1855,9 +1858,60 @@ static int normal_map_shading(void) {
       /* cos between the tilted normal (sin_t along T, cos_t along z) and the light */
       double cosl = -(sin_t * (quads[q].tx * d[0] + quads[q].ty * d[1]) + cos_t * d[2]);
       double want = 0.5 * 2 * cosl / M_PI;
+      if (!strcmp(quads[q].style, "mitsuba")) { /* the shadowing term for mapped normals (Conty Estevez et al. 2019) */
+        double a2 = fmin(0.125 * (sin_t * sin_t) / (cos_t * cos_t), 1), cl = -d[2];
+        want *= 2 / (1 + sqrt(1 + a2 * (1 - cl * cl) / (cl * cl)));
+      }
       fprintf(stderr, "%s, light %s: radiance %.5f, expected %.5f\n", quads[q].file, tilted ? "30 degrees off" : "along the normal", got, want);
       CHECK(fabs(got - want) <= 1e-3 * want, "%s: %.5f, expected %.5f", quads[q].file, got, want);
     }
+  return 0;
+}
+
+/* The glTF quad (its TANGENT along +v) under a JSON material, whose maps follow
+ * Mitsuba's conventions by default, renders as Mitsuba renders the same quad as OBJ
+ * (tests/data/mitsuba-maps, test_mitsuba maps_minimal_xml): a map tilting along v, one
+ * facing away from the viewer, a bump ramp, a twosided around the map seen from behind;
+ * image means within 0.5 %. */
+static int gltf_quad_mitsuba_maps(void) {
+  unsigned char dummy[64];
+  memset(dummy, 200, sizeof dummy);
+  char dp[1200];
+  snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
+  CHECK(stbi_write_png(dp, 4, 4, 4, dummy, 16), "png");
+  CHECK(write_gltf_quad("mq.gltf", NULL, 0, "", 0) == 0, "write glTF");
+#define MAPS VALO_SOURCE_DIR "/tests/data/mitsuba-maps/"
+  static const struct { const char *name, *map, *cam, *up, *light; } cases[] = {
+      {"tilt-v", "\"normal_map\": \"" MAPS "tilt-v.png\"", "0, 0, 4", "0, 1, 0", "0, -0.642788, -0.766044"},
+      {"tilt-away", "\"normal_map\": \"" MAPS "tilt-u.png\"", "-3.825200, 0, 1.169492", "0, 0, 1", "0, 0, -1"},
+      {"bump-u", "\"bump_map\": \"" MAPS "ramp-u.png\", \"bump_scale\": 4", "0, 0, 4", "0, 1, 0", "-0.642788, 0, -0.766044"},
+      {"back-mirror", "\"normal_map\": \"" MAPS "tilt-u.png\", \"map_back\": \"mirror\"", "1.5, 0, -4", "0, 1, 0", "0.5, 0, 0.866025"},
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+    char json[2048];
+    snprintf(json, sizeof json,
+             "{ \"camera\": {\"position\": [%s], \"look_at\": [0, 0, 0], \"up\": [%s], \"fov\": 8}, \"film\": {\"width\": 16, \"height\": 16},\n"
+             "  \"render\": {\"spp\": 16, \"max_depth\": 1},\n"
+             "  \"materials\": {\"m\": {\"type\": \"diffuse\", \"reflectance\": 0.5, %s}},\n"
+             "  \"shapes\": [{\"file\": \"mq.gltf\", \"material\": \"m\", \"transform\": {\"scale\": 4}}],\n"
+             "  \"lights\": [{\"type\": \"directional\", \"direction\": [%s], \"irradiance\": 2}] }\n",
+             cases[i].cam, cases[i].up, cases[i].map, cases[i].light);
+    int w, h;
+    float *px = render_json_text(json, NULL, &w, &h);
+    CHECK(px, "%s: render failed", cases[i].name);
+    char ref_path[1200];
+    snprintf(ref_path, sizeof ref_path, MAPS "%s-obj-mitsuba.exr", cases[i].name);
+    image ref;
+    valo_error err;
+    CHECK(image_read(ref_path, &ref, &err) == VALO_OK, "%s", err.message);
+    double a = 0, b = 0;
+    for (int k = 0; k < w * h * 3; k++) { a += px[k]; b += ref.rgb[k]; }
+    free(px);
+    image_free(&ref);
+    fprintf(stderr, "glTF quad, %s: mean %.5f, Mitsuba's OBJ quad %.5f\n", cases[i].name, a / (w * h * 3), b / (w * h * 3));
+    CHECK(fabs(a / b - 1) < 0.005, "%s: %.5f against Mitsuba's %.5f", cases[i].name, a / (w * h * 3), b / (w * h * 3));
+  }
+#undef MAPS
   return 0;
 }
 
@@ -1988,7 +2042,7 @@ static int brdf_closed_form(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"helmet_glb_texels", helmet_glb_texels}, {"helmet_gltf_texels", helmet_gltf_texels},
                                     {"wrap_modes", wrap_modes}, {"alpha_cutout", alpha_cutout},
-                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_metallic_roughness", gltf_metallic_roughness},
+                                    {"normal_map", normal_map}, {"bump_map", bump_map}, {"gltf_quad_mitsuba_maps", gltf_quad_mitsuba_maps}, {"gltf_metallic_roughness", gltf_metallic_roughness},
                                     {"phong_exponent_map", phong_exponent_map},
                                     {"stress_no_nan", stress_no_nan}, {"uv_orientation", uv_orientation},
                                     {"alpha_cutoff", alpha_cutoff}, {"opacity_stochastic", opacity_stochastic}, {"gltf_blend", gltf_blend}, {"blend_mixes", blend_mixes}, {"texture_objects", texture_objects}, {"sided_material", sided_material}, {"black_back_material", black_back_material}, {"vertex_colors", vertex_colors}, {"gltf_transmission", gltf_transmission}, {"gltf_texture_transform", gltf_texture_transform}, {"gltf_quantized", gltf_quantized}, {"gltf_draco", gltf_draco}, {"gltf_clearcoat_maps", gltf_clearcoat_maps}, {"gltf_pbr_extensions", gltf_pbr_extensions}, {"roughness_maps", roughness_maps}, {"anisotropic_roughness", anisotropic_roughness}, {"luminance_textures", luminance_textures},

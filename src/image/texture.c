@@ -188,3 +188,29 @@ void texture_lookup(const texture *t, float u, float v, float out[4]) {
   texture_texel(t, x0, y0 + 1, c); texture_texel(t, x0 + 1, y0 + 1, d);
   for (int k = 0; k < 4; k++) out[k] = (a[k] * (1 - fx) + b[k] * fx) * (1 - fy) + (c[k] * (1 - fx) + d[k] * fx) * fy;
 }
+
+void texture_gradient(const texture *t, float u, float v, const float w[3], float *du, float *dv) {
+  *du = *dv = 0;
+  if (t->smp.filter == TEX_NEAREST) return;
+  const float *m = t->smp.uvm;
+  float tu = u, tv = v;
+  if (t->smp.has_uvm) { tu = m[0] * u + m[1] * v + m[2]; tv = m[3] * u + m[4] * v + m[5]; }
+  if (!isfinite(tu) || !isfinite(tv)) return;
+  float x = tu * t->w - 0.5f, y = (1 - tv) * t->h - 0.5f;
+  float fx0 = floorf(x), fy0 = floorf(y);
+  if (fabsf(fx0) > 1e8f || fabsf(fy0) > 1e8f) return;
+  int x0 = (int)fx0, y0 = (int)fy0;
+  float fx = x - fx0, fy = y - fy0, px[4][4], f[4];
+  texture_texel(t, x0, y0, px[0]); texture_texel(t, x0 + 1, y0, px[1]);
+  texture_texel(t, x0, y0 + 1, px[2]); texture_texel(t, x0 + 1, y0 + 1, px[3]);
+  for (int k = 0; k < 4; k++) f[k] = w[0] * px[k][0] + w[1] * px[k][1] + w[2] * px[k][2];
+  float dfx = (f[1] - f[0]) * (1 - fy) + (f[3] - f[2]) * fy, dfy = (f[2] - f[0]) * (1 - fx) + (f[3] - f[1]) * fx;
+  float dtu = dfx * (float)t->w, dtv = -dfy * (float)t->h; /* y runs down the image as v runs up */
+  if (t->smp.has_uvm) {
+    *du = m[0] * dtu + m[3] * dtv;
+    *dv = m[1] * dtu + m[4] * dtv;
+  } else {
+    *du = dtu;
+    *dv = dtv;
+  }
+}

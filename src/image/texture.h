@@ -40,6 +40,10 @@ valo_status texture_checkerboard(texture *t, const float c0[3], const float c1[3
 void texture_free(texture *t);
 /* RGBA at (u, v), sampled as t->smp says. */
 void texture_lookup(const texture *t, float u, float v, float out[4]);
+/* The derivatives with respect to u and v of the bilinear lookup of w[0] r + w[1] g +
+ * w[2] b at (u, v), within the texel cell holding it, through the map of the texture
+ * coordinates (as Mitsuba's bitmap eval_1_grad); 0 for a nearest lookup. */
+void texture_gradient(const texture *t, float u, float v, const float w[3], float *du, float *dv);
 /* The texel (x, y) itself (x right, y down from the top row). */
 void texture_texel(const texture *t, int x, int y, float out[4]);
 #endif

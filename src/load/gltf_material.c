@@ -95,6 +95,7 @@ valo_status gltf_transmission(scene *s, const struct aiMaterial *am, int tex_tra
   blend.weight = w;
   blend.tex_weight = tex_trans; /* glTF's transmission texture: its red channel times the factor */
   blend.tex_normal = m->tex_normal; blend.tex_bump = m->tex_bump; blend.bump_scale = m->bump_scale;
+  blend.map_tangents = m->map_tangents;
   blend.tex_alpha = m->tex_alpha; blend.alpha_channel = m->alpha_channel; blend.alpha_cutoff = m->alpha_cutoff;
   blend.opacity = m->opacity; blend.alpha_stochastic = m->alpha_stochastic;
   memcpy(blend.name, m->name, sizeof blend.name);

@@ -172,6 +172,7 @@ static void convert_textures(scene *s, const struct aiScene *ai, const struct ai
   m->tex_ks = load_slot(s, ai, am, aiTextureType_SPECULAR, 0, dir, 1, NULL);
   m->tex_ns = load_slot(s, ai, am, aiTextureType_SHININESS, 0, dir, 0, NULL);
   m->tex_normal = load_slot(s, ai, am, aiTextureType_NORMALS, 0, dir, 0, NULL);
+  m->map_tangents = 1; /* maps in the mesh's tangents with their handedness, as glTF and most tools */
   /* MTL bump / map_bump (Assimp's HEIGHT slot) with its -bm multiplier. */
   int height = load_slot(s, ai, am, aiTextureType_HEIGHT, 0, dir, 0, NULL);
   if (height >= 0) {

@@ -197,22 +197,22 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   if (!type) return json_bad(c, where, "needs a \"type\" (diffuse, phong, mirror, dielectric, thindielectric, conductor, pbr, plastic, principled, blend, sided, null)");
   *m = material_default();
   snprintf(m->name, sizeof m->name, "%s", name);
-  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
-  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", NULL};
-  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "transmittance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
-  static const char *const k_thin[] = {"type", "ior", "transmittance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", NULL};
-  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
+  static const char *const k_diffuse[] = {"type", "reflectance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "map_style", "map_back", NULL};
+  static const char *const k_phong[] = {"type", "diffuse", "specular", "exponent", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "map_style", "map_back", NULL};
+  static const char *const k_mirror[] = {"type", "reflectance", "diffuse", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "map_style", "map_back", NULL};
+  static const char *const k_dielectric[] = {"type", "ior", "dispersion", "transmittance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "map_style", "map_back", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
+  static const char *const k_thin[] = {"type", "ior", "transmittance", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "map_style", "map_back", NULL};
+  static const char *const k_conductor[] = {"type", "preset", "eta", "k", "spectrum", "reflectance", "roughness", "roughness_u", "roughness_v", "distribution", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission", "two_sided", "black_back", "bump_map", "bump_scale", "map_style", "map_back", "roughness_map", "roughness_map_is_alpha", "smith", NULL};
   static const char *const k_plastic[] = {"type", "diffuse", "specular", "ior", "roughness", "distribution", "nonlinear", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                          "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "smith", NULL};
+                                          "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "map_style", "map_back", "smith", NULL};
   /* (a sided material takes the same keys but type, weight and weight_raw) */
   static const char *const k_blend[] = {"weight", "weight_raw", "type", "materials", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                        "bump_map", "bump_scale", NULL};
+                                        "bump_map", "bump_scale", "map_style", "map_back", NULL};
   static const char *const k_principled[] = {"type", "base_color", "metallic", "roughness", "specular", "ior", "spec_tint", "sheen", "sheen_tint", "flatness",
                                              "clearcoat", "clearcoat_gloss", "spec_trans", "anisotropic", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw",
-                                             "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
+                                             "emission", "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "map_style", "map_back", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   static const char *const k_pbr[] = {"type", "base_color", "metallic", "roughness", "ior", "specular", "specular_color", "clearcoat", "clearcoat_roughness", "clearcoat_map", "clearcoat_roughness_map", "sheen_color", "sheen_roughness", "sheen_map", "metallic_roughness_map", "normal_map", "alpha_map", "alpha_cutoff", "opacity", "opacity_raw", "emission",
-                                      "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
+                                      "two_sided", "black_back", "vertex_colors", "bump_map", "bump_scale", "map_style", "map_back", "roughness_map", "roughness_map_is_alpha", "metallic_map", NULL};
   if (!strcmp(type, "null")) {
     /* No surface at all: rays pass through (a medium's boundary); nothing else to set. */
     static const char *const k_null[] = {"type", NULL};
@@ -336,6 +336,16 @@ valo_status json_parse_material(jctx *c, const cJSON *o, const char *name, mater
   double bscale = 1;
   TRY(json_get_num(c, o, "bump_scale", where, -1e6, 1e6, &bscale));
   m->bump_scale = (float)bscale;
+  /* how normal and bump maps are read: Mitsuba 3's conventions (the default), or the mesh's
+   * tangents with their handedness (glTF's); seen from behind, the whole frame turned or
+   * only its normal (Mitsuba's twosided around the map) */
+  const char *style = "mitsuba", *back = "turn";
+  TRY(json_get_str(c, o, "map_style", where, &style));
+  if (strcmp(style, "mitsuba") && strcmp(style, "tangents")) return json_bad(c, where, "map_style must be \"mitsuba\" or \"tangents\"");
+  m->map_tangents = !strcmp(style, "tangents");
+  TRY(json_get_str(c, o, "map_back", where, &back));
+  if (strcmp(back, "turn") && strcmp(back, "mirror")) return json_bad(c, where, "map_back must be \"turn\" or \"mirror\"");
+  m->map_back_mirror = !strcmp(back, "mirror");
   double rough = m->roughness;
   TRY(json_get_num(c, o, "roughness", where, 0, 1, &rough));
   m->roughness = (float)rough;

@@ -211,6 +211,7 @@ static valo_status translate_one(mctx *c, xml_node *b, cJSON *m) {
     if (st) { cJSON_Delete(file); return st; }
     cJSON_AddItemToObject(m, normal ? "normal_map" : "bump_map", file);
     if (!normal) cJSON_AddNumberToObject(m, "bump_scale", scale);
+    if (c->twosided && !cJSON_GetObjectItemCaseSensitive(m, "map_back")) cJSON_AddStringToObject(m, "map_back", "mirror"); /* the twosided is around the map */
   } else if (!strcmp(type, "mask")) {
     /* Mitsuba's mask lets light through with probability 1 - opacity: valo's "opacity",
      * a number (Mitsuba's default 0.5) or a texture (a bitmap sRGB-decoded unless raw). */

@@ -211,7 +211,7 @@ static inline float phong_cos_alpha(vec3 wo, vec3 wi) {
   return v3_dot(r, wi);
 }
 
-rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+static rgb model_eval(const bsdf *b, vec3 wo, vec3 wi) {
   if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_eval(b, wo, wi);
   if (b->type == BSDF_PRINCIPLED) return principled_eval(b, wo, wi); /* it may transmit */
   if (wo.z <= 0 || wi.z <= 0) return c3(0, 0, 0);
@@ -237,7 +237,7 @@ rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
   return c3(0, 0, 0);
 }
 
-float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+static float model_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (b->type == BSDF_ROUGH_DIELECTRIC) return rd_pdf(b, wo, wi);
   if (b->type == BSDF_PRINCIPLED) return principled_pdf(b, wo, wi);
   if (wo.z <= 0 || wi.z <= 0) return 0;
@@ -268,7 +268,7 @@ static int sample_finite(bsdf_sample *s) {
   return 0;
 }
 
-int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
+static int model_sample(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
   s->delta = 0;
   s->nonfinite = 0;
   s->eta_scale = 1;
@@ -292,8 +292,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
       s->wi = sample_cosine_hemisphere(u1, u2);
     }
     if (s->wi.z <= 0) return 0; /* Phong lobe below the surface: rejected (digest 000) */
-    s->pdf = bsdf_pdf(b, wo, s->wi);
-    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
+    s->pdf = model_pdf(b, wo, s->wi);
+    s->weight = c3_scale(model_eval(b, wo, s->wi), s->wi.z / s->pdf);
     return sample_finite(s);
   }
   case BSDF_CONDUCTOR: {
@@ -354,8 +354,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
     vec3 wm = mfa_sample(b->beckmann, b->alpha, b->alpha_v, wo, u1, u2);
     s->wi = v3_reflect(wo, wm);
     if (s->wi.z <= 0) return 0;
-    s->pdf = bsdf_pdf(b, wo, s->wi);
-    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), s->wi.z / s->pdf);
+    s->pdf = model_pdf(b, wo, s->wi);
+    s->weight = c3_scale(model_eval(b, wo, s->wi), s->wi.z / s->pdf);
     return sample_finite(s);
   }
   case BSDF_ROUGH_DIELECTRIC: {
@@ -377,8 +377,8 @@ int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsd
       if (s->wi.z * wo.z >= 0) return 0;
       s->eta_scale = 1 / (etap * etap);
     }
-    s->pdf = bsdf_pdf(b, wo, s->wi);
-    s->weight = c3_scale(bsdf_eval(b, wo, s->wi), fabsf(s->wi.z) / s->pdf);
+    s->pdf = model_pdf(b, wo, s->wi);
+    s->weight = c3_scale(model_eval(b, wo, s->wi), fabsf(s->wi.z) / s->pdf);
     return sample_finite(s);
   }
   }
@@ -397,4 +397,39 @@ rgb material_albedo(const material *m, float cos_o) {
   case MAT_NULL: case MAT_BLEND: break; /* a blend: hits see one of its materials */
   }
   return c3(0, 0, 0);
+}
+
+/* ---- mapped normals (Mitsuba 3's normalmap and bumpmap) ----
+ * With b->mapped the frame's normal is a mapped one and b->n0 is the surface's own shading
+ * normal in that frame. A direction wi counts only on the same side of both (else f and
+ * the pdf are 0), and f is multiplied by the shadowing term of Conty Estevez et al. 2019
+ * ("A Microfacet-Based Shadowing Function to Solve the Bump Terminator Problem"):
+ * G = 2 / (1 + sqrt(1 + a2 tan^2 theta_i)), a2 = min(0.125 tan^2 theta_n, 1), both angles
+ * from n0 (theta_n the mapped normal's), on wi alone (the light's side in a camera path). */
+static int map_sides_agree(const bsdf *b, vec3 wi) { return v3_dot(wi, b->n0) * wi.z > 0; }
+static float map_shadowing(const bsdf *b, vec3 wi) {
+  float cn = b->n0.z, ci = v3_dot(wi, b->n0);
+  float tn2 = fmaxf(1 - cn * cn, 0) / (cn * cn), ti2 = fmaxf(1 - ci * ci, 0) / (ci * ci);
+  float a2 = fminf(0.125f * tn2, 1);
+  float g = 2 / (1 + sqrtf(1 + a2 * ti2));
+  return isfinite(g) ? g : 0;
+}
+
+rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+  if (!b->mapped) return model_eval(b, wo, wi);
+  if (!map_sides_agree(b, wi)) return c3(0, 0, 0);
+  return c3_scale(model_eval(b, wo, wi), map_shadowing(b, wi));
+}
+
+float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+  if (!b->mapped) return model_pdf(b, wo, wi);
+  return map_sides_agree(b, wi) ? model_pdf(b, wo, wi) : 0;
+}
+
+int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
+  if (!model_sample(b, wo, ulobe, u1, u2, s)) return 0;
+  if (!b->mapped) return 1;
+  if (!map_sides_agree(b, s->wi)) return 0;
+  s->weight = c3_scale(s->weight, map_shadowing(b, s->wi));
+  return 1;
 }

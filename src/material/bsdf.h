@@ -40,6 +40,9 @@ typedef struct bsdf {
                          (it points into the material given to bsdf_from_material, which must outlive it) */
   rgb sh_color;       /* and its colour, alpha and max(colour) */
   float sh_alpha, sh_max;
+  int mapped;         /* the frame's normal is a normal or bump map's under Mitsuba's conventions
+                         (material.map_tangents 0): set by shading_frame, with */
+  vec3 n0;            /* the surface's own shading normal in the frame (bsdf.c, "mapped normals") */
 } bsdf;
 
 typedef struct bsdf_sample {
@@ -53,7 +56,9 @@ typedef struct bsdf_sample {
 } bsdf_sample;
 
 bsdf bsdf_from_material(const material *m);
-/* Non-delta part of f(wo, wi). */
+/* Non-delta part of f(wo, wi); with b->mapped, 0 where wi lies on different sides of the
+ * mapped and the surface's own normal, else times the shadowing term for mapped normals
+ * (the pdf and the samples likewise). */
 rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi);
 /* Density of bsdf_sample producing wi through a non-delta lobe. */
 float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi);

@@ -18,35 +18,97 @@ static int uv_derivatives(const scene *s, const uint32_t *ix, vec3 *dpdu, vec3 *
   return 1;
 }
 
-/* Bump mapping (Blinn 1978, as pbrt's BumpMap): the surface displaced along the
- * shading normal n by d(u,v) = scale * height(u,v) has tangents dp/du + d_u n and
- * dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is the new shading
- * normal. dp/du and dp/dv are the triangle's own UV derivatives, made orthogonal to n so
- * that a flat height map leaves n unchanged; d_u and d_v are central differences over
- * half a texel of the filtered map (after its map of the texture coordinates, if any),
- * so the slope of a bilinear linear ramp is exact. */
-static void apply_bump(const scene *s, isect *it, const uint32_t *ix) {
+/* Bump mapping (Blinn 1978, as pbrt's BumpMap and Mitsuba 3's bumpmap): the surface
+ * displaced along the shading normal n by d(u,v) = scale * height(u,v) has tangents
+ * dp/du + d_u n and dp/dv + d_v n (the d dn/du terms are dropped), whose cross product is
+ * the new normal, turned to the geometric normal's side. dp/du and dp/dv are the
+ * triangle's own UV derivatives, made orthogonal to n so that a flat height map leaves n
+ * unchanged. Under Mitsuba's conventions d_u and d_v are its bitmap's: the exact slope of
+ * the bilinear lookup in the texel cell of the hit (0 for a nearest lookup) of the texels'
+ * luminance; with the mesh's tangents (map_tangents) central differences over half a
+ * texel of the mean of RGB. Returns the bumped normal, or n. */
+static vec3 bump_normal(const scene *s, const isect *it, const uint32_t *ix, vec3 n) {
   const texture *tx = &s->tex[it->m->tex_bump];
   vec3 dpdu, dpdv;
-  if (!uv_derivatives(s, ix, &dpdu, &dpdv) || tx->w < 1 || tx->h < 1) return;
-  vec3 n = it->ns;
+  if (!uv_derivatives(s, ix, &dpdu, &dpdv) || tx->w < 1 || tx->h < 1) return n;
   dpdu = v3_sub(dpdu, v3_scale(n, v3_dot(n, dpdu)));
   dpdv = v3_sub(dpdv, v3_scale(n, v3_dot(n, dpdv)));
-  float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
-  if (tx->smp.has_uvm) { /* half a texel after the map of the texture coordinates */
-    float su = fmaxf(fabsf(tx->smp.uvm[0]) * tx->w, fabsf(tx->smp.uvm[3]) * tx->h), sv = fmaxf(fabsf(tx->smp.uvm[1]) * tx->w, fabsf(tx->smp.uvm[4]) * tx->h);
-    if (su > 1e-6f) hu = 0.5f / su;
-    if (sv > 1e-6f) hv = 0.5f / sv;
+  float d_u, d_v;
+  if (!it->m->map_tangents) {
+    static const float lum[3] = {0.212671f, 0.715160f, 0.072169f}; /* Mitsuba's luminance */
+    texture_gradient(tx, it->u, it->v, lum, &d_u, &d_v);
+    d_u *= it->m->bump_scale;
+    d_v *= it->m->bump_scale;
+  } else {
+    float hu = 0.5f / (float)tx->w, hv = 0.5f / (float)tx->h, px[4], a, b;
+    if (tx->smp.has_uvm) { /* half a texel after the map of the texture coordinates */
+      float su = fmaxf(fabsf(tx->smp.uvm[0]) * tx->w, fabsf(tx->smp.uvm[3]) * tx->h), sv = fmaxf(fabsf(tx->smp.uvm[1]) * tx->w, fabsf(tx->smp.uvm[4]) * tx->h);
+      if (su > 1e-6f) hu = 0.5f / su;
+      if (sv > 1e-6f) hv = 0.5f / sv;
+    }
+    texture_lookup(tx, it->u + hu, it->v, px); a = px[0] + px[1] + px[2];
+    texture_lookup(tx, it->u - hu, it->v, px); b = px[0] + px[1] + px[2];
+    d_u = it->m->bump_scale * (a - b) / (3 * 2 * hu);
+    texture_lookup(tx, it->u, it->v + hv, px); a = px[0] + px[1] + px[2];
+    texture_lookup(tx, it->u, it->v - hv, px); b = px[0] + px[1] + px[2];
+    d_v = it->m->bump_scale * (a - b) / (3 * 2 * hv);
   }
-  texture_lookup(tx, it->u + hu, it->v, px); a = px[0] + px[1] + px[2];
-  texture_lookup(tx, it->u - hu, it->v, px); b = px[0] + px[1] + px[2];
-  float d_u = it->m->bump_scale * (a - b) / (3 * 2 * hu);
-  texture_lookup(tx, it->u, it->v + hv, px); a = px[0] + px[1] + px[2];
-  texture_lookup(tx, it->u, it->v - hv, px); b = px[0] + px[1] + px[2];
-  float d_v = it->m->bump_scale * (a - b) / (3 * 2 * hv);
   vec3 nb = v3_cross(v3_add(dpdu, v3_scale(n, d_u)), v3_add(dpdv, v3_scale(n, d_v)));
-  if (v3_dot(nb, n) < 0) nb = v3_neg(nb);
-  if (v3_len2(nb) > 1e-30f && v3_finite(nb)) it->ns = v3_norm(nb);
+  if (v3_dot(nb, it->m->map_tangents ? n : it->ng) < 0) nb = v3_neg(nb);
+  return v3_len2(nb) > 1e-30f && v3_finite(nb) ? v3_norm(nb) : n;
+}
+
+/* A tangent-space normal map's normal: n = 2 rgb - 1 in the frame (T, B, N) at the hit.
+ * Mitsuba's frame (Mitsuba 3.9's SurfaceInteraction::initialize_sh_frame): T = the
+ * triangle's dp/du made orthogonal to N, B = N x T, whatever the handedness of the UVs;
+ * with map_tangents, T from the mesh's per-vertex tangents and B = w N x T, w their
+ * handedness (glTF's convention: B points along +v). Returns N when there is no frame. */
+static vec3 mapped_normal(const scene *s, const isect *it, const uint32_t *ix, vec3 N) {
+  vec3 T;
+  float w = 1;
+  if (!it->m->map_tangents) {
+    vec3 dpdu, dpdv;
+    if (!uv_derivatives(s, ix, &dpdu, &dpdv)) return N;
+    T = dpdu;
+  } else {
+    if (!s->tan) return N;
+    float b0 = 1 - it->b1 - it->b2;
+    const float *t0 = &s->tan[4 * ix[0]], *t1 = &s->tan[4 * ix[1]], *t2 = &s->tan[4 * ix[2]];
+    T = v3(b0 * t0[0] + it->b1 * t1[0] + it->b2 * t2[0], b0 * t0[1] + it->b1 * t1[1] + it->b2 * t2[1], b0 * t0[2] + it->b1 * t1[2] + it->b2 * t2[2]);
+    w = t0[3];
+  }
+  T = v3_sub(T, v3_scale(N, v3_dot(N, T)));
+  if (!(v3_len2(T) > 1e-12f) || !v3_finite(T)) return N;
+  T = v3_norm(T);
+  vec3 B = v3_scale(v3_cross(N, T), w);
+  float px[4];
+  texture_lookup(&s->tex[it->m->tex_normal], it->u, it->v, px);
+  vec3 n2 = v3_add(v3_add(v3_scale(T, 2 * px[0] - 1), v3_scale(B, 2 * px[1] - 1)), v3_scale(N, 2 * px[2] - 1));
+  return v3_len2(n2) > 1e-12f && v3_finite(n2) ? v3_norm(n2) : N;
+}
+
+/* The normal and bump maps of it's material applied to it->ns. Under Mitsuba's conventions
+ * (normalmap.cpp and bumpmap.cpp, flip_invalid_normals): seen from behind through a
+ * twosided around the map (map_back_mirror), the map's normal is mirrored in the tangent
+ * plane, as that twosided turns only the frame's n; then a mapped normal on the other side
+ * of the viewer wi than the surface's own normal has its tangential part mirrored, so the
+ * surface stays lit; it->n0 keeps the surface's own normal for the shadowing term. */
+static void apply_maps(const scene *s, const ray *r, isect *it, const uint32_t *ix) {
+  vec3 n0 = it->ns, n = n0;
+  if (it->m->tex_normal >= 0) n = mapped_normal(s, it, ix, n);
+  if (it->m->tex_bump >= 0) n = bump_normal(s, it, ix, n);
+  if (it->m->map_tangents) { it->ns = n; return; }
+  vec3 wi = v3_neg(r->d);
+  float side = v3_dot(wi, n0);
+  if (it->m->map_back_mirror && side < 0) { /* the map's frame is (s, t, -n0) */
+    n = v3_sub(n, v3_scale(n0, 2 * v3_dot(n, n0)));
+    n0 = v3_neg(n0);
+    side = -side;
+  }
+  if (side * v3_dot(wi, n) <= 0 && side != 0) n = v3_sub(v3_scale(n0, 2 * v3_dot(n, n0)), n);
+  it->ns = n;
+  it->n0 = n0;
+  it->mapped = 1;
 }
 
 /* The direction of increasing u on triangle ix (the UV derivative dp/du); without texture
@@ -102,24 +164,9 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
     it->u = b0 * s->uv[2 * ix[0]] + h->b1 * s->uv[2 * ix[1]] + h->b2 * s->uv[2 * ix[2]];
     it->v = b0 * s->uv[2 * ix[0] + 1] + h->b1 * s->uv[2 * ix[1] + 1] + h->b2 * s->uv[2 * ix[2] + 1];
   }
-  if (it->m->tex_normal >= 0 && s->tan && (s->tri_flags[h->tri] & TRI_HAS_UVS)) {
-    /* Tangent-space normal map: n = 2 rgb - 1 in the (T, B, N) frame at the hit. */
-    const float *t0 = &s->tan[4 * ix[0]], *t1 = &s->tan[4 * ix[1]], *t2 = &s->tan[4 * ix[2]];
-    vec3 T = v3(b0 * t0[0] + h->b1 * t1[0] + h->b2 * t2[0], b0 * t0[1] + h->b1 * t1[1] + h->b2 * t2[1],
-                b0 * t0[2] + h->b1 * t1[2] + h->b2 * t2[2]);
-    vec3 N = it->ns;
-    T = v3_sub(T, v3_scale(N, v3_dot(N, T)));
-    if (v3_len2(T) > 1e-12f) {
-      T = v3_norm(T);
-      vec3 B = v3_scale(v3_cross(N, T), t0[3]);
-      float px[4];
-      texture_lookup(&s->tex[it->m->tex_normal], it->u, it->v, px);
-      vec3 nm = v3(2 * px[0] - 1, 2 * px[1] - 1, 2 * px[2] - 1);
-      vec3 n2 = v3_add(v3_add(v3_scale(T, nm.x), v3_scale(B, nm.y)), v3_scale(N, nm.z));
-      if (v3_len2(n2) > 1e-12f && v3_finite(n2)) it->ns = v3_norm(n2);
-    }
-  }
-  if (it->m->tex_bump >= 0 && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_bump(s, it, ix);
+  it->mapped = 0;
+  it->n0 = it->ns;
+  if ((it->m->tex_normal >= 0 || it->m->tex_bump >= 0) && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_maps(s, r, it, ix);
   if (it->m->type == MAT_BLEND) it->m = blend_pick(s, r, it); /* after the blend's own maps */
   if (it->m->black_back && v3_dot(r->d, it->ng) > 0) it->m = &s->black;
   if (it->m->anisotropic) it->dpdu = surface_dpdu(s, it, ix);
@@ -163,11 +210,11 @@ static int material_has_smooth(const scene *s, const material *m, int depth) {
 }
 int surface_has_smooth(const scene *s, uint32_t t) { return material_has_smooth(s, &s->mats[s->tri_mat[t]], 0); }
 
-frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
-  vec3 ns = it->ns;
+frame shading_frame(isect *it, bsdf *b, vec3 wo) {
+  vec3 ns = it->ns, n0 = it->n0;
   if (!bsdf_transmits(b)) {
     if (v3_dot(it->ng, wo) < 0) it->ng = v3_neg(it->ng);
-    if (v3_dot(ns, wo) < 0) ns = v3_neg(ns);
+    if (v3_dot(ns, wo) < 0) { ns = v3_neg(ns); n0 = v3_neg(n0); }
   }
   frame f = frame_from_n(ns);
   if (bsdf_anisotropic(b)) { /* s along the surface's u direction (Gram-Schmidt against ns) */
@@ -177,6 +224,8 @@ frame shading_frame(isect *it, const bsdf *b, vec3 wo) {
       f.t = v3_cross(ns, f.s);
     }
   }
+  b->mapped = it->mapped;
+  if (it->mapped) b->n0 = frame_to_local(&f, n0);
   return f;
 }
 

@@ -18,6 +18,8 @@ typedef struct isect {
   uint32_t tri;
   const material *m;
   vec3 dpdu;          /* an anisotropic material's u direction at the hit (shading_frame's s) */
+  int mapped;         /* ns is a normal or bump map's under Mitsuba's conventions, and */
+  vec3 n0;            /* the surface's own (interpolated) shading normal */
 } isect;
 
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
@@ -28,8 +30,9 @@ bsdf bsdf_at(const scene *s, const isect *it);
 int surface_has_smooth(const scene *s, uint32_t t);
 static inline vec3 offset_origin_isect(const isect *it, vec3 d) { return offset_origin(it->p, it->perr, it->ng, d); }
 /* Shading frame at it for viewer direction wo, faced for opaque BSDFs (geometric normal
- * too); returns the frame and updates it->ng. */
-frame shading_frame(isect *it, const bsdf *b, vec3 wo);
+ * too); returns the frame and updates it->ng; gives b the surface's own normal in the
+ * frame when the frame's is a mapped one (bsdf.mapped). */
+frame shading_frame(isect *it, bsdf *b, vec3 wo);
 /* A ray leaving it in direction d, from an origin offset past its error bound. */
 static inline ray spawn_ray(const isect *it, vec3 d) {
   ray r;

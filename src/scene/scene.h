@@ -74,6 +74,13 @@ typedef struct material {
   int rough_is_alpha;
   int tex_metal;     /* multiplies metallic (mean of RGB, linear; MTL map_Pm), -1 = none */
   float bump_scale;  /* displacement in scene units = bump_scale * height */
+  int map_tangents;  /* normal and bump maps: 1, the mesh's per-vertex tangents with their
+                        handedness (glTF's TANGENT, else computed), as glTF asks; 0 (JSON's
+                        and Mitsuba's default), Mitsuba 3's conventions: the frame s = the
+                        triangle's dp/du, t = n x s, a mapped normal facing away from the
+                        viewer mirrored, and the shadowing term for mapped normals */
+  int map_back_mirror; /* Mitsuba's twosided around the map: seen from behind, the map's
+                          frame is (s, t, -n) (only n turned); else the whole frame turns */
   int alpha_channel; /* 1: cutout reads the texture's alpha channel, 0: its red channel */
   float alpha_cutoff;/* a hit counts where alpha >= cutoff */
   float opacity;     /* a hit counts with probability opacity (times tex_alpha's value when
