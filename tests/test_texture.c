@@ -1806,6 +1806,16 @@ static int anisotropic_roughness(void) {
   return 0;
 }
 
+/* write_gltf_quad's .gltf with a flat grey base-colour texture beside it. */
+static int write_plain_gltf_quad(const char *name) {
+  unsigned char grey[64];
+  memset(grey, 200, sizeof grey);
+  char dp[1200];
+  snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
+  if (!stbi_write_png(dp, 4, 4, 4, grey, 16)) return -1;
+  return write_gltf_quad(name, NULL, 0, "", 0);
+}
+
 /* Normal maps in shading: a map tilting the normal 30 degrees towards +T on a
  * diffuse quad (albedo 0.5) under a directional light of irradiance 2. Light along the
  * geometric normal: radiance 0.5 * 2 cos 30 / pi, whichever way the normal tilts; light
@@ -1830,12 +1840,7 @@ static int normal_map_shading(void) {
   CHECK(scratch_file("nq_plain.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n") &&
             scratch_file("nq_mirror.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nvt 1 0\nvt 0 0\nvt 0 1\nvt 1 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n"),
         "write");
-  unsigned char dummy[64];
-  memset(dummy, 200, sizeof dummy);
-  char dp[1200];
-  snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
-  CHECK(stbi_write_png(dp, 4, 4, 4, dummy, 16), "png");
-  CHECK(write_gltf_quad("nq_tangent.gltf", NULL, 0, "", 0) == 0, "write glTF");
+  CHECK(write_plain_gltf_quad("nq_tangent.gltf") == 0, "write glTF");
   const struct { const char *file; double tx, ty; const char *style; } quads[3] = {
       {"nq_plain.obj", 1, 0, "mitsuba"}, {"nq_mirror.obj", -1, 0, "mitsuba"}, {"nq_tangent.gltf", 0, 1, "tangents"}};
   for (int q = 0; q < 3; q++)
@@ -1874,12 +1879,7 @@ static int normal_map_shading(void) {
  * facing away from the viewer, a bump ramp, a twosided around the map seen from behind;
  * image means within 0.5 %. */
 static int gltf_quad_mitsuba_maps(void) {
-  unsigned char dummy[64];
-  memset(dummy, 200, sizeof dummy);
-  char dp[1200];
-  snprintf(dp, sizeof dp, "%s/quad-texture.png", scratch_dir());
-  CHECK(stbi_write_png(dp, 4, 4, 4, dummy, 16), "png");
-  CHECK(write_gltf_quad("mq.gltf", NULL, 0, "", 0) == 0, "write glTF");
+  CHECK(write_plain_gltf_quad("mq.gltf") == 0, "write glTF");
 #define MAPS VALO_SOURCE_DIR "/tests/data/mitsuba-maps/"
   static const struct { const char *name, *map, *cam, *up, *light; } cases[] = {
       {"tilt-v", "\"normal_map\": \"" MAPS "tilt-v.png\"", "0, 0, 4", "0, 1, 0", "0, -0.642788, -0.766044"},
