@@ -432,6 +432,11 @@ static int stats_json(void) {
   remove(js);
   EXPECT_FAIL(0, "render", obj, "-o", out, "--res", "64x48", "--spp", "6", "--threads", "2", "--stats-json", js);
   SAID("peak memory"); SAID(" MB; lost:"); NO_SANITIZER();
+  /* the summary and the stats say which ray backend ran (the kd-tree by default) */
+  const char *accel = "kdtree";
+  char built[64];
+  snprintf(built, sizeof built, " s (%s), render", accel);
+  SAID(built);
   FILE *f = fopen(js, "rb");
   CHECK(f != NULL, "no %s", js);
   char buf[8192];
@@ -446,7 +451,8 @@ static int stats_json(void) {
   int ok = spp == 6 && samples == 6 * 64 * 48 && rays >= samples && rs > 0 && fabs(rps - rays / rs) <= 1e-4 * rps &&
            json_num(o, "load_seconds") >= 0 && json_num(o, "build_seconds") >= 0 && peak > 64 * 48 * 12 && json_num(o, "width") == 64 &&
            json_num(o, "threads") == 2 && cJSON_IsString(status) && !strcmp(status->valuestring, "ok") && json_num(o, "exit_code") == 0 &&
-           cJSON_IsObject(lost) && cJSON_GetArraySize(lost) == VALO_LOSS_COUNT;
+           cJSON_IsObject(lost) && cJSON_GetArraySize(lost) == VALO_LOSS_COUNT &&
+           cJSON_IsString(cJSON_GetObjectItemCaseSensitive(o, "accel")) && !strcmp(cJSON_GetObjectItemCaseSensitive(o, "accel")->valuestring, accel);
   for (int k = 0; ok && k < VALO_LOSS_COUNT; k++) ok = json_num(lost, valo_loss_name(k)) == 0;
   cJSON_Delete(o);
   CHECK(ok, "stats disagree with the run:\n%s", buf);
@@ -454,6 +460,10 @@ static int stats_json(void) {
   char tmp[1300];
   snprintf(tmp, sizeof tmp, "ls %s | grep -c stats.json.tmp > /dev/null", scratch_dir());
   CHECK(system(tmp) != 0, "a temporary stats file was left");
+  if (test_embree()) {
+    EXPECT_FAIL(0, "render", obj, "-o", out, "--res", "8x8", "--spp", "1", "--accel", "embree");
+    SAID(" s (embree), render");
+  }
   EXPECT_FAIL(1, "render", obj, "-o", out, "--res", "8x8", "--stats-json", "/no/such/dir/s.json");
   SAID("/no/such/dir/s.json"); SAID("does not exist"); NOT_SAID("summary");
   EXPECT_FAIL(2, "render", obj, "--stats-json");

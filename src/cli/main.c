@@ -353,9 +353,9 @@ static int cmd_render(int argc, char **argv) {
         n += (size_t)snprintf(lost + n, sizeof lost - n, " (%.3g%% of surface samples)", 100.0 * (double)st.lost[k] / (double)st.surface_samples);
     }
     fprintf(stderr,
-            "valo: summary: %llu triangles; load %.2f s, build %.2f s, render %.2f s; %d spp; %.3g rays, %.2f Mrays/s; "
+            "valo: summary: %llu triangles; load %.2f s, build %.2f s (%s), render %.2f s; %d spp; %.3g rays, %.2f Mrays/s; "
             "peak memory %.0f MB; lost: %s\n",
-            (unsigned long long)st.triangles, load_s, st.build_seconds, st.render_seconds, st.spp_done, (double)st.rays,
+            (unsigned long long)st.triangles, load_s, st.build_seconds, st.accel, st.render_seconds, st.spp_done, (double)st.rays,
             st.render_seconds > 0 ? st.rays / st.render_seconds * 1e-6 : 0.0, (double)peak / 1048576.0, lost);
     valo_rank_stats k;
     for (int i = 0; valo_render_rank_stats(r, i, &k) == 0; i++)
