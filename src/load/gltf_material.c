@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "image/texture.h"
 #include "material/sheen.h"
+#include "core/grow.h"
 #include <assimp/material.h>
 #include <assimp/scene.h>
 #include <math.h>
@@ -44,7 +45,7 @@ static valo_status volume_medium(scene *s, const struct aiMaterial *am, const ch
   memset(&md, 0, sizeof md);
   md.sigma_a = c3(sa[0], sa[1], sa[2]);
   snprintf(md.name, sizeof md.name, "%.50s (volume)", where);
-  medium *q = realloc(s->media, (s->nmedia + 1) * sizeof *q);
+  medium *q = grow_for(s->media, s->nmedia, sizeof *q);
   if (!q) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   s->media = q;
   q[s->nmedia] = md;

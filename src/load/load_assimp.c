@@ -24,6 +24,7 @@
 #include "load/import_probe.h"
 #include "load/obj_check.h"
 #include "load/ply_check.h"
+#include "core/grow.h"
 #include <assimp/cfileio.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/texture.h>
@@ -576,7 +577,7 @@ valo_status load_mesh_cached(scene *s, const char *path, const float *xf12, uint
   if (cache) {
     /* kept for the file's next placement (a failed keep only costs a second import) */
     mesh_cache *mc = *cache ? *cache : calloc(1, sizeof *mc);
-    imported *e = mc ? realloc(mc->e, (size_t)(mc->n + 1) * sizeof *e) : NULL;
+    imported *e = mc ? grow_for(mc->e, (size_t)mc->n, sizeof *e) : NULL;
     if (mc) *cache = mc;
     if (e) {
       mc->e = e;

@@ -9,6 +9,7 @@
 #include "core/strutil.h"
 #include "load/serialized.h"
 #include "core/strmap.h"
+#include "core/grow.h"
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <limits.h>
@@ -279,7 +280,7 @@ static valo_status parse_shape(jctx *c, const cJSON *o, int index) {
   TRY(json_get_num(c, px, "spacing", w2, 1e-9, 1e9, &sp));
   TRY(json_get_num(c, px, "radius", w2, 1e-9, 1e9, &rad));
   TRY(json_get_num(c, px, "strength", w2, 0, 1e9, &m));
-  shape_ao *na = realloc(c->s->shape_ao, (c->s->nshape_ao + 1) * sizeof *na);
+  shape_ao *na = grow_for(c->s->shape_ao, c->s->nshape_ao, sizeof *na);
   if (!na) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   c->s->shape_ao = na;
   shape_ao sa = {first, c->s->ntris, (float)sp, (float)rad, (float)m};

@@ -8,6 +8,7 @@
 #include "material/plastic.h"
 #include "material/sheen.h"
 #include "image/texture.h"
+#include "core/grow.h"
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -104,7 +105,7 @@ static valo_status parse_nk_spectrum(jctx *c, const cJSON *o, const char *where0
       dst[a][i] = (float)v;
     }
   }
-  nk_curve *q = realloc(c->s->nk, (c->s->nnk + 1) * sizeof *q);
+  nk_curve *q = grow_for(c->s->nk, c->s->nnk, sizeof *q);
   if (!q) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   c->s->nk = q;
   q[c->s->nnk++] = cv;
@@ -453,7 +454,7 @@ valo_status json_parse_media(jctx *c, const cJSON *o) {
     m.g = (float)g;
     if (!c3_finite(m.sigma_a) || !c3_finite(m.sigma_s)) return json_bad(c, where, "sigma_a and sigma_s times scale must be finite");
     if (grid) TRY(parse_grid(c, e, where, &m));
-    medium *q = realloc(c->s->media, (c->s->nmedia + 1) * sizeof *q);
+    medium *q = grow_for(c->s->media, c->s->nmedia, sizeof *q);
     if (!q) { density_grid_free(m.grid); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
     c->s->media = q;
     q[c->s->nmedia++] = m;

@@ -10,6 +10,7 @@
 #include "load/mitsuba_internal.h"
 #include "core/error.h"
 #include "core/atomicfile.h"
+#include "core/grow.h"
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -218,7 +219,7 @@ static valo_status read_shape(mctx *c, xml_node *n) {
   cJSON *sh = cJSON_CreateObject();
   if (!sh) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   cJSON_AddItemToArray(c->shapes, sh);
-  const xml_node **l = realloc(c->shape_at, (size_t)(c->nshape_at + 1) * sizeof *l);
+  const xml_node **l = grow_for(c->shape_at, (size_t)c->nshape_at, sizeof *l);
   if (!l) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   c->shape_at = l;
   l[c->nshape_at++] = n;

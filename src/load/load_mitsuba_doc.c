@@ -5,6 +5,7 @@
 #include "load/load_json_internal.h"
 #include "load/mitsuba_internal.h"
 #include "core/error.h"
+#include "core/grow.h"
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -68,7 +69,7 @@ static valo_status read_path(mctx *c, const xml_node *parent, const xml_node *n)
     return st;
   }
   free(cand);
-  if (!(k = realloc(c->search, (size_t)(c->nsearch + 1) * sizeof *k))) { free(abs); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+  if (!(k = grow_for(c->search, (size_t)c->nsearch, sizeof *k))) { free(abs); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
   c->search = k;
   c->search[c->nsearch++] = abs;
   return VALO_OK;
@@ -96,7 +97,7 @@ static valo_status expand_includes(mctx *c, xml_node *parent, int depth) {
     if (strchr(f, '$')) return mi_bad(c, n, "a $parameter in an included file's name is not read");
     if (depth >= MI_INCLUDE_DEPTH) return mi_bad(c, n, "includes nested more than %d deep (does a file include itself?)", MI_INCLUDE_DEPTH);
     if (c->nincluded >= MI_INCLUDE_FILES) return mi_bad(c, n, "more than %d files included", MI_INCLUDE_FILES);
-    char *path = mi_resolve(c, f), **inc = realloc(c->included, (size_t)(c->nincluded + 1) * sizeof *inc);
+    char *path = mi_resolve(c, f), **inc = grow_for(c->included, (size_t)c->nincluded, sizeof *inc);
     if (inc) c->included = inc;
     if (!path || !inc) { free(path); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
     c->included[c->nincluded++] = path;

@@ -6,6 +6,7 @@
 #include "load/mitsuba_internal.h"
 #include "load/load_json_internal.h"
 #include "core/error.h"
+#include "core/grow.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -156,11 +157,9 @@ static valo_status translate_bsdf(mctx *c, xml_node *b, cJSON *m) {
   if (c->nbsdf_stack >= MI_BSDF_DEPTH) return mi_bad(c, b, "BSDFs nested more than %d deep through <ref>s", MI_BSDF_DEPTH);
   if (++c->bsdf_work > MI_BSDF_WORK)
     return mi_bad(c, b, "BSDFs that refer to others expand to more than %d translations (a chain whose links refer to the next twice?)", MI_BSDF_WORK);
-  if (!(c->nbsdf_stack & (c->nbsdf_stack - 1))) { /* grown at 0, 1, 2, 4, ... */
-    const xml_node **k = realloc(c->bsdf_stack, (size_t)(c->nbsdf_stack ? 2 * c->nbsdf_stack : 1) * sizeof *k);
-    if (!k) return NOMEM;
-    c->bsdf_stack = k;
-  }
+  const xml_node **k = grow_for(c->bsdf_stack, (size_t)c->nbsdf_stack, sizeof *k);
+  if (!k) return NOMEM;
+  c->bsdf_stack = k;
   c->bsdf_stack[c->nbsdf_stack++] = b;
   valo_status st = translate_one(c, b, m);
   c->nbsdf_stack--;
@@ -420,7 +419,7 @@ valo_status mi_material(mctx *c, xml_node *b, cJSON *emit, const xml_node *at, c
   }
   TRY(add_material(c, m, name));
   if (b && id && !emit && !c->twosided) {
-    void *q = realloc(c->bsdf_names, (size_t)(c->nbsdf_names + 1) * sizeof *c->bsdf_names);
+    void *q = grow_for(c->bsdf_names, (size_t)c->nbsdf_names, sizeof *c->bsdf_names);
     if (!q) return NOMEM;
     c->bsdf_names = q;
     c->bsdf_names[c->nbsdf_names].id = id;
@@ -503,7 +502,7 @@ valo_status mi_emitter(mctx *c, xml_node *e) {
   cJSON *l = cJSON_CreateObject();
   if (!l) return NOMEM;
   cJSON_AddItemToArray(c->lights, l);
-  const xml_node **ln = realloc(c->light_at, (size_t)(c->nlight_at + 1) * sizeof *ln);
+  const xml_node **ln = grow_for(c->light_at, (size_t)c->nlight_at, sizeof *ln);
   if (!ln) return NOMEM;
   c->light_at = ln;
   ln[c->nlight_at++] = e;

@@ -6,6 +6,7 @@
 #include "load/load_json_internal.h"
 #include "core/error.h"
 #include "core/spectrum.h"
+#include "core/grow.h"
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -61,7 +62,7 @@ const char *mi_found(mctx *c, const char *name) {
   int nomem;
   char *p = in_search(c, name, &nomem), **k;
   if (!p) return nomem ? NULL : name;
-  if (!(k = realloc(c->found, (size_t)(c->nfound + 1) * sizeof *k))) { free(p); return NULL; }
+  if (!(k = grow_for(c->found, (size_t)c->nfound, sizeof *k))) { free(p); return NULL; }
   c->found = k;
   return c->found[c->nfound++] = p;
 }

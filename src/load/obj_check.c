@@ -2,6 +2,7 @@
  * reads the MTL files, the second checks each line and writes the repaired text. */
 #include "load/obj_check.h"
 #include "core/error.h"
+#include "core/grow.h"
 #include <assimp/cfileio.h>
 #include <ctype.h>
 #include <errno.h>
@@ -182,7 +183,7 @@ static valo_status read_mtl(obj_check *oc, const char *path, const char *obj_pat
     int nt = tokens(s, e, tb, te, 8);
     if (nt == 0 || *tb[0] == '#') { ob_put(&o, s, (size_t)(next - s)); continue; }
     if (tok_is(tb[0], te[0], "newmtl") && nt >= 2) {
-      mtl_pbr *np = realloc(oc->pbr, (size_t)(oc->npbr + 1) * sizeof *np);
+      mtl_pbr *np = grow_for(oc->pbr, (size_t)oc->npbr, sizeof *np);
       if (!np) { free(txt); free(o.p); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
       oc->pbr = np;
       cur = &oc->pbr[oc->npbr++];

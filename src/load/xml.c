@@ -2,6 +2,7 @@
  * XML_MAX_DEPTH is an error, so no input can exhaust the stack. */
 #include "load/xml.h"
 #include "core/error.h"
+#include "core/grow.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,11 +161,9 @@ static valo_status read_element(xml_in *x, xml_node *parent, int depth, xml_node
     for (int i = 0; i < n->nattrs; i++)
       if (!strcmp(n->attrs[i].name, an)) { free(an); return bad(x, at, "attribute given twice"); }
     if (n->nattrs == XML_MAX_ATTRS) { free(an); return bad(x, at, "more than 256 attributes on one element"); }
-    xml_attr *a = n->attrs;
-    if (!(n->nattrs & (n->nattrs - 1))) { /* grown at 0, 1, 2, 4, ... */
-      if (!(a = realloc(n->attrs, (size_t)(n->nattrs ? 2 * n->nattrs : 1) * sizeof *a))) { free(an); return err_set(x->err, VALO_ERR_NOMEM, "out of memory"); }
-      n->attrs = a;
-    }
+    xml_attr *a = grow_for(n->attrs, (size_t)n->nattrs, sizeof *a);
+    if (!a) { free(an); return err_set(x->err, VALO_ERR_NOMEM, "out of memory"); }
+    n->attrs = a;
     a[n->nattrs].name = an;
     a[n->nattrs].value = NULL;
     n->nattrs++;

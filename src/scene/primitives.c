@@ -4,6 +4,7 @@
 #include "scene/scene.h"
 #include "core/error.h"
 #include "core/mat34.h"
+#include "core/grow.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,7 +71,7 @@ valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, in
                                {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
   uint32_t nf = 20u << (2 * subdiv);
   vec3 *tris = malloc((size_t)nf * 3 * sizeof(vec3)), *tmp = malloc((size_t)nf * 3 * sizeof(vec3));
-  sphere_shape *sps = realloc(s->spheres, (s->nspheres + 1) * sizeof *sps);
+  sphere_shape *sps = grow_for(s->spheres, s->nspheres, sizeof *sps);
   if (sps) s->spheres = sps;
   if (!sps || !tris || !tmp || scene_reserve(s, nf * 3, nf)) { free(tris); free(tmp); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
   sphere_shape sp = {c, r, s->ntris, s->ntris + nf, flip, 0, 0, 0, {0}};

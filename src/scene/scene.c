@@ -6,6 +6,7 @@
 #include "scene/envmap.h"
 #include "scene/volume.h"
 #include "image/texture.h"
+#include "core/grow.h"
 #include <stdlib.h>
 #include <string.h>
 #include <stdio.h>
@@ -91,7 +92,7 @@ material material_default(void) {
 }
 
 int scene_add_shape_media(scene *s, uint32_t first, int32_t interior, int32_t exterior) {
-  shape_media *q = realloc(s->shape_media, (s->nshape_media + 1) * sizeof *q);
+  shape_media *q = grow_for(s->shape_media, s->nshape_media, sizeof *q);
   if (!q) return -1;
   s->shape_media = q;
   q[s->nshape_media++] = (shape_media){first, s->ntris, interior, exterior};
