@@ -60,7 +60,7 @@ typedef struct valo_options {
                              another integrator are ignored. The scene file's come first,
                              then these (later entries win). Unknown or out-of-range
                              names make valo_render_create fail, naming them. */
-  char accel[16];         /* "kdtree" (default) or "embree" */
+  char accel[16];         /* "embree" (the default where valo was built with Embree 3) or "kdtree" */
   char sampler[16];       /* "sobol" (default: Owen-scrambled Sobol, padded per dimension)
                              or "independent" (a hash per sample and dimension) */
   char light_sampler[16]; /* how next-event estimation picks a light in scenes with more

@@ -1,17 +1,58 @@
 /* embree.c — owns the Embree 3 backend behind accel.h: one triangle geometry with its own
- * vertex/index buffers, robust (watertight) scene flag, rtcIntersect1/rtcOccluded1. */
+ * vertex/index buffers, robust (watertight) scene flag, rtcIntersect1/rtcOccluded1. Every
+ * candidate hit Embree finds is tested again by valo's own watertight test
+ * (geometry/triangle.h, the kd-tree's), whose error valo's offset ray origins are made
+ * for: Embree's own test, less precise on large triangles, let a ray find the surface it
+ * leaves (ambient occlusion of a floor 200 units wide: 1.6 % of rays, 2 000 wide: 44 %).
+ * The hit reported is that test's t and barycentrics, so both backends shade a hit alike. */
 #include "geometry/accel.h"
+#include "geometry/triangle.h"
 #include "core/error.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #ifdef VALO_HAVE_EMBREE
 #include <embree3/rtcore.h>
 
-typedef struct embree_accel { accel base; RTCDevice dev; RTCScene scn; accel_filter filter; } embree_accel;
+struct embree_accel {
+  accel base;
+  RTCDevice dev;
+  RTCScene scn;
+  accel_filter filter; /* alpha: filter.pass NULL when no triangle needs it */
+  const float *vb;     /* the geometry's own vertex and index buffers (the second test) */
+  const unsigned *ib;
+};
 
-/* Intersection and occlusion filter: rejects hits the alpha test discards. */
-static void em_filter(const struct RTCFilterFunctionNArguments *args) {
+/* A query's context: Embree's first, so that a filter can reach the rest. */
+typedef struct embree_accel embree_accel;
+typedef struct em_query {
+  struct RTCIntersectContext ctx;
+  const embree_accel *e;
+  ray_shear sh;
+  vec3 o, d;
+  float tmax;
+} em_query;
+
+static void em_corners(const embree_accel *e, unsigned prim, float v[9]) {
+  for (int k = 0; k < 3; k++) memcpy(&v[3 * k], &e->vb[3 * (size_t)e->ib[3 * (size_t)prim + k]], 3 * sizeof(float));
+}
+
+/* 1 when the ray from o along d meets the plane of triangle v behind its origin or not at
+ * all (in double): a hit Embree finds there but valo's test does not is the surface the
+ * ray leaves. Where the plane lies ahead, the two tests differ on an edge between two
+ * triangles (each watertight, by its own rules), and Embree's hit stands. */
+static int em_left(const float v[9], vec3 o, vec3 d) {
+  double e1[3], e2[3], n[3];
+  for (int k = 0; k < 3; k++) { e1[k] = (double)v[3 + k] - v[k]; e2[k] = (double)v[6 + k] - v[k]; }
+  n[0] = e1[1] * e2[2] - e1[2] * e2[1]; n[1] = e1[2] * e2[0] - e1[0] * e2[2]; n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  double nd = n[0] * d.x + n[1] * d.y + n[2] * d.z, nw = n[0] * ((double)v[0] - o.x) + n[1] * ((double)v[1] - o.y) + n[2] * ((double)v[2] - o.z);
+  return !(nd != 0 && nw / nd > 0);
+}
+
+/* The alpha test (a geometry filter, set when a triangle needs it): rejects the hits it
+ * discards. */
+static void em_alpha(const struct RTCFilterFunctionNArguments *args) {
   const embree_accel *e = args->geometryUserPtr;
   for (unsigned i = 0; i < args->N; i++) {
     if (args->valid[i] != -1) continue;
@@ -29,29 +70,63 @@ static void em_filter(const struct RTCFilterFunctionNArguments *args) {
   }
 }
 
+/* Occlusion queries' context filter: drops a candidate valo's test does not find that
+ * lies on the surface the ray leaves (em_left). */
+static void em_verify(const struct RTCFilterFunctionNArguments *args) {
+  const em_query *q = (const em_query *)args->context;
+  for (unsigned i = 0; i < args->N; i++) {
+    if (args->valid[i] != -1) continue;
+    unsigned prim = ((const unsigned *)args->hit)[5 * args->N + i];
+    float v[9], t, b1, b2;
+    em_corners(q->e, prim, v);
+    if (!tri_intersect(&q->sh, v, q->tmax, &t, &b1, &b2) && em_left(v, q->o, q->d)) args->valid[i] = 0;
+  }
+}
+
+/* The closest hit: Embree's, tested again by valo's test. Where that test does not find
+ * it and the ray does not even cross the triangle's plane ahead (Embree's error on a large
+ * triangle exceeds valo's offset: the surface the ray leaves), the query goes on past it
+ * (at most four times); where the two tests disagree on an edge, Embree's hit stands. */
 static int em_intersect(const accel *a, const ray *r, hit *h) {
   const embree_accel *e = (const embree_accel *)a;
-  struct RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  struct RTCRayHit rh;
-  rh.ray.org_x = r->o.x; rh.ray.org_y = r->o.y; rh.ray.org_z = r->o.z;
-  rh.ray.dir_x = r->d.x; rh.ray.dir_y = r->d.y; rh.ray.dir_z = r->d.z;
-  rh.ray.tnear = 0; rh.ray.tfar = r->tmax; rh.ray.time = 0; rh.ray.mask = 0xFFFFFFFF; rh.ray.id = 0; rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID; rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(e->scn, &ctx, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(rh.ray.tfar > 0)) return 0;
-  h->t = rh.ray.tfar; h->b1 = rh.hit.u; h->b2 = rh.hit.v; h->tri = rh.hit.primID;
-  return 1;
+  em_query q;
+  rtcInitIntersectContext(&q.ctx);
+  q.sh = ray_shear_make(r->o, r->d);
+  q.tmax = r->tmax;
+  q.e = e;
+  float tnear = 0;
+  for (int tries = 0; tries < 4; tries++) {
+    struct RTCRayHit rh;
+    rh.ray.org_x = r->o.x; rh.ray.org_y = r->o.y; rh.ray.org_z = r->o.z;
+    rh.ray.dir_x = r->d.x; rh.ray.dir_y = r->d.y; rh.ray.dir_z = r->d.z;
+    rh.ray.tnear = tnear; rh.ray.tfar = r->tmax; rh.ray.time = 0; rh.ray.mask = 0xFFFFFFFF; rh.ray.id = 0; rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID; rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(e->scn, &q.ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || !(rh.ray.tfar > 0)) return 0;
+    h->t = rh.ray.tfar; h->b1 = rh.hit.u; h->b2 = rh.hit.v; h->tri = rh.hit.primID;
+    float v[9];
+    em_corners(e, rh.hit.primID, v);
+    if (tri_intersect(&q.sh, v, q.tmax, &h->t, &h->b1, &h->b2)) return 1; /* valo's own numbers */
+    if (!em_left(v, r->o, r->d)) return 1; /* the tests differ on an edge: Embree's hit stands */
+    tnear = nextafterf(rh.ray.tfar, INFINITY);
+  }
+  return 0;
 }
 static int em_occluded(const accel *a, const ray *r) {
   const embree_accel *e = (const embree_accel *)a;
-  struct RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
+  em_query q;
+  rtcInitIntersectContext(&q.ctx);
+  q.sh = ray_shear_make(r->o, r->d);
+  q.tmax = r->tmax;
+  q.o = r->o;
+  q.d = r->d;
+  q.e = e;
+  q.ctx.filter = em_verify;
   struct RTCRay ry;
   ry.org_x = r->o.x; ry.org_y = r->o.y; ry.org_z = r->o.z;
   ry.dir_x = r->d.x; ry.dir_y = r->d.y; ry.dir_z = r->d.z;
   ry.tnear = 0; ry.tfar = r->tmax; ry.time = 0; ry.mask = 0xFFFFFFFF; ry.id = 0; ry.flags = 0;
-  rtcOccluded1(e->scn, &ctx, &ry);
+  rtcOccluded1(e->scn, &q.ctx, &ry);
   return ry.tfar < 0;
 }
 static void em_destroy(accel *a) {
@@ -74,7 +149,7 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   e->dev = rtcNewDevice(NULL);
   if (!e->dev) { free(e); return err_set(err, VALO_ERR_UNSUPPORTED, "embree: cannot create a device"); }
   e->scn = rtcNewScene(e->dev);
-  rtcSetSceneFlags(e->scn, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneFlags(e->scn, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
   if (ntris > 0) {
     /* Vertices: one per triangle corner would waste memory; share the indexed set. */
     uint32_t maxv = 0;
@@ -85,11 +160,13 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
     if (!vb || !ib) { rtcReleaseGeometry(g); em_destroy(&e->base); return err_set(err, VALO_ERR_NOMEM, "embree: out of memory"); }
     for (uint32_t i = 0; i < maxv; i++) { vb[3 * i] = pos[i].x; vb[3 * i + 1] = pos[i].y; vb[3 * i + 2] = pos[i].z; }
     memcpy(ib, idx, (size_t)ntris * 3 * sizeof(unsigned));
-    if (filter && filter->pass && filter->tri_flags) {
-      e->filter = *filter;
+    if (filter && filter->pass && filter->tri_flags) e->filter = *filter;
+    e->vb = vb;
+    e->ib = ib;
+    if (e->filter.pass) {
       rtcSetGeometryUserData(g, e);
-      rtcSetGeometryIntersectFilterFunction(g, em_filter);
-      rtcSetGeometryOccludedFilterFunction(g, em_filter);
+      rtcSetGeometryIntersectFilterFunction(g, em_alpha);
+      rtcSetGeometryOccludedFilterFunction(g, em_alpha);
     }
     rtcCommitGeometry(g);
     rtcAttachGeometry(e->scn, g);
