@@ -164,48 +164,55 @@ void texture_texel(const texture *t, int x, int y, float out[4]) {
   memcpy(out, &t->px[4 * ((size_t)y * t->w + x)], 4 * sizeof(float));
 }
 
-void texture_lookup(const texture *t, float u, float v, float out[4]) {
+/* (u, v) through the map of the texture coordinates; (0, 0), returning 0, when it is not
+ * finite. */
+static int mapped_uv(const texture *t, float *u, float *v) {
   if (t->smp.has_uvm) {
-    float tu = t->smp.uvm[0] * u + t->smp.uvm[1] * v + t->smp.uvm[2];
-    v = t->smp.uvm[3] * u + t->smp.uvm[4] * v + t->smp.uvm[5];
-    u = tu;
+    float tu = t->smp.uvm[0] * *u + t->smp.uvm[1] * *v + t->smp.uvm[2];
+    *v = t->smp.uvm[3] * *u + t->smp.uvm[4] * *v + t->smp.uvm[5];
+    *u = tu;
   }
-  if (!isfinite(u) || !isfinite(v)) { u = 0; v = 0; }
+  if (isfinite(*u) && isfinite(*v)) return 1;
+  *u = *v = 0;
+  return 0;
+}
+
+/* The bilinear cell of mapped (u, v): its four texels a b / c d (a top-left) and the
+ * weights fx, fy of the right and lower ones. Texel centres sit at (x + 0.5)/w; v = 0 is
+ * the bottom row. */
+static void bilinear_cell(const texture *t, float u, float v, float px[4][4], float *fx, float *fy) {
+  float x = u * t->w - 0.5f, y = (1 - v) * t->h - 0.5f;
+  float fx0 = floorf(x), fy0 = floorf(y);
+  if (fabsf(fx0) > 1e8f || fabsf(fy0) > 1e8f) { fx0 = 0; fy0 = 0; }
+  int x0 = (int)fx0, y0 = (int)fy0;
+  *fx = x - fx0;
+  *fy = y - fy0;
+  texture_texel(t, x0, y0, px[0]); texture_texel(t, x0 + 1, y0, px[1]);
+  texture_texel(t, x0, y0 + 1, px[2]); texture_texel(t, x0 + 1, y0 + 1, px[3]);
+}
+
+void texture_lookup(const texture *t, float u, float v, float out[4]) {
+  mapped_uv(t, &u, &v);
   if (t->smp.filter == TEX_NEAREST) {
     float fx = floorf(u * t->w), fy = floorf((1 - v) * t->h);
     if (fabsf(fx) > 1e8f || fabsf(fy) > 1e8f) { fx = 0; fy = 0; }
     texture_texel(t, (int)fx, (int)fy, out);
     return;
   }
-  /* Texel centres sit at (x + 0.5)/w; v = 0 is the bottom row. */
-  float x = u * t->w - 0.5f, y = (1 - v) * t->h - 0.5f;
-  float fx0 = floorf(x), fy0 = floorf(y);
-  if (fabsf(fx0) > 1e8f || fabsf(fy0) > 1e8f) { fx0 = 0; fy0 = 0; }
-  int x0 = (int)fx0, y0 = (int)fy0;
-  float fx = x - fx0, fy = y - fy0;
-  float a[4], b[4], c[4], d[4];
-  texture_texel(t, x0, y0, a); texture_texel(t, x0 + 1, y0, b);
-  texture_texel(t, x0, y0 + 1, c); texture_texel(t, x0 + 1, y0 + 1, d);
-  for (int k = 0; k < 4; k++) out[k] = (a[k] * (1 - fx) + b[k] * fx) * (1 - fy) + (c[k] * (1 - fx) + d[k] * fx) * fy;
+  float px[4][4], fx, fy;
+  bilinear_cell(t, u, v, px, &fx, &fy);
+  for (int k = 0; k < 4; k++) out[k] = (px[0][k] * (1 - fx) + px[1][k] * fx) * (1 - fy) + (px[2][k] * (1 - fx) + px[3][k] * fx) * fy;
 }
 
 void texture_gradient(const texture *t, float u, float v, const float w[3], float *du, float *dv) {
   *du = *dv = 0;
-  if (t->smp.filter == TEX_NEAREST) return;
-  const float *m = t->smp.uvm;
-  float tu = u, tv = v;
-  if (t->smp.has_uvm) { tu = m[0] * u + m[1] * v + m[2]; tv = m[3] * u + m[4] * v + m[5]; }
-  if (!isfinite(tu) || !isfinite(tv)) return;
-  float x = tu * t->w - 0.5f, y = (1 - tv) * t->h - 0.5f;
-  float fx0 = floorf(x), fy0 = floorf(y);
-  if (fabsf(fx0) > 1e8f || fabsf(fy0) > 1e8f) return;
-  int x0 = (int)fx0, y0 = (int)fy0;
-  float fx = x - fx0, fy = y - fy0, px[4][4], f[4];
-  texture_texel(t, x0, y0, px[0]); texture_texel(t, x0 + 1, y0, px[1]);
-  texture_texel(t, x0, y0 + 1, px[2]); texture_texel(t, x0 + 1, y0 + 1, px[3]);
+  if (t->smp.filter == TEX_NEAREST || !mapped_uv(t, &u, &v)) return;
+  float px[4][4], f[4], fx, fy;
+  bilinear_cell(t, u, v, px, &fx, &fy);
   for (int k = 0; k < 4; k++) f[k] = w[0] * px[k][0] + w[1] * px[k][1] + w[2] * px[k][2];
   float dfx = (f[1] - f[0]) * (1 - fy) + (f[3] - f[2]) * fy, dfy = (f[2] - f[0]) * (1 - fx) + (f[3] - f[1]) * fx;
   float dtu = dfx * (float)t->w, dtv = -dfy * (float)t->h; /* y runs down the image as v runs up */
+  const float *m = t->smp.uvm;
   if (t->smp.has_uvm) {
     *du = m[0] * dtu + m[3] * dtv;
     *dv = m[1] * dtu + m[4] * dtv;
