@@ -118,7 +118,7 @@ static void breakdown(const char *json_path, int w, int h, double *t_splat, doub
   *t_build = bench_now() - t0;
   *npts = sp.n_pts;
   accel *acc;
-  accel_create("kdtree", s->pos, s->idx, s->ntris, 2, NULL, &acc, &err);
+  accel_create("kdtree", s->pos, s->cap_verts, s->idx, s->ntris, 2, NULL, &acc, &err);
   camera c = scene_camera_fit(s, (float)w / (float)h);
   vec3 fwd = v3_norm(v3_sub(c.look_at, c.pos)), right = v3_norm(v3_cross(fwd, c.up)), up = v3_cross(right, fwd);
   float th = tanf(0.5f * c.fov_deg * 3.14159265f / 180), asp = (float)w / (float)h;

@@ -219,7 +219,7 @@ static void bench_scene(const char *name, scene *s) {
     for (int k = 0; k < 2; k++) {
       accel_destroy(acc[k]);
       double t0 = bench_now();
-      if (accel_create(kinds[k], s->pos, s->idx, s->ntris, 2, NULL, &acc[k], &err)) { fprintf(stderr, "%s\n", err.message); acc[k] = NULL; }
+      if (accel_create(kinds[k], s->pos, s->cap_verts, s->idx, s->ntris, 2, NULL, &acc[k], &err)) { fprintf(stderr, "%s\n", err.message); acc[k] = NULL; }
       double dt = bench_now() - t0;
       build[k] = dt < build[k] ? dt : build[k];
     }

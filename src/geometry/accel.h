@@ -49,11 +49,14 @@ typedef struct accel_filter {
   uint8_t flag_bit;
 } accel_filter;
 
-/* kind: "kdtree" or "embree". Triangles are given as indexed vertices; the structure
- * keeps its own copy. threads: used by builders that can use them (the kd-tree's build
+/* kind: "kdtree" or "embree". Triangles are given as indexed vertices, npos of them
+ * readable at pos. The kd-tree keeps its own copy; Embree shares pos and idx (they must
+ * outlive the structure) when at least one vertex past the highest one the triangles use
+ * is readable (Embree reads each vertex with a 16-byte load; scene_commit keeps a spare),
+ * else it copies them. Sharing means a hit's corners are in cache when it is shaded. threads: used by builders that can use them (the kd-tree's build
  * gives the same tree for any count; <= 0: all). filter: NULL or one that outlives the
  * structure. */
-valo_status accel_create(const char *kind, const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads,
+valo_status accel_create(const char *kind, const vec3 *pos, uint32_t npos, const uint32_t *idx, uint32_t ntris, int threads,
                          const accel_filter *filter, accel **out, valo_error *err);
 static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return a->ops->intersect(a, r, h); }
 static inline int accel_occluded(const accel *a, const ray *r) { return a->ops->occluded(a, r); }
@@ -61,7 +64,7 @@ static inline void accel_destroy(accel *a) { if (a) a->ops->destroy(a); }
 
 valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads, const accel_filter *filter, accel **out,
                           valo_error *err);
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+valo_status embree_create(const vec3 *pos, uint32_t npos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
                           valo_error *err);
 int embree_available(void);
 

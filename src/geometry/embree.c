@@ -1,5 +1,5 @@
-/* embree.c — owns the Embree 3 backend behind accel.h: one triangle geometry with its own
- * vertex/index buffers, robust (watertight) scene flag, rtcIntersect1/rtcOccluded1. Every
+/* embree.c — owns the Embree 3 backend behind accel.h: one triangle geometry on the
+ * scene's own vertex/index arrays (shared; copied when no spare vertex follows), robust (watertight) scene flag, rtcIntersect1/rtcOccluded1. Every
  * candidate hit Embree finds is tested again by valo's own watertight test
  * (geometry/triangle.h, the kd-tree's), whose error valo's offset ray origins are made
  * for: Embree's own test, less precise on large triangles, let a ray find the surface it
@@ -20,7 +20,7 @@ struct embree_accel {
   RTCDevice dev;
   RTCScene scn;
   accel_filter filter; /* alpha: filter.pass NULL when no triangle needs it */
-  const float *vb;     /* the geometry's own vertex and index buffers (the second test) */
+  const float *vb;     /* the geometry's vertex and index buffers (the second test) */
   const unsigned *ib;
 };
 
@@ -140,7 +140,7 @@ static const accel_ops em_ops = {"embree", em_intersect, em_occluded, em_destroy
 
 int embree_available(void) { return 1; }
 
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+valo_status embree_create(const vec3 *pos, uint32_t npos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
                           valo_error *err) {
   *out = NULL;
   embree_accel *e = calloc(1, sizeof *e);
@@ -151,15 +151,26 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
   e->scn = rtcNewScene(e->dev);
   rtcSetSceneFlags(e->scn, RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
   if (ntris > 0) {
-    /* Vertices: one per triangle corner would waste memory; share the indexed set. */
     uint32_t maxv = 0;
     for (size_t i = 0; i < (size_t)ntris * 3; i++) if (idx[i] + 1 > maxv) maxv = idx[i] + 1;
+    if (maxv > npos) { em_destroy(&e->base); return err_set(err, VALO_ERR_INVALID, "embree: a triangle uses vertex %u of %u", maxv - 1, npos); }
     RTCGeometry g = rtcNewGeometry(e->dev, RTC_GEOMETRY_TYPE_TRIANGLE);
-    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), maxv);
-    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), ntris);
-    if (!vb || !ib) { rtcReleaseGeometry(g); em_destroy(&e->base); return err_set(err, VALO_ERR_NOMEM, "embree: out of memory"); }
-    for (uint32_t i = 0; i < maxv; i++) { vb[3 * i] = pos[i].x; vb[3 * i + 1] = pos[i].y; vb[3 * i + 2] = pos[i].z; }
-    memcpy(ib, idx, (size_t)ntris * 3 * sizeof(unsigned));
+    const float *vb;
+    const unsigned *ib;
+    if (maxv < npos) { /* a spare vertex after the last one used: Embree's 16-byte loads stay inside */
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, pos, 0, sizeof(vec3), maxv);
+      rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, idx, 0, 3 * sizeof(unsigned), ntris);
+      vb = &pos[0].x;
+      ib = idx;
+    } else {
+      float *v = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), maxv);
+      unsigned *i3 = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), ntris);
+      if (!v || !i3) { rtcReleaseGeometry(g); em_destroy(&e->base); return err_set(err, VALO_ERR_NOMEM, "embree: out of memory"); }
+      for (uint32_t i = 0; i < maxv; i++) { v[3 * i] = pos[i].x; v[3 * i + 1] = pos[i].y; v[3 * i + 2] = pos[i].z; }
+      memcpy(i3, idx, (size_t)ntris * 3 * sizeof(unsigned));
+      vb = v;
+      ib = i3;
+    }
     if (filter && filter->pass && filter->tri_flags) e->filter = *filter;
     e->vb = vb;
     e->ib = ib;
@@ -179,9 +190,9 @@ valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, 
 }
 #else
 int embree_available(void) { return 0; }
-valo_status embree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
+valo_status embree_create(const vec3 *pos, uint32_t npos, const uint32_t *idx, uint32_t ntris, const accel_filter *filter, accel **out,
                           valo_error *err) {
-  (void)pos; (void)idx; (void)ntris;
+  (void)pos; (void)npos; (void)idx; (void)ntris;
   *out = NULL;
   return err_set(err, VALO_ERR_UNSUPPORTED, "this valo was built without Embree (install libembree-dev and rebuild)");
 }

@@ -71,7 +71,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->alpha_filter.user = s;
   ss->alpha_filter.tri_flags = s->tri_flags;
   ss->alpha_filter.flag_bit = TRI_ALPHA;
-  st = accel_create(o.accel, s->pos, s->idx, s->ntris, o.threads, any_alpha ? &ss->alpha_filter : NULL, &ss->acc, err);
+  st = accel_create(o.accel, s->pos, s->cap_verts, s->idx, s->ntris, o.threads, any_alpha ? &ss->alpha_filter : NULL, &ss->acc, err);
   if (st) goto fail;
   ss->build_seconds = now_seconds() - t0;
   int cones = strcmp(o.sphere_lights, "triangles") != 0;

@@ -352,6 +352,9 @@ static valo_status commit_media(scene *s, valo_error *err) {
 valo_status scene_commit(scene *s, valo_error *err) {
   if (s->ntris == 0 && s->nlights == 0 && !s->has_env)
     return err_set(err, VALO_ERR_INVALID, "%s: the scene has no geometry and no lights", s->path);
+  /* A spare vertex after the last: Embree shares pos and reads each vertex with a 16-byte load. */
+  if (scene_reserve(s, 1, 0)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
+  s->pos[s->nverts] = v3(0, 0, 0);
   bbox b = bbox_empty();
   for (uint32_t i = 0; i < s->nverts; i++) b = bbox_add(b, s->pos[i]);
   for (uint32_t i = 0; i < s->nlights; i++)

@@ -194,7 +194,7 @@ typedef struct scene {
   float *tan_file;         /* 4 per vertex: a tangent the file gave (glTF TANGENT: xyz and
                               the bitangent sign); w = 0 where it gave none; NULL until a
                               file gives one (then grown with the other vertex arrays) */
-  uint32_t nverts, cap_verts;
+  uint32_t nverts, cap_verts; /* after commit cap_verts > nverts, pos[nverts] readable (accel_create) */
   uint32_t *idx;           /* 3 per triangle */
   uint32_t *tri_mat;
   uint8_t *tri_flags;
