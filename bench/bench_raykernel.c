@@ -8,7 +8,11 @@
  * instead times camera misses, camera hits and bounce rays apart; --bound times the
  * kd-tree's node walk alone (its leaves free) against the real queries and Embree, and
  * the share of triangle groups a query tests again (what mailboxing could skip).
- * Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] [--classes] [--bound] */
+ * --packets times Embree's own queries on camera rays, bounce rays and shadow rays, one
+ * ray at a time (rtcIntersect1, as valo uses it) against packets of 8 and 16 consecutive
+ * rays (rtcIntersect8/16, rtcOccluded8/16) and streams of 256 (rtcIntersect1M): what
+ * many rays in flight would gain in traversal alone.
+ * Usage: bench_raykernel [--quick] [--only NAME] [--no-build-table] [--classes] [--bound] [--packets] */
 #include "bench_util.h"
 #include "scene/scene.h"
 #include "load/load.h"
@@ -22,6 +26,10 @@
 #include <malloc.h>
 #include <string.h>
 #include <time.h>
+
+#ifdef VALO_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
 
 #ifndef VALO_SHARED_DIR
 #define VALO_SHARED_DIR "../shared"
@@ -207,6 +215,117 @@ static void bound_row(const char *name, const char *kind, accel *const acc[2], c
   free(tr);
 }
 
+#ifdef VALO_HAVE_EMBREE
+/* --packets: Embree's queries one at a time, in packets and in streams, on the same rays. */
+enum { PK_ONE, PK_8, PK_16, PK_STREAM, PK_KINDS };
+static long pk_trace(RTCScene scn, const ray *rays, long n, int kind, int shadow) {
+  struct RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  long hits = 0;
+  if (kind == PK_ONE) {
+    for (long i = 0; i < n; i++) {
+      struct RTCRayHit rh;
+      memset(&rh, 0, sizeof rh);
+      rh.ray.org_x = rays[i].o.x; rh.ray.org_y = rays[i].o.y; rh.ray.org_z = rays[i].o.z;
+      rh.ray.dir_x = rays[i].d.x; rh.ray.dir_y = rays[i].d.y; rh.ray.dir_z = rays[i].d.z;
+      rh.ray.tfar = rays[i].tmax; rh.ray.mask = 0xFFFFFFFF; rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      if (shadow) { rtcOccluded1(scn, &ctx, &rh.ray); hits += rh.ray.tfar < 0; }
+      else { rtcIntersect1(scn, &ctx, &rh); hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID; }
+    }
+    return hits;
+  }
+  if (kind == PK_STREAM) {
+    enum { M = 256 };
+    static struct RTCRayHit rh[M];
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    for (long i0 = 0; i0 < n; i0 += M) {
+      int m = (int)(n - i0 < M ? n - i0 : M);
+      for (int j = 0; j < m; j++) {
+        const ray *r = &rays[i0 + j];
+        memset(&rh[j], 0, sizeof rh[j]);
+        rh[j].ray.org_x = r->o.x; rh[j].ray.org_y = r->o.y; rh[j].ray.org_z = r->o.z;
+        rh[j].ray.dir_x = r->d.x; rh[j].ray.dir_y = r->d.y; rh[j].ray.dir_z = r->d.z;
+        rh[j].ray.tfar = r->tmax; rh[j].ray.mask = 0xFFFFFFFF; rh[j].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      }
+      if (shadow) { rtcOccluded1M(scn, &ctx, &rh[0].ray, (unsigned)m, sizeof rh[0]); for (int j = 0; j < m; j++) hits += rh[j].ray.tfar < 0; }
+      else { rtcIntersect1M(scn, &ctx, rh, (unsigned)m, sizeof rh[0]); for (int j = 0; j < m; j++) hits += rh[j].hit.geomID != RTC_INVALID_GEOMETRY_ID; }
+    }
+    return hits;
+  }
+  int w = kind == PK_8 ? 8 : 16;
+  for (long i0 = 0; i0 < n; i0 += w) {
+    RTC_ALIGN(64) struct RTCRayHit16 p;
+    RTC_ALIGN(64) int valid[16];
+    memset(&p, 0, sizeof p);
+    for (int j = 0; j < w; j++) {
+      valid[j] = i0 + j < n ? -1 : 0;
+      const ray *r = &rays[i0 + j < n ? i0 + j : n - 1];
+      p.ray.org_x[j] = r->o.x; p.ray.org_y[j] = r->o.y; p.ray.org_z[j] = r->o.z;
+      p.ray.dir_x[j] = r->d.x; p.ray.dir_y[j] = r->d.y; p.ray.dir_z[j] = r->d.z;
+      p.ray.tfar[j] = r->tmax; p.ray.mask[j] = 0xFFFFFFFF; p.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+    }
+    /* RTCRayHit8 is RTCRayHit16's layout with 8 lanes: repack for the 8-wide query. */
+    if (w == 8) {
+      RTC_ALIGN(32) struct RTCRayHit8 q;
+      memset(&q, 0, sizeof q);
+      for (int j = 0; j < 8; j++) {
+        q.ray.org_x[j] = p.ray.org_x[j]; q.ray.org_y[j] = p.ray.org_y[j]; q.ray.org_z[j] = p.ray.org_z[j];
+        q.ray.dir_x[j] = p.ray.dir_x[j]; q.ray.dir_y[j] = p.ray.dir_y[j]; q.ray.dir_z[j] = p.ray.dir_z[j];
+        q.ray.tfar[j] = p.ray.tfar[j]; q.ray.mask[j] = 0xFFFFFFFF; q.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+      }
+      if (shadow) rtcOccluded8(valid, scn, &ctx, &q.ray); else rtcIntersect8(valid, scn, &ctx, &q);
+      for (int j = 0; j < 8; j++) if (valid[j]) hits += shadow ? q.ray.tfar[j] < 0 : q.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
+    } else {
+      if (shadow) rtcOccluded16(valid, scn, &ctx, &p.ray); else rtcIntersect16(valid, scn, &ctx, &p);
+      for (int j = 0; j < 16; j++) if (valid[j]) hits += shadow ? p.ray.tfar[j] < 0 : p.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
+    }
+  }
+  return hits;
+}
+static void packet_rows(const char *name, const scene *s, const ray *rays, long n, const ray *sh, long ns) {
+  RTCDevice dev = rtcNewDevice(NULL);
+  RTCScene scn = rtcNewScene(dev);
+  rtcSetSceneFlags(scn, RTC_SCENE_FLAG_ROBUST);
+  RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, s->pos, 0, sizeof(vec3), s->nverts);
+  rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, s->idx, 0, 3 * sizeof(uint32_t), s->ntris);
+  rtcCommitGeometry(g);
+  rtcAttachGeometry(scn, g);
+  rtcReleaseGeometry(g);
+  rtcCommitScene(scn);
+  /* camera rays (make_rays starts with one and gives each its bounce after it) and bounces */
+  ray *cls[3] = {malloc(sizeof(ray) * (size_t)n), malloc(sizeof(ray) * (size_t)n), (ray *)sh};
+  long nc[3] = {0, 0, ns};
+  vec3 eye = rays[0].o;
+  for (long i = 0; i < n; i++) {
+    int k = rays[i].o.x == eye.x && rays[i].o.y == eye.y && rays[i].o.z == eye.z ? 0 : 1;
+    cls[k][nc[k]++] = rays[i];
+  }
+  static const char *const names[3] = {"camera", "bounce", "shadow"};
+  for (int c = 0; c < 3; c++) {
+    double best[PK_KINDS];
+    long hits[PK_KINDS];
+    for (int k = 0; k < PK_KINDS; k++) best[k] = 1e30;
+    for (int rep = 0; rep < REPS; rep++)
+      for (int k = 0; k < PK_KINDS; k++) {
+        double t0 = bench_now();
+        hits[k] = pk_trace(scn, cls[c], nc[c], k, c == 2);
+        double dt = bench_now() - t0;
+        if (dt < best[k]) best[k] = dt;
+      }
+    for (int k = 1; k < PK_KINDS; k++)
+      if (hits[k] != hits[0]) fprintf(stderr, "note: %s %s: %ld hits one at a time, %ld by kind %d\n", name, names[c], hits[0], hits[k], k);
+    printf("| %s | %s | %ld | %.2f | %.2f | %.2f | %.2f |\n", name, names[c], nc[c], nc[c] / best[PK_ONE] * 1e-6, best[PK_ONE] / best[PK_8],
+           best[PK_ONE] / best[PK_16], best[PK_ONE] / best[PK_STREAM]);
+    fflush(stdout);
+  }
+  free(cls[0]); free(cls[1]);
+  rtcReleaseScene(scn);
+  rtcReleaseDevice(dev);
+}
+#endif
+static int g_packets;
+
 static void bench_scene(const char *name, scene *s) {
   valo_error err;
   if (scene_commit(s, &err)) { fprintf(stderr, "%s: %s\n", name, err.message); return; }
@@ -227,6 +346,14 @@ static void bench_scene(const char *name, scene *s) {
   long n, ns;
   ray *sh;
   ray *rays = make_rays(s, acc[1], &n, &sh, &ns);
+  if (g_packets) {
+#ifdef VALO_HAVE_EMBREE
+    packet_rows(name, s, rays, n, sh, ns);
+#endif
+    free(rays); free(sh);
+    accel_destroy(acc[0]); accel_destroy(acc[1]);
+    return;
+  }
   if (g_classes || g_bound) {
     if (g_classes) class_table(name, acc, rays, n);
     else { bound_row(name, "closest hit", acc, rays, n, 0); bound_row(name, "shadow", acc, sh, ns, 1); }
@@ -261,9 +388,16 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--no-build-table")) build_table = 0;
     else if (!strcmp(argv[i], "--classes")) g_classes = 1, build_table = 0;
     else if (!strcmp(argv[i], "--bound")) g_bound = 1, build_table = 0;
+    else if (!strcmp(argv[i], "--packets")) g_packets = 1, build_table = 0;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
-    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|sponza|cornell] [--no-build-table] [--classes] [--bound]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_raykernel [--quick] [--only bunny|nefertiti|dragon|sponza|cornell] [--no-build-table] [--classes] [--bound] [--packets]\n"); return 2; }
   }
+  if (g_packets) {
+    if (!embree_available()) { fprintf(stderr, "bench_raykernel --packets: this valo was built without Embree\n"); return 2; }
+    printf("## Embree's queries one at a time against packets and streams, 1 thread (same rays)\n\n");
+    printf("| scene | rays | count | rtcIntersect1 / rtcOccluded1 Mrays/s | packets of 8 / one at a time | packets of 16 / one at a time "
+           "| streams of 256 / one at a time |\n|---|---|---|---|---|---|---|\n");
+  } else
   if (g_bound) {
     printf("## The kd-tree's node walk alone, 1 thread (kd-tree vs Embree %s)\n\n", embree_available() ? "3" : "(absent)");
     printf("| scene | rays | count | nodes per ray | box nodes per ray | descent nodes per ray | leaves per ray | groups of 4 per ray | kd Mrays/s "
