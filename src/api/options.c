@@ -19,48 +19,18 @@ static void integrator_list(char *list, size_t n) {
   }
 }
 
-/* Numbers of every option of `target` to their "not given" value, names and text empty. */
-static void init_target(opt_target target, void *o) {
-  for (const option_decl *d = option_table; d->info.flag || d->info.json; d++) {
-    if (d->target != target) continue;
-    char *f = (char *)o + d->offset;
-    switch (d->type) {
-    case OPT_INT: case OPT_FLAG: case OPT_CHOICE: *(int *)f = (int)d->unset; break;
-    case OPT_INT64: *(int64_t *)f = (int64_t)d->unset; break;
-    case OPT_REAL: *(double *)f = d->unset; break;
-    case OPT_FLOAT: *(float *)f = (float)d->unset; break;
-    case OPT_SIZE: case OPT_RECT: case OPT_NAME: case OPT_PARAMS: break;
-    }
-  }
-}
-/* The load and output options have no file to come from: their defaults at once. */
-static void default_target(opt_target target, void *o) {
-  for (const option_decl *d = option_table; d->info.flag || d->info.json; d++) {
-    if (d->target != target) continue;
-    char *f = (char *)o + d->offset;
-    switch (d->type) {
-    case OPT_NAME: if (d->def_text) snprintf(f, d->size, "%s", d->def_text); break;
-    case OPT_REAL: *(double *)f = d->def; break;
-    case OPT_FLOAT: *(float *)f = (float)d->def; break;
-    case OPT_INT: case OPT_FLAG: case OPT_CHOICE: *(int *)f = (int)d->def; break;
-    case OPT_INT64: *(int64_t *)f = (int64_t)d->def; break;
-    case OPT_SIZE: case OPT_RECT: case OPT_PARAMS: break;
-    }
-  }
-}
-
 VALO_API void valo_options_init(valo_options *o) {
   memset(o, 0, sizeof *o);
-  init_target(OPT_RENDER, o);
+  options_init_target(OPT_RENDER, o);
   o->aovs = VALO_UNSET; /* set by the API caller (the CLI: from its outputs), not an option */
 }
 VALO_API void valo_output_options_init(valo_output_options *o) {
   memset(o, 0, sizeof *o);
-  default_target(OPT_OUTPUT, o);
+  options_default_target(OPT_OUTPUT, o);
 }
 VALO_API void valo_load_options_init(valo_load_options *o) {
   memset(o, 0, sizeof *o);
-  default_target(OPT_LOAD, o);
+  options_default_target(OPT_LOAD, o);
 }
 
 VALO_API const valo_option_info *valo_option_at(int i) {

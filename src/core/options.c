@@ -288,3 +288,33 @@ valo_status option_check(const option_decl *d, const valo_options *o, valo_error
   }
   return VALO_OK;
 }
+
+/* Numbers of every option of `target` to their "not given" value, names and text empty. */
+void options_init_target(opt_target target, void *o) {
+  for (const option_decl *d = option_table; d->info.flag || d->info.json; d++) {
+    if (d->target != target) continue;
+    char *f = (char *)o + d->offset;
+    switch (d->type) {
+    case OPT_INT: case OPT_FLAG: case OPT_CHOICE: *(int *)f = (int)d->unset; break;
+    case OPT_INT64: *(int64_t *)f = (int64_t)d->unset; break;
+    case OPT_REAL: *(double *)f = d->unset; break;
+    case OPT_FLOAT: *(float *)f = (float)d->unset; break;
+    case OPT_SIZE: case OPT_RECT: case OPT_NAME: case OPT_PARAMS: break;
+    }
+  }
+}
+/* The load and output options have no file to come from: their defaults at once. */
+void options_default_target(opt_target target, void *o) {
+  for (const option_decl *d = option_table; d->info.flag || d->info.json; d++) {
+    if (d->target != target) continue;
+    char *f = (char *)o + d->offset;
+    switch (d->type) {
+    case OPT_NAME: if (d->def_text) snprintf(f, d->size, "%s", d->def_text); break;
+    case OPT_REAL: *(double *)f = d->def; break;
+    case OPT_FLOAT: *(float *)f = (float)d->def; break;
+    case OPT_INT: case OPT_FLAG: case OPT_CHOICE: *(int *)f = (int)d->def; break;
+    case OPT_INT64: *(int64_t *)f = (int64_t)d->def; break;
+    case OPT_SIZE: case OPT_RECT: case OPT_PARAMS: break;
+    }
+  }
+}

@@ -53,6 +53,11 @@ valo_status option_set(const option_decl *d, const char *value, valo_options *ro
 int option_is_set(const option_decl *d, const valo_options *o);
 /* Copies option d from src to dst (render options; OPT_PARAMS appends). */
 void option_copy(const option_decl *d, valo_options *dst, const valo_options *src);
+/* Every option of target in o (a valo_options, valo_load_options or valo_output_options)
+ * to its "not given" value, names and text empty (init), or to its default (default: the
+ * load and output options, which have no file to come from). */
+void options_init_target(opt_target target, void *o);
+void options_default_target(opt_target target, void *o);
 /* Sets option d in o to its default (when it has one). */
 void option_default(const option_decl *d, valo_options *o);
 /* Checks a set render option against its range or names: VALO_OK or an error naming it. */

@@ -1,6 +1,7 @@
 /* adaptive.c — see adaptive.h. */
 #include "render/adaptive.h"
 #include "render/tiles.h"
+#include "render/checkpoint.h"
 #include "core/clock.h"
 #include "core/error.h"
 #include <math.h>
@@ -112,7 +113,7 @@ valo_status adapt_digest(session *ss, int uniform_spp, double total, double budg
     }
     ss->spp_done = (int)(taken / (double)np);
     ss->ckpt_state = (ckpt_state){CKPT_ADAPT_DIGEST, 0, 0, taken, NULL, NULL};
-    session_checkpoint_tick(ss, ts, t0);
+    checkpoint_tick(ss, ts, t0);
     if (budget > 0 && el >= budget) break;
   }
   ss->spp_done = (int)(taken / (double)np);
@@ -265,7 +266,7 @@ valo_status adapt_error(session *ss, double total, double budget, double t0, val
        * budget's stages depend on timing, and are not checkpointed */
       ss->spp_done = (int)(taken / (double)np);
       ss->ckpt_state = (ckpt_state){CKPT_ADAPT_ERROR, stage, stages, taken, first, fin};
-      session_checkpoint_tick(ss, ts, t0);
+      checkpoint_tick(ss, ts, t0);
     }
     if (taken >= total || (budget > 0 && el >= budget)) break;
   }

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/memlimit.h"
 #include "core/options.h"
+#include "core/clock.h"
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -101,7 +102,7 @@ valo_status checkpoint_write(const session *ss, const thread_stats *ts, const ch
   const film *fm = &ss->film;
   size_t np = film_pixels(fm);
   put(&w, CKPT_MAGIC, 8);
-  put_str(&w, valo_version());
+  put_str(&w, VALO_VERSION_STRING);
   put_str(&w, ss->s->path);
   uint64_t sh = scene_hash(ss->s);
   put(&w, &sh, sizeof sh);
@@ -208,8 +209,8 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   mine = malloc(OPTS_CAP);
   if (!opts || !mine) { st = err_set(err, VALO_ERR_NOMEM, "%s: out of memory", path); goto done; }
   get_str(&r, ver, sizeof ver);
-  if (!r.bad && strcmp(ver, valo_version())) {
-    st = err_set(err, VALO_ERR_INVALID, "%s: the checkpoint was made by valo %s; this is valo %s: refused", path, ver, valo_version());
+  if (!r.bad && strcmp(ver, VALO_VERSION_STRING)) {
+    st = err_set(err, VALO_ERR_INVALID, "%s: the checkpoint was made by valo %s; this is valo %s: refused", path, ver, VALO_VERSION_STRING);
     goto done;
   }
   get_str(&r, spath, sizeof spath);
@@ -276,4 +277,14 @@ done:
   free(mine);
   free(data);
   return st;
+}
+
+void checkpoint_tick(session *ss, const thread_stats *ts, double run_t0) {
+  if (!ss->ckpt_path[0]) return;
+  double now = now_seconds();
+  if (ss->ckpt_every > 0 && now - ss->ckpt_last < ss->ckpt_every) return;
+  ss->ckpt_run_seconds = now - run_t0;
+  valo_error e;
+  if (checkpoint_write(ss, ts, ss->ckpt_path, &e)) log_warning("%s (the render goes on)", e.message);
+  ss->ckpt_last = now_seconds();
 }

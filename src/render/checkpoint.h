@@ -12,6 +12,10 @@
 /* Writes ss's state to path; ts: this run's per-thread counters so far (opt.threads of
  * them). */
 valo_status checkpoint_write(const session *ss, const thread_stats *ts, const char *path, valo_error *err);
+/* At a pass boundary (ss->ckpt_state says which): writes the checkpoint to ss->ckpt_path
+ * when one is due (ss->ckpt_every); ts are this run's counters, run_t0 its start. A
+ * failed write is a warning: the render goes on. */
+void checkpoint_tick(session *ss, const thread_stats *ts, double run_t0);
 /* Restores ss's state from path (after session_create, before session_run). */
 valo_status checkpoint_read(session *ss, const char *path, valo_error *err);
 #endif

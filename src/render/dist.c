@@ -284,10 +284,10 @@ static dist_state *dist_get(session *ss) {
   return d;
 }
 
-valo_status dist_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err) {
+static valo_status master_run(session *ss, const tile_pass *tp, thread_stats *ts, valo_error *err) {
   dist_state *d = dist_get(ss);
   if (!d) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  pass_ctx p = {.ss = ss, .d = d, .s0 = s0, .s1 = s1, .prep = prep, .target = target, .ntiles = tiles_count(ss), .ts = ts};
+  pass_ctx p = {.ss = ss, .d = d, .s0 = tp->s0, .s1 = tp->s1, .prep = tp->prep, .target = tp->target, .ntiles = tiles_count(ss), .ts = ts};
   atomic_init(&p.next, 0);
   atomic_init(&p.local_tiles, 0);
   atomic_init(&p.local_samples, 0);
@@ -300,6 +300,7 @@ valo_status dist_tiles(session *ss, int s0, int s1, const uint32_t *target, int 
   if (d->err_status) return err_set(err, d->err_status, "%s", d->err_msg);
   return VALO_OK;
 }
+const tile_source dist_master = {master_run};
 
 void dist_finish(session *ss, thread_stats *sum) {
   dist_state *d = dist_get(ss);
@@ -370,7 +371,7 @@ valo_status dist_worker(session *ss, thread_stats *ts, valo_error *err) {
     if (h[0] == MSG_STOP) break;
     double t0 = now_seconds();
     valo_status wst = target ? VALO_OK : err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d target", ss->opt.width, ss->opt.height);
-    if (!wst && h[1] != ss->view_frame && session_set_view(ss, h[1]))
+    if (!wst && h[1] != ss->view_frame && tiles_set_view(ss, h[1]))
       wst = err_set(err, VALO_ERR_INVALID, "the camera at frame %d has its up vector along the view direction", h[1]);
     if (!wst && h[2] >= 0 && h[2] != prepared) {
       wst = ss->integ->prepare(ss->istate, &ss->ctx, h[2], err);
@@ -430,10 +431,11 @@ int dist_rank(void) { return 0; }
 int dist_size(void) { return 1; }
 void dist_finalize(void) {}
 int dist_agree(int rc, valo_error *err) { (void)err; return rc; }
-valo_status dist_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err) {
-  (void)ss; (void)s0; (void)s1; (void)target; (void)prep; (void)ts;
+static valo_status master_run(session *ss, const tile_pass *tp, thread_stats *ts, valo_error *err) {
+  (void)ss; (void)tp; (void)ts;
   return err_set(err, VALO_ERR_INVALID, "valo was built without MPI");
 }
+const tile_source dist_master = {master_run};
 valo_status dist_worker(session *ss, thread_stats *ts, valo_error *err) {
   (void)ss; (void)ts;
   return err_set(err, VALO_ERR_INVALID, "valo was built without MPI");

@@ -9,7 +9,7 @@
  * MPI, or outside an MPI launcher, there is one rank and none of this runs. */
 #ifndef VALO_DIST_H
 #define VALO_DIST_H
-#include "render/session.h"
+#include "render/tiles.h"
 
 /* Joins the MPI job when the process was started by an MPI launcher (mpirun, srun);
  * returns the number of processes the launcher started (1 outside one). dist_size is
@@ -24,10 +24,9 @@ void dist_finalize(void);
  * status of the lowest failing rank (0 when none failed); on every rank err then holds
  * that rank's message, prefixed "rank K (host): " when K is not this rank. */
 int dist_agree(int rc, valo_error *err);
-/* Rank 0, more than one rank: takes the samples of one pass on every rank. Uniform
- * passes ([s0, s1) of every pixel; target NULL) or each pixel up to target[pix]; prep is
- * the sample index whose prepare the pass needs (-1: none). */
-valo_status dist_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err);
+/* Rank 0, more than one rank: the tile source (render/tiles.h) that takes each pass's
+ * samples on every rank. */
+extern const tile_source dist_master;
 /* Ranks above 0: renders what rank 0 hands out until it says stop. */
 valo_status dist_worker(session *ss, thread_stats *ts, valo_error *err);
 /* Rank 0, at the end of a run: stops the other ranks and adds their counters to sum,

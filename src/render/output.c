@@ -5,6 +5,7 @@
 #include "image/tonemap.h"
 #include "core/error.h"
 #include "core/strutil.h"
+#include "core/options.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -88,7 +89,7 @@ valo_status output_write(const session *ss, const char *path, const valo_output_
   if (!px) return err_set(err, VALO_ERR_NOMEM, "out of memory");
   const valo_output_options *use = o;
   valo_output_options raw;
-  valo_output_options_init(&raw);
+  options_default_target(OPT_OUTPUT, &raw);
   if (k < 0) {
     film_resolve(&ss->film, px);
   } else {

@@ -13,23 +13,6 @@
 
 static int alpha_filter_pass(const void *user, uint32_t tri, float b1, float b2, uint64_t key) { return scene_alpha_pass(user, tri, b1, b2, key); }
 
-int session_set_view(session *ss, int f) {
-  camera c = ss->opt.frames > 0 ? scene_camera_at(ss->s, &ss->cam_still, (float)f) : ss->cam_still;
-  ss->view_frame = f;
-  cam_view *v = &ss->lens.view;
-  int bad = cam_view_make(&c, ss->frame_w, ss->frame_h, v);
-  v->x0 = ss->crop_x;
-  v->y0 = ss->crop_y;
-  v->film_w = ss->opt.width;
-  v->film_h = ss->opt.height;
-  return bad;
-}
-
-int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget) {
-  if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
-  return progress && progress(user, frac, spp, el);
-}
-
 valo_status session_create(const scene *s, const valo_options *opts, const integrator_ops *integ, const double *params, float ao_dist,
                            session **out, valo_error *err) {
   *out = NULL;
@@ -50,6 +33,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->crop_x = crop ? o.crop_x : 0;
   ss->crop_y = crop ? o.crop_y : 0;
   ss->integ = integ;
+  ss->work = dist_size() > 1 && dist_rank() == 0 ? &dist_master : &tiles_local;
   memcpy(ss->param, params, sizeof ss->param);
   ss->ao_dist = ao_dist;
   ss->sampler_kind = strcmp(o.sampler, "independent") ? SAMPLER_SOBOL : SAMPLER_INDEPENDENT;
@@ -93,7 +77,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
   ss->cam_still = scene_camera_fit(s, (float)frame_w / (float)frame_h);
   const camera *c = &ss->cam_still;
-  if (session_set_view(ss, 0)) {
+  if (tiles_set_view(ss, 0)) {
     st = err_set(err, VALO_ERR_INVALID, "%s: camera up vector is parallel to the view direction", s->path);
     goto fail;
   }
@@ -151,16 +135,6 @@ void session_destroy(session *ss) {
   free(ss);
 }
 
-void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0) {
-  if (!ss->ckpt_path[0]) return;
-  double now = now_seconds();
-  if (ss->ckpt_every > 0 && now - ss->ckpt_last < ss->ckpt_every) return;
-  ss->ckpt_run_seconds = now - run_t0;
-  valo_error e;
-  if (checkpoint_write(ss, ts, ss->ckpt_path, &e)) log_warning("%s (the render goes on)", e.message);
-  ss->ckpt_last = now_seconds();
-}
-
 /* One frame of an image-wide integrator, added to the film as one sample per pixel (in
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
@@ -183,7 +157,7 @@ static valo_status run_sequence(session *ss, valo_progress_fn progress, void *us
   double t0 = now_seconds();
   double budget = ss->opt.time_budget > 0 ? ss->opt.time_budget : 0;
   for (int f = ss->frames_done; f < ss->opt.frames; f++) {
-    if (session_set_view(ss, f)) return err_set(err, VALO_ERR_INVALID, "%s: the camera at frame %d has its up vector along the view direction", ss->s->path, f);
+    if (tiles_set_view(ss, f)) return err_set(err, VALO_ERR_INVALID, "%s: the camera at frame %d has its up vector along the view direction", ss->s->path, f);
     film_clear(&ss->film);
     ss->spp_done = 0;
     if (ss->integ->kind == INTEGRATOR_IMAGE) {
@@ -278,7 +252,7 @@ valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo
       break;
     }
     ss->ckpt_state = (ckpt_state){CKPT_UNIFORM, 0, 0, 0, NULL, NULL};
-    session_checkpoint_tick(ss, ts, t0);
+    checkpoint_tick(ss, ts, t0);
     if (budget > 0 && el >= budget) break;
     /* Adaptive with a time budget: the uniform first pass gets ADAPT_UNIFORM of the time
      * (at least 4 spp), as it gets that share of a sample budget, so adaptive sampling
@@ -312,9 +286,9 @@ valo_status session_set_camera(session *ss, const camera *c, valo_error *err) {
   ss->cam_still.fov_deg = c->fov_deg;
   ss->cam_still.ortho_height = c->ortho_height;
   ss->cam_still.spherical = c->spherical;
-  if (v3_len(v3_sub(c->look_at, c->pos)) > 0 && !session_set_view(ss, 0)) return VALO_OK;
+  if (v3_len(v3_sub(c->look_at, c->pos)) > 0 && !tiles_set_view(ss, 0)) return VALO_OK;
   ss->cam_still = keep;
-  session_set_view(ss, 0);
+  tiles_set_view(ss, 0);
   return err_set(err, VALO_ERR_INVALID, "the camera looks at its own position, or its up vector is parallel to the view direction");
 }
 

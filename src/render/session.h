@@ -2,7 +2,9 @@
  * this frame and the last, the accelerator, the light sampler, the integrator instance,
  * the budgets, passes, frames, cancellation and progress, and the counters. The public
  * valo_render handle (src/api/) wraps it. Options reach it resolved and checked
- * (src/api/options.c). */
+ * (src/api/options.c). Within render/, calls run one way: session -> adaptive ->
+ * checkpoint, and session -> dist (the MPI tile source) -> tiles (the tile loop and its
+ * local source) -> aov -> film. */
 #ifndef VALO_SESSION_H
 #define VALO_SESSION_H
 #include "integrator/integrator.h"
@@ -13,6 +15,7 @@
 #define TILE 16 /* tiles of TILE x TILE pixels: the unit of work and of cancellation */
 
 typedef struct session session;
+struct tile_source; /* render/tiles.h: where a pass's tiles are rendered */
 /* Where a checkpoint stands (render/checkpoint.h): the uniform passes, a stage of the
  * error rule's plan (the counts it started from, first, and ends at, fin), or a round
  * of the digest rule; taken: samples over the whole film. */
@@ -64,6 +67,7 @@ struct session {
                               window at (crop_x, crop_y): the whole frame without a crop */
   int crop_x, crop_y;
   int stepped;             /* rendered by session_step (valo view): image-wide frames as a sequence's */
+  const struct tile_source *work; /* this process's threads, or under MPI rank 0 handing tiles to every rank */
   struct dist_state *dist; /* rank 0 under MPI: the other ranks' state (render/dist.c) */
   rank_stats *ranks;       /* rank 0 under MPI, after a run: every rank's share, nranks of them */
   int nranks;
@@ -77,20 +81,16 @@ valo_status session_create(const scene *s, const valo_options *o, const integrat
 void session_destroy(session *ss);
 /* Renders: passes until the sample or time budget, or a sequence of frames. */
 valo_status session_run(session *ss, valo_progress_fn progress, void *user, valo_error *err);
-/* The pinhole basis of frame f (the scene's camera animation in a sequence, else the
- * still camera) into ss->lens.view; -1 when up is parallel to the view direction. */
-int session_set_view(session *ss, int f);
 /* Moves the still camera (position, look-at, up, field of view); refused for sequences
  * and degenerate cameras, which leave it unchanged. */
 valo_status session_set_camera(session *ss, const camera *c, valo_error *err);
 /* One step of interactive rendering (valo_render_step in valo.h). */
 valo_status session_step(session *ss, int spp, int restart, valo_error *err);
-/* At a pass boundary (ss->ckpt_state says which): writes the checkpoint when one is due;
- * ts are this run's counters, run_t0 its start. A failed write is a warning: the render
- * goes on. */
-void session_checkpoint_tick(session *ss, const thread_stats *ts, double run_t0);
 /* Calls the progress callback (if any) with the larger of frac and the share of the time
  * budget spent; non-zero when it asks to cancel. */
-int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget);
+static inline int session_report_progress(valo_progress_fn progress, void *user, double frac, int spp, double el, double budget) {
+  if (budget > 0 && el / budget > frac) frac = el / budget < 1 ? el / budget : 1;
+  return progress && progress(user, frac, spp, el);
+}
 static inline int session_cancelled(const session *ss) { return atomic_load_explicit(&ss->cancel, memory_order_relaxed); }
 #endif

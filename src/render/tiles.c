@@ -3,16 +3,26 @@
  * the same for any thread count, tile order or number of processes (render/dist.c). */
 #include "render/tiles.h"
 #include "render/aov.h"
-#include "render/dist.h"
 #include "core/threadpool.h"
 #include "core/error.h"
 
 typedef struct pass_job {
   session *ss;
-  int s0, s1;             /* sample indices [s0, s1) */
-  const uint32_t *target; /* or, when not NULL: each pixel from its count up to target[pix] */
-  thread_stats *ts;       /* one per thread */
+  const tile_pass *p;
+  thread_stats *ts; /* one per thread */
 } pass_job;
+
+int tiles_set_view(session *ss, int f) {
+  camera c = ss->opt.frames > 0 ? scene_camera_at(ss->s, &ss->cam_still, (float)f) : ss->cam_still;
+  ss->view_frame = f;
+  cam_view *v = &ss->lens.view;
+  int bad = cam_view_make(&c, ss->frame_w, ss->frame_h, v);
+  v->x0 = ss->crop_x;
+  v->y0 = ss->crop_y;
+  v->film_w = ss->opt.width;
+  v->film_h = ss->opt.height;
+  return bad;
+}
 
 void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts) {
   uint64_t pix = (uint64_t)y * (uint64_t)ss->opt.width + (uint64_t)x;
@@ -58,14 +68,20 @@ uint64_t tiles_render_tile(session *ss, int64_t tile, int s0, int s1, const uint
 static void render_tile(void *user, int64_t item, int thread) {
   pass_job *j = user;
   if (session_cancelled(j->ss)) return;
-  tiles_render_tile(j->ss, item, j->s0, j->s1, j->target, &j->ts[thread]);
+  tiles_render_tile(j->ss, item, j->p->s0, j->p->s1, j->p->target, &j->ts[thread]);
 }
 
-static valo_status run_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err) {
-  if (dist_size() > 1) return dist_tiles(ss, s0, s1, target, prep, ts, err);
-  pass_job job = {ss, s0, s1, target, ts};
+static valo_status local_run(session *ss, const tile_pass *p, thread_stats *ts, valo_error *err) {
+  (void)err;
+  pass_job job = {ss, p, ts};
   parallel_for(ss->opt.threads, tiles_count(ss), render_tile, &job);
   return VALO_OK;
+}
+const tile_source tiles_local = {local_run};
+
+static valo_status run_tiles(session *ss, int s0, int s1, const uint32_t *target, int prep, thread_stats *ts, valo_error *err) {
+  tile_pass p = {s0, s1, target, prep};
+  return (ss->work ? ss->work : &tiles_local)->run(ss, &p, ts, err);
 }
 
 valo_status tiles_render_to(session *ss, const uint32_t *target, thread_stats *ts, valo_error *err) { return run_tiles(ss, 0, 0, target, -1, ts, err); }
