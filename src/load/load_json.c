@@ -255,7 +255,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
 static valo_status parse_shape(jctx *c, const cJSON *o, int index) {
   char where[64];
   snprintf(where, sizeof where, "shapes[%d]", index);
-  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "p0", "p1", "subdivisions", "flip_normals", "smooth",
+  static const char *const keys[] = {"type", "file", "transform", "material", "center", "radius", "p0", "p1", "subdivisions", "exact_area", "flip_normals", "smooth",
                                      "proximity", "interior", "exterior", "face_normals", "smooth_normals", "shape_index", "mitsuba_uv", "flip_v", "uv_frame", NULL};
   TRY(json_check_keys(c, o, where, keys));
   uint32_t first = c->s->ntris;
@@ -315,7 +315,7 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
   }
   /* Keys another kind of shape takes are errors, not silently ignored. */
   int mesh = !strcmp(type, "mesh"), sphere = !strcmp(type, "sphere");
-  static const char *const sphere_only[] = {"center", "radius", "subdivisions", "smooth", NULL};
+  static const char *const sphere_only[] = {"center", "radius", "subdivisions", "exact_area", "smooth", NULL};
   for (int j = 0; (mesh || sphere) && sphere_only[j]; j++)
     if (mesh && cJSON_GetObjectItemCaseSensitive(o, sphere_only[j])) {
       char msg[160];
@@ -383,7 +383,10 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
           off += fabs((double)rot[a] * rot[b] + (double)rot[3 + a] * rot[3 + b] + (double)rot[6 + a] * rot[6 + b] - (a == b));
       if (n != 9 || !(off < 1e-3)) return json_bad(c, where, "\"uv_frame\" must be 9 numbers, a 3x3 rotation (row-major, local to world)");
     }
+    int exact_area = 0;
+    TRY(json_get_bool(c, o, "exact_area", where, &exact_area));
     TRY(scene_add_sphere(c->s, center, (float)r, sub, flip, smooth, mat, c->err));
+    if (exact_area) scene_sphere_exact_area(c->s, c->s->nspheres - 1);
     return mitsuba_uv ? scene_sphere_uv(c->s, c->s->nspheres - 1, rot) : VALO_OK;
   }
   static const char *const prims[] = {"rectangle", "cube", "disk", "cylinder"};
@@ -403,9 +406,9 @@ static valo_status parse_shape_geometry(jctx *c, const cJSON *o, const char *whe
       if (!(v3_len(v3_sub(p1, p0)) > 0)) return json_bad(c, where, "a cylinder's p0 and p1 must differ");
       scene_cylinder_place(p0, p1, (float)r, xf);
     }
-    static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "file", "p0", "p1"};
-    for (int j = 0; j < 7; j++)
-      if (!(cyl && (j == 1 || j > 4)) && cJSON_GetObjectItemCaseSensitive(o, own[j])) {
+    static const char *const own[] = {"center", "radius", "subdivisions", "smooth", "exact_area", "file", "p0", "p1"};
+    for (int j = 0; j < 8; j++)
+      if (!(cyl && (j == 1 || j > 5)) && cJSON_GetObjectItemCaseSensitive(o, own[j])) {
         char msg[160];
         snprintf(msg, sizeof msg, "a %s takes no \"%s\": it is the unit shape placed by \"transform\"", type, own[j]);
         return json_bad(c, where, msg);

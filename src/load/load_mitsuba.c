@@ -316,9 +316,9 @@ static valo_status read_shape(mctx *c, xml_node *n) {
     TRY(mi_color(c, e, "radiance", MI_EMITTER, &emit));
     if (!emit && !(emit = vec_json(1, 1, 1))) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
     mi_warn_unused(c, e);
-    /* An emitting sphere finer than valo's default (5 120 triangles, 0.12 % less area and
-     * power than Mitsuba's exact sphere): 81 920 triangles, 0.0075 % less. */
-    if (!strcmp(type, "sphere") && !cJSON_AddNumberToObject(sh, "subdivisions", 6)) { cJSON_Delete(emit); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
+    /* An emitting sphere gives Mitsuba's exact sphere's power: valo's 5 120 triangles
+     * scaled to its area (unscaled they have 0.12 % less area, and power). */
+    if (!strcmp(type, "sphere") && !cJSON_AddTrueToObject(sh, "exact_area")) { cJSON_Delete(emit); return err_set(c->err, VALO_ERR_NOMEM, "out of memory"); }
   }
   char name[192];
   valo_status st = mi_material(c, b, emit, n, name, sizeof name);

@@ -58,6 +58,23 @@ valo_status scene_sphere_uv(scene *s, uint32_t g, const float *rot) {
   return VALO_OK;
 }
 
+void scene_sphere_exact_area(scene *s, uint32_t g) {
+  sphere_shape *sp = &s->spheres[g];
+  double area = 0;
+  for (uint32_t t = sp->first; t < sp->end; t++) {
+    const uint32_t *ix = &s->idx[3 * t];
+    area += 0.5 * v3_len(v3_cross(v3_sub(s->pos[ix[1]], s->pos[ix[0]]), v3_sub(s->pos[ix[2]], s->pos[ix[0]])));
+  }
+  if (!(area > 0)) return;
+  float k = (float)sqrt(4 * M_PI * (double)sp->r * sp->r / area);
+  for (uint32_t t = sp->first; t < sp->end; t++)
+    for (int j = 0; j < 3; j++) {
+      vec3 *p = &s->pos[s->idx[3 * t + j]];
+      *p = v3_add(sp->c, v3_scale(v3_sub(*p, sp->c), k));
+    }
+  sp->r *= k;
+}
+
 /* Icosphere: 12 vertices, 20 faces, each subdivision splits a face in four. Vertices
  * are not shared between faces (flat arrays stay simple); normals are exact. */
 valo_status scene_add_sphere(scene *s, vec3 c, float r, int subdiv, int flip, int smooth, uint32_t mat, valo_error *err) {

@@ -330,6 +330,10 @@ valo_status scene_add_mesh(scene *s, const mesh_data *m, const float *xf, uint32
  * inward; smooth: exact sphere normals as shading normals (else flat facets). */
 valo_status scene_add_sphere(scene *s, vec3 center, float radius, int subdiv, int flip,
                              int smooth, uint32_t mat, valo_error *err);
+/* Scales sphere g's triangles about its centre so that their area is the exact sphere's
+ * (4 pi r^2: an emitter then gives the exact sphere's power); its radius becomes its
+ * vertices' (r times the scale), so that the cone it subtends holds every facet. */
+void scene_sphere_exact_area(scene *s, uint32_t g);
 /* Lays out sphere g's texture coordinates as an equirectangular map, a triangle across
  * the seam keeping its u's together (the map repeats) and a pole vertex taking the mean u
  * of the other two. rot NULL: valo's own, +y the pole at the image's top, u = 1/2 +
