@@ -53,7 +53,7 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   ls->dist = before + h.t;
   ls->p_light = hi.p;
   ls->n_light = hi.ng;
-  ls->L = light_area_radiance(s, &s->lights[lid], hi.ng, v3_neg(wi), hi.u, hi.v);
+  ls->L = light_tri_radiance(s, h.tri, hi.ng, v3_neg(wi), hi.u, hi.v);
   ls->pdf = k->pdf;
   ls->visible = 1;
   return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
@@ -136,6 +136,6 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
   }
   int32_t lid = s->tri_light[h->tri];
   if (lid < 0) return c3(0, 0, 0);
-  return light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
+  return light_tri_radiance(s, h->tri, it->ng, v3_neg(r->d), it->u, it->v);
 }
 

@@ -38,7 +38,7 @@ void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *s
   }
   int32_t lid = s->tri_light[h->tri];
   if (lid >= 0) {
-    *Le = light_area_radiance(s, &s->lights[lid], it->ng, v3_neg(r->d), it->u, it->v);
+    *Le = light_tri_radiance(s, h->tri, it->ng, v3_neg(r->d), it->u, it->v);
     if (!c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
   }
 }

@@ -16,6 +16,16 @@ rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u
   return c3_mul(L, c3(px[0], px[1], px[2]));
 }
 
+rgb light_tri_radiance(const scene *s, uint32_t tri, vec3 ng, vec3 w, float u, float v) {
+  const material *m = &s->mats[s->tri_mat[tri]];
+  float c = v3_dot(ng, w);
+  rgb L = (c > 0 || (m->two_sided && c < 0)) ? m->emission : c3(0, 0, 0);
+  if (m->tex_ke < 0 || c3_black(L)) return L;
+  float px[4];
+  texture_lookup(&s->tex[m->tex_ke], u, v, px);
+  return c3_mul(L, c3(px[0], px[1], px[2]));
+}
+
 float light_power(const scene *s, const light *l) {
   switch (l->type) {
   case LIGHT_AREA: return PI_F * l->area * c3_avg(l->L) * (l->two_sided ? 2.0f : 1.0f);

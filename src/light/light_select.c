@@ -340,7 +340,7 @@ static int sphere_cone(const sphere_shape *sp, vec3 p, light_cone *k) {
 
 int light_sphere_at(const light_sampler *ls, const scene *s, uint32_t li, vec3 p, light_cone *k) {
   if (!ls->sphere_cones || !ls->unit0 || li >= s->nlights) return 0;
-  const light *l = &s->lights[li];
+  const light *l = &s->lights[ls->unit0[ls->unit_of[li]]]; /* its unit's first: a sphere's lights share type and sphere */
   if (l->type != LIGHT_AREA || !l->sphere) return 0;
   return sphere_cone(&s->spheres[l->sphere - 1], p, k);
 }
