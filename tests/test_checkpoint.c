@@ -114,11 +114,13 @@ static int one_kill(const ckpt_case *c) {
 }
 
 /* A real SIGKILL mid-way, then --resume: the EXR is byte-identical to an uninterrupted
- * render's. Each is killed well before its last checkpoint (path: 8 of them; adaptive:
+ * render's (splatted ones too: the filters' weight sums are in it). Each is killed well before its last checkpoint (path: 8 of them; adaptive:
  * about 22, killed past the uniform half of the budget; photon 6; vpl 12). */
 static int kill_and_resume(void) {
   static const ckpt_case cases[] = {
       {"path", {NULL}, 128, 4, 1},
+      {"path splatted (gaussian)", {"--filter", "gaussian", "--splat", NULL}, 128, 4, 1},
+      {"path splatted, adaptive", {"--filter", "gaussian", "--splat", "--adaptive", NULL}, 64, 12, 33},
       {"path adaptive (error rule)", {"--adaptive", NULL}, 64, 12, 33},
       {"path adaptive (digest rule)", {"--adaptive", "--adaptive-rule", "digest", NULL}, 64, 12, 33},
       {"photon", {"--integrator", "photon", "--param", "photon.global=5000", "--param", "photon.caustic=2000", "--param", "photon.gather=4", NULL},

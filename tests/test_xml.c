@@ -129,7 +129,7 @@ static int xml_equals_json(void) {
   char json[4096];
   snprintf(json, sizeof json,
            "{\"camera\": {\"position\": [0, 2, 6], \"look_at\": [0, 0.5, 0], \"up\": [0, 1, 0], \"fov\": %.17g},\n"
-           " \"film\": {\"width\": 48, \"height\": 32, \"filter\": \"tent\", \"filter_radius\": 1},\n"
+           " \"film\": {\"width\": 48, \"height\": 32, \"filter\": \"tent\", \"filter_radius\": 1, \"splat\": true},\n"
            " \"render\": {\"integrator\": \"path\", \"max_depth\": 4, \"spp\": 4, \"sampler\": \"independent\"},\n"
            " \"materials\": {\"white\": {\"type\": \"diffuse\", \"reflectance\": [0.7, 0.6, 0.5]},\n"
            "   \"metal\": {\"type\": \"conductor\", \"eta\": [0.2, 0.9, 1.1], \"k\": [3.9, 2.4, 2.1], \"reflectance\": [0.8, 0.8, 0.8],\n"
@@ -726,7 +726,7 @@ static int rfilters(void) {
     CHECK(st == VALO_OK, "%s: %s", cases[i].rf, err.message);
     CHECK(warned == cases[i].warns, "%s: %s", cases[i].rf, warned ? "warned" : "no warning");
     char *text = read_text_file(out);
-    snprintf(want, sizeof want, "\"filter\":\t\"%s\",\n\t\t\"filter_radius\":\t%g\n", cases[i].name, cases[i].radius);
+    snprintf(want, sizeof want, "\"filter\":\t\"%s\",\n\t\t\"splat\":\ttrue,\n\t\t\"filter_radius\":\t%g\n", cases[i].name, cases[i].radius);
     CHECK(text && strstr(text, want), "%s: the film is not %s of radius %g: %s", cases[i].rf, cases[i].name, cases[i].radius, text ? text : "");
     free(text);
   }

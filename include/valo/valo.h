@@ -97,6 +97,10 @@ typedef struct valo_options {
                              "gaussian" or "blackman-harris" (docs/scene-format.md, "film") */
   double filter_radius;   /* its radius in pixels; VALO_UNSET = the filter's default (box
                              0.5, tent 1, gaussian 2, blackman-harris 1.5) */
+  int splat;              /* 1: each sample is splatted into every pixel the filter reaches
+                             and each pixel divided by its weights' sum (Mitsuba's film),
+                             else the filter is sampled, a sample counting for its pixel
+                             alone (docs/scene-format.md, "film"); VALO_UNSET = 0 */
   int frames;             /* > 0: render a sequence of this many frames (the scene's
                              camera animation, or a static camera), each at spp samples
                              per pixel, calling the frame callback after each

@@ -64,6 +64,9 @@ const option_decl option_table[] = {
           "the filter's radius (default: box 0.5, tent 1, gaussian 2,\nblackman-harris 1.5 as Cycles' filter width, mitchell and\n"
           "catmull-rom 2, lanczos 3)"),
      R(filter_radius), .type = OPT_REAL, .lo = 0.1, .hi = 16, .keep_unset = 1, .unset = VALO_UNSET, .range_text = "pixels, 0.1..16"},
+    {INFO("--splat", NULL, "film.splat",
+          "splat each sample into every pixel the filter reaches (Mitsuba's\nfilm; a Mitsuba file's default) instead of sampling the filter"),
+     R(splat), .type = OPT_FLAG, .hi = 1, .def = 0, .unset = VALO_UNSET},
     {INFO("--integrator", "NAME", "render.integrator", "the integrator (default path; --help-integrators lists them)"), R(integrator),
      .type = OPT_NAME, .def_text = "path", .range_text = "an integrator's name"},
     {INFO("--param", "NAME=VALUE", NULL,

@@ -94,6 +94,8 @@ static valo_status read_film(mctx *c, xml_node *film, int *w, int *h) {
   TRY(put_num(c, f, "width", *w));
   TRY(put_num(c, f, "height", *h));
   if (!cJSON_AddStringToObject(f, "filter", rf)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  /* Mitsuba's film splats each sample into the pixels its filter reaches */
+  if (!cJSON_AddBoolToObject(f, "splat", 1)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   return put_num(c, f, "filter_radius", radius);
 }
 

@@ -111,13 +111,14 @@ valo_status checkpoint_write(const session *ss, const thread_stats *ts, const ch
   put_u32(&w, (uint32_t)fm->width);
   put_u32(&w, (uint32_t)fm->height);
   int32_t st[6] = {ss->spp_done, ss->ckpt_state.phase, ss->ckpt_state.stage, ss->ckpt_state.stages, ss->image_frames,
-                   (fm->sq ? 1 : 0) | (fm->aov ? 2 : 0)};
+                   (fm->sq ? 1 : 0) | (fm->aov ? 2 : 0) | (fm->wsum ? 4 : 0)};
   put(&w, st, sizeof st);
   put(&w, &ss->ckpt_state.taken, sizeof(double));
   put(&w, fm->sum, np * 3 * sizeof *fm->sum);
   put(&w, fm->count, np * sizeof *fm->count);
   if (fm->sq) put(&w, fm->sq, np * 4 * sizeof *fm->sq);
   if (fm->aov) put(&w, fm->aov, np * AOV_FLOATS * sizeof *fm->aov);
+  if (fm->wsum) put(&w, fm->wsum, np * sizeof *fm->wsum);
   if (ss->ckpt_state.phase == CKPT_ADAPT_ERROR) {
     put(&w, ss->ckpt_state.first, np * sizeof(uint32_t));
     put(&w, ss->ckpt_state.fin, np * sizeof(uint32_t));
@@ -236,7 +237,7 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   get(&r, s6, sizeof s6);
   double taken = 0;
   get(&r, &taken, sizeof taken);
-  if (!r.bad && (w != (uint32_t)fm->width || h != (uint32_t)fm->height || s6[5] != ((fm->sq ? 1 : 0) | (fm->aov ? 2 : 0)) ||
+  if (!r.bad && (w != (uint32_t)fm->width || h != (uint32_t)fm->height || s6[5] != ((fm->sq ? 1 : 0) | (fm->aov ? 2 : 0) | (fm->wsum ? 4 : 0)) ||
                  s6[0] < 0 || s6[1] < 0 || s6[1] > CKPT_ADAPT_DIGEST)) {
     st = err_set(err, VALO_ERR_PARSE, "%s: the checkpoint's film does not match this render: refused", path);
     goto done;
@@ -245,6 +246,7 @@ valo_status checkpoint_read(session *ss, const char *path, valo_error *err) {
   get(&r, fm->count, np * sizeof *fm->count);
   if (fm->sq) get(&r, fm->sq, np * 4 * sizeof *fm->sq);
   if (fm->aov) get(&r, fm->aov, np * AOV_FLOATS * sizeof *fm->aov);
+  if (fm->wsum) get(&r, fm->wsum, np * sizeof *fm->wsum);
   ckpt_state cs = {s6[1], s6[2], s6[3], taken, NULL, NULL};
   if (cs.phase == CKPT_ADAPT_ERROR) {
     cs.first = malloc(np * sizeof(uint32_t));

@@ -87,6 +87,20 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
     goto fail;
   }
   ss->lens.filter = ss->filter.kind == FILTER_BOX && ss->filter.radius == 0.5f ? NULL : &ss->filter;
+  /* Splatting: a positive filter wider than the pixel's box and at most TILE / 2 pixels
+   * in radius (tiles.c's rounds), samples from the tile loop. */
+  if (o.splat == 1 && ss->lens.filter && ss->filter.weight == 1 && ss->filter.radius <= TILE / 2 && integ->kind != INTEGRATOR_IMAGE) {
+    if (dist_size() > 1) {
+      log_warning("splatting into neighbouring pixels is not done across MPI ranks: the filter is sampled instead (the same image in expectation)");
+    } else {
+      if (film_enable_splat(&ss->film)) {
+        st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
+        goto fail;
+      }
+      ss->splat = 1;
+      ss->lens.filter = NULL; /* samples jittered over their pixel, then splatted through ss->filter */
+    }
+  }
   if (integ->kind == INTEGRATOR_IMAGE && ss->filter.weight != 1 && !(ss->frame_wt = calloc((size_t)o.width * o.height, sizeof(float)))) {
     st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
     goto fail;

@@ -48,6 +48,8 @@ struct session {
   camera cam_still;        /* the scene camera fitted to the film (frame 0 of an animation) */
   cam_lens lens;           /* this frame's camera and lens */
   pixel_filter filter;     /* the lens's pixel filter (lens.filter: NULL for the box of one pixel) */
+  int splat;               /* samples splatted through filter (film.wsum; tiles.c renders tiles
+                              in four rounds so that no two threads reach one pixel) */
   cam_view view_prev;      /* the previous frame's */
   int frames_done;         /* a sequence: frames finished */
   int image_frames;        /* render_frame calls made (the integrator's frame index) */

@@ -10,6 +10,7 @@ typedef struct pass_job {
   session *ss;
   const tile_pass *p;
   thread_stats *ts; /* one per thread */
+  int round;        /* splatting: the tiles (tx, ty) with (tx % 2, ty % 2) = (round % 2, round / 2) */
 } pass_job;
 
 int tiles_set_view(session *ss, int f) {
@@ -31,10 +32,18 @@ void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats 
   for (int si = s0; si < s1; si++) {
     sampler smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
     float w;
+    float jx = 0, jy = 0;
+    if (ss->splat) { /* camera_ray's jitter over the pixel, the same numbers */
+      sampler j = smp;
+      sampler_set_dim(&j, SDIM_FILM);
+      sampler_2d(&j, &jx, &jy);
+    }
     ray ry = camera_ray(&ss->lens, x, y, &smp, &w);
     ts->rays++;
     if (ss->film.aov) aov_record(ss, ry, &ss->film.aov[AOV_FLOATS * pix], &smp, ts);
-    film_add(&ss->film, pix, ss->integ->li(&ss->ctx, ry, &smp, ts), w, ts);
+    rgb L = ss->integ->li(&ss->ctx, ry, &smp, ts);
+    if (ss->splat) film_add_splat(&ss->film, pix, (float)x + jx, (float)y + jy, L, &ss->filter, ts);
+    else film_add(&ss->film, pix, L, w, ts);
   }
 }
 
@@ -71,10 +80,32 @@ static void render_tile(void *user, int64_t item, int thread) {
   tiles_render_tile(j->ss, item, j->p->s0, j->p->s1, j->p->target, &j->ts[thread]);
 }
 
+/* The item-th tile of a splatting round: tiles two apart in x and y, whose splats (at
+ * most the filter's radius, up to TILE / 2 pixels, past their edges) never meet. */
+static int64_t round_tile(const session *ss, int round, int64_t item) {
+  int64_t tx = (ss->opt.width + TILE - 1) / TILE, nx = (tx - round % 2 + 1) / 2;
+  return (item / nx * 2 + round / 2) * tx + item % nx * 2 + round % 2;
+}
+static void render_round_tile(void *user, int64_t item, int thread) {
+  pass_job *j = user;
+  if (session_cancelled(j->ss)) return;
+  tiles_render_tile(j->ss, round_tile(j->ss, j->round, item), j->p->s0, j->p->s1, j->p->target, &j->ts[thread]);
+}
+
 static valo_status local_run(session *ss, const tile_pass *p, thread_stats *ts, valo_error *err) {
   (void)err;
-  pass_job job = {ss, p, ts};
-  parallel_for(ss->opt.threads, tiles_count(ss), render_tile, &job);
+  pass_job job = {ss, p, ts, 0};
+  if (!ss->splat) {
+    parallel_for(ss->opt.threads, tiles_count(ss), render_tile, &job);
+    return VALO_OK;
+  }
+  /* Four rounds, one after another: a pixel gets its splats from up to four tiles, always
+   * in round order, so the image does not depend on the thread count. */
+  int64_t tx = (ss->opt.width + TILE - 1) / TILE, ty = (ss->opt.height + TILE - 1) / TILE;
+  for (job.round = 0; job.round < 4; job.round++) {
+    int64_t nx = (tx - job.round % 2 + 1) / 2, ny = (ty - job.round / 2 + 1) / 2;
+    if (nx > 0 && ny > 0) parallel_for(ss->opt.threads, nx * ny, render_round_tile, &job);
+  }
   return VALO_OK;
 }
 const tile_source tiles_local = {local_run};
