@@ -4,8 +4,8 @@
  * width is this radius), and three with negative lobes: Mitchell-Netravali (B = C = 1/3),
  * Catmull-Rom (B = 0, C = 1/2), both cubics stretched over [-radius, radius] as pbrt's
  * (Mitsuba's, fixed at radius 2), and Lanczos (sinc(x) sinc(x/radius), Mitsuba's of
- * radius "lobes"); all separable in x and y. It is sampled, not splatted (filter
- * importance sampling, as pbrt-v4): a camera sample lands at an offset from its pixel's
+ * radius "lobes"); all separable in x and y. By default it is sampled (filter
+ * importance sampling, as pbrt-v4; film.splat splats through it instead, render/film.h): a camera sample lands at an offset from its pixel's
  * centre drawn in proportion to |filter| and counts for that pixel alone, with weight 1
  * where the filter is positive and, for the filters with negative lobes, sign(filter) x
  * integral |filter| / integral filter per axis. The film stays a per-pixel average (the
