@@ -8,22 +8,22 @@
 #include <stdlib.h>
 #include <string.h>
 
-rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v) {
-  rgb L = light_area_emitted(l, ng, w);
-  if (l->tex_ke < 0 || c3_black(L)) return L;
+/* L times the emission map tex_ke (if any) at (u, v). */
+static rgb emission_mapped(const scene *s, rgb L, int tex_ke, float u, float v) {
+  if (tex_ke < 0 || c3_black(L)) return L;
   float px[4];
-  texture_lookup(&s->tex[l->tex_ke], u, v, px);
+  texture_lookup(&s->tex[tex_ke], u, v, px);
   return c3_mul(L, c3(px[0], px[1], px[2]));
+}
+
+rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u, float v) {
+  return emission_mapped(s, light_area_emitted(l, ng, w), l->tex_ke, u, v);
 }
 
 rgb light_tri_radiance(const scene *s, uint32_t tri, vec3 ng, vec3 w, float u, float v) {
   const material *m = &s->mats[s->tri_mat[tri]];
   float c = v3_dot(ng, w);
-  rgb L = (c > 0 || (m->two_sided && c < 0)) ? m->emission : c3(0, 0, 0);
-  if (m->tex_ke < 0 || c3_black(L)) return L;
-  float px[4];
-  texture_lookup(&s->tex[m->tex_ke], u, v, px);
-  return c3_mul(L, c3(px[0], px[1], px[2]));
+  return emission_mapped(s, (c > 0 || (m->two_sided && c < 0)) ? m->emission : c3(0, 0, 0), m->tex_ke, u, v);
 }
 
 float light_power(const scene *s, const light *l) {

@@ -39,25 +39,26 @@ int film_enable_splat(film *f) {
   return f->wsum ? 0 : -1;
 }
 
+/* Adaptive sampling's sums of squares of pixel pix's own samples. */
+static void add_squares(film *f, size_t pix, rgb L) {
+  if (!f->sq) return;
+  double *q = &f->sq[4 * pix], l = c3_lum(L);
+  q[0] += (double)L.r * L.r; q[1] += (double)L.g * L.g; q[2] += (double)L.b * L.b; q[3] += l * l;
+}
+
 void film_add(film *f, size_t pix, rgb L, float w, thread_stats *ts) {
   f->count[pix]++;
   if (!sample_usable(ts, L)) return;
   if (w != 1) L = c3_scale(L, w);
   double *acc = &f->sum[3 * pix];
   acc[0] += L.r; acc[1] += L.g; acc[2] += L.b;
-  if (f->sq) {
-    double *q = &f->sq[4 * pix], l = c3_lum(L);
-    q[0] += (double)L.r * L.r; q[1] += (double)L.g * L.g; q[2] += (double)L.b * L.b; q[3] += l * l;
-  }
+  add_squares(f, pix, L);
 }
 
 void film_add_splat(film *f, size_t pix, float fx, float fy, rgb L, const pixel_filter *pf, thread_stats *ts) {
   f->count[pix]++;
   if (!sample_usable(ts, L)) return;
-  if (f->sq) {
-    double *q = &f->sq[4 * pix], l = c3_lum(L);
-    q[0] += (double)L.r * L.r; q[1] += (double)L.g * L.g; q[2] += (double)L.b * L.b; q[3] += l * l;
-  }
+  add_squares(f, pix, L);
   float r = pf->radius;
   int x0 = (int)ceilf(fx - 0.5f - r), x1 = (int)floorf(fx - 0.5f + r), y0 = (int)ceilf(fy - 0.5f - r), y1 = (int)floorf(fy - 0.5f + r);
   if (x0 < 0) x0 = 0;
