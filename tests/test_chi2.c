@@ -947,6 +947,85 @@ static int light_selection_facing(void) {
   return rc;
 }
 
+/* ---- infinite lights (light.h): next-event estimation picks each of the n infinite
+ * lights (the environment, a sun) with probability 1 / (n + 1), and the finite ones share
+ * the rest by power (a bright lamp would get less than 1 % by the power rule here: the
+ * environment's power grows with the scene's radius squared); photon and VPL tracing
+ * (light_select_power) stay by power over all lights. Pmfs sum to 1, select agrees with
+ * light_select_pmf, frequencies match (chi-square); with a black lamp, the infinite lights
+ * take everything. */
+static int light_selection_infinite(void) {
+  int rc = 0;
+  for (int black = 0; black < 2 && !rc; black++) {
+    scene *s = scene_new("infinite");
+    scene_reserve(s, 6, 2);
+    s->pos[0] = v3(0, 1, 0); s->pos[1] = v3(0, 1, 1); s->pos[2] = v3(1, 1, 0);
+    s->pos[3] = v3(-50, 0, -50); s->pos[4] = v3(50, 0, -50); s->pos[5] = v3(0, 0, 50); /* a big dark floor */
+    s->nverts = 6;
+    for (int k = 0; k < 6; k++) s->idx[k] = (uint32_t)k;
+    s->tri_mat[0] = 0; s->tri_mat[1] = 1; s->tri_flags[0] = s->tri_flags[1] = 0; s->ntris = 2;
+    material m = material_default();
+    m.emission = black ? c3(0, 0, 0) : c3(20, 20, 20);
+    CHECK(scene_add_material(s, &m) == 0, "material");
+    material f = material_default();
+    CHECK(scene_add_material(s, &f) == 1, "material");
+    light pt = {0};
+    pt.type = LIGHT_POINT; pt.p = v3(3, 3, 3); pt.L = black ? c3(0, 0, 0) : c3(1, 1, 1);
+    CHECK(scene_add_light(s, &pt) == 0, "light");
+    light sun = {0};
+    sun.type = LIGHT_DIRECTIONAL; sun.dir = v3(0, -1, 0); sun.L = c3(2, 2, 2);
+    CHECK(scene_add_light(s, &sun) == 0, "light");
+    s->has_env = 1;
+    s->env_radiance = c3(0.5f, 0.5f, 0.5f);
+    valo_error err;
+    CHECK(scene_commit(s, &err) == VALO_OK, "%s", err.message);
+    light_sampler ls;
+    CHECK(light_sampler_init(&ls, s, LIGHT_SELECT_GRID, 1) == 0, "init");
+    uint32_t n = s->nlights;
+    CHECK(n == (black ? 3u : 4u) && ls.ninf == 2, "%u lights, %u infinite", n, ls.ninf); /* a black lamp has no light */
+    vec3 p = v3(0.2f, 1.7f, 0.2f);
+    double total = 0, obs[4] = {0}, ex[4], pw_inf = 0, pw_all = 0;
+    for (uint32_t i = 0; i < n; i++) {
+      float pm = light_select_pmf(&ls, s, i, p);
+      total += pm;
+      int inf = s->lights[i].type == LIGHT_ENV || s->lights[i].type == LIGHT_DIRECTIONAL;
+      float want = inf ? (black ? 0.5f : 1.0f / 3) : -1;
+      CHECK(!inf || fabsf(pm - want) < 1e-6f, "infinite light %u: pmf %g, want %g", i, pm, want);
+      CHECK(!black || inf || pm == 0, "black light %u: pmf %g", i, pm);
+      pw_all += ls.power[i];
+      if (inf) pw_inf += ls.power[i];
+    }
+    CHECK(fabs(total - 1) < 1e-5, "pmfs sum to %g", total);
+    CHECK(black || pw_inf / pw_all > 0.99, "the power rule would give the infinite lights only %.3f", pw_inf / pw_all);
+    long ns = nsamples() / 10;
+    for (long k = 0; k < ns; k++) {
+      sampler sm = sampler_make(5, (uint64_t)k, (uint64_t)black);
+      float pmf;
+      uint32_t li = light_select(&ls, s, p, sampler_1d(&sm), &pmf);
+      CHECK(li < n, "no light picked");
+      CHECK(pmf == light_select_pmf(&ls, s, li, p), "light %u: select says %g, pmf %g", li, pmf, light_select_pmf(&ls, s, li, p));
+      obs[li]++;
+    }
+    double o[4], e[4];
+    int m2 = 0;
+    for (uint32_t i = 0; i < n; i++) {
+      ex[i] = ns * light_select_pmf(&ls, s, i, p);
+      if (ex[i] > 0) { o[m2] = obs[i]; e[m2++] = ex[i]; } else CHECK(obs[i] == 0, "light %u of pmf 0 picked %g times", i, obs[i]);
+    }
+    rc = chi2_check(black ? "light selection, infinite lights and black lamps" : "light selection with infinite lights", o, e, m2);
+    /* light tracing keeps the power rule */
+    for (int k = 0; k < 64 && !rc; k++) {
+      float pmf;
+      uint32_t li = light_select_power(&ls, (k + 0.5f) / 64, &pmf);
+      CHECK(li < n && fabsf(pmf - ls.power[li] / (float)pw_all) < 1e-5f * pmf + 1e-9f, "light tracing: light %u pmf %g, power share %g", li, pmf,
+            ls.power[li] / pw_all);
+    }
+    light_sampler_free(&ls);
+    scene_free(s);
+  }
+  return rc;
+}
+
 static float u01(uint64_t *st) {
   uint64_t z = (*st += 0x9E3779B97F4A7C15ull);
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -1012,6 +1091,9 @@ static int light_grid_selection(void) {
       }
     }
     CHECK(fabs(total - 1) < 1e-4, "pmfs sum to %g", total);
+    for (uint32_t i = 0; i < n; i++) /* the only infinite light: half of the choice */
+      CHECK(s->lights[i].type != LIGHT_DIRECTIONAL || light_select_pmf(&ls, s, i, p) == 0.5f, "the sun's pmf %g, not 1/2",
+            light_select_pmf(&ls, s, i, p));
     /* lamps whose back faces the whole cell around p (p behind their plane by more than
      * the cell's diagonal) get the power share alone: the grid's own part is 0, up to the
      * rounding of its float running sums (two ulps of 1) */
@@ -1390,7 +1472,7 @@ int main(int argc, char **argv) {
                                     {"microfacet_furnace", microfacet_furnace}, {"ggx_albedo", ggx_albedo}, {"bsdf_reciprocity", bsdf_reciprocity},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness}, {"pbr_sheen", pbr_sheen}, {"plastic", plastic}, {"principled", principled},
                                     {"sobol_sampler", sobol_sampler},
-                                    {"light_selection_facing", light_selection_facing}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
+                                    {"light_selection_facing", light_selection_facing}, {"light_selection_infinite", light_selection_infinite}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
                                     {"pixel_filters", pixel_filters}, {"hg_phase", hg_phase}, {"free_flight", free_flight}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

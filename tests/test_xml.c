@@ -60,7 +60,7 @@ static int parser(void) {
 static const char *XML_SCENE =
     "<scene version=\"3.0.0\">\n"
     "  <default name=\"spp\" value=\"4\"/>\n"
-    "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"5\"/></integrator>\n"
+    "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"5\"/><integer name=\"rr_depth\" value=\"2\"/></integrator>\n"
     "  <sensor type=\"perspective\">\n"
     "    <float name=\"fov\" value=\"50\"/>\n"
     "    <transform name=\"to_world\"><lookat origin=\"0, 2, 6\" target=\"0, 0.5, 0\" up=\"0, 1, 0\"/></transform>\n"
@@ -121,8 +121,8 @@ static void differ(const float *a, const float *b, int n, double *far, double *m
 
 static int xml_equals_json(void) {
   /* The JSON the XML means: Mitsuba's horizontal 50-degree field on a 48 x 32 film is a
-   * vertical one of 2 atan(tan 25 / 1.5); max_depth 5 counts the camera ray, valo's 4 does
-   * not; alpha 0.09 is roughness 0.3; bk7 in air is 1.5046 / 1.00028; the spot's beam is
+   * vertical one of 2 atan(tan 25 / 1.5); max_depth 5 and rr_depth 2 count the camera ray,
+   * valo's 4 and 1 do not; alpha 0.09 is roughness 0.3; bk7 in air is 1.5046 / 1.00028; the spot's beam is
    * 3/4 of its cut-off (delta 7.5 degrees), falling off linearly in angle as Mitsuba's
    * does; the disk, with no BSDF, is Mitsuba's default diffuse 0.5. */
   double vfov = 360 / M_PI * atan(tan(25 * M_PI / 180) / 1.5);
@@ -130,7 +130,7 @@ static int xml_equals_json(void) {
   snprintf(json, sizeof json,
            "{\"camera\": {\"position\": [0, 2, 6], \"look_at\": [0, 0.5, 0], \"up\": [0, 1, 0], \"fov\": %.17g},\n"
            " \"film\": {\"width\": 48, \"height\": 32, \"filter\": \"tent\", \"filter_radius\": 1, \"splat\": true},\n"
-           " \"render\": {\"integrator\": \"path\", \"max_depth\": 4, \"spp\": 4, \"sampler\": \"independent\"},\n"
+           " \"render\": {\"integrator\": \"path\", \"max_depth\": 4, \"rr_depth\": 1, \"spp\": 4, \"sampler\": \"independent\"},\n"
            " \"materials\": {\"white\": {\"type\": \"diffuse\", \"reflectance\": [0.7, 0.6, 0.5]},\n"
            "   \"metal\": {\"type\": \"conductor\", \"eta\": [0.2, 0.9, 1.1], \"k\": [3.9, 2.4, 2.1], \"reflectance\": [0.8, 0.8, 0.8],\n"
            "             \"roughness\": 0.3, \"distribution\": \"beckmann\"},\n"
@@ -173,9 +173,9 @@ static int xml_equals_json(void) {
 /* Mitsuba 0.6's names (camelCase, lookAt) mean what Mitsuba 3's do: the same image. */
 static int mitsuba_06_names(void) {
   char *old = strdup(XML_SCENE);
-  static const char *const from[] = {"version=\"3.0.0\"", "max_depth", "to_world", "to_world", "to_world", "to_world", "to_world",
+  static const char *const from[] = {"version=\"3.0.0\"", "max_depth", "rr_depth", "to_world", "to_world", "to_world", "to_world", "to_world",
                                      "sample_count", "int_ior", "ext_ior", "specular_reflectance", "cutoff_angle", "<lookat", "<lookat"};
-  static const char *const to[] = {"version=\"0.6.0\"", "maxDepth", "toWorld", "toWorld", "toWorld", "toWorld", "toWorld",
+  static const char *const to[] = {"version=\"0.6.0\"", "maxDepth", "rrDepth", "toWorld", "toWorld", "toWorld", "toWorld", "toWorld",
                                    "sampleCount", "intIOR", "extIOR", "specularReflectance", "cutoffAngle", "<lookAt", "<lookAt"};
   for (size_t k = 0; k < sizeof from / sizeof from[0]; k++) {
     char *p = strstr(old, from[k]);

@@ -53,6 +53,9 @@ typedef struct valo_options {
   int max_depth;          /* path length limit; -1 (default): unlimited, ended by Russian
                              roulette (a safety cap of 1024 bounces applies);
                              VALO_DEPTH_UNSET when not given */
+  int rr_depth;           /* the bounce (0: the first surface the camera ray meets) from
+                             which Russian roulette may end a path; default 5 (Mitsuba's
+                             rr_depth 6: Mitsuba counts the camera ray); VALO_UNSET */
   char integrator[32];    /* "path" (default) */
   char params[1024];      /* integrator parameters (docs/integrators.md): "name=value"
                              entries separated by spaces, commas or newlines; a name may

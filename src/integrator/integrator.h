@@ -32,6 +32,7 @@ typedef struct render_ctx {
   const accel *acc;
   light_sampler ls;
   int max_depth;           /* -1: unlimited (Russian roulette, capped at PATH_HARD_CAP) */
+  int rr_depth;            /* Russian roulette from this bounce on (path_roulette) */
   int hide_emitters;       /* camera rays do not count the emission they meet first */
   const double *param;     /* the integrator's parameter values, in its table's order */
   const void *state;       /* what the integrator's create/prepare made (photon maps, points) */

@@ -32,7 +32,7 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
     if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
     beta = c3_mul(beta, weight);
-    if (!path_survive(&st, &beta, depth, smp)) break;
+    if (!path_survive(&st, &beta, depth, c->rr_depth, smp)) break;
   }
   return L;
 }

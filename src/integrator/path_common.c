@@ -85,9 +85,9 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
   return 1;
 }
 
-float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp) {
+float path_roulette(const path_state *st, float max_beta, int depth, int rr_depth, sampler *smp) {
   float rr = max_beta * st->eta_acc;
-  if (depth < 2 || rr >= 1) return 1;
+  if (depth < rr_depth || rr >= 1) return 1;
   float q = fmaxf(0.0f, 1 - rr);
   if (sampler_1d(smp) < q) return 0;
   return 1 / (1 - q);

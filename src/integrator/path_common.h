@@ -41,17 +41,17 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
  * returns 1 with *bs and the world direction *wi, or 0 when no direction came out or it
  * disagrees with the geometric normal about reflection vs transmission. */
 int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi);
-/* Russian roulette (pbrt-v4) after depth 2: survive with probability
- * min(1, max throughput x eta^2); returns the factor to scale the throughput by on
- * survival, 0 to end the path. */
-float path_roulette(const path_state *st, float max_beta, int depth, sampler *smp);
+/* Russian roulette (pbrt-v4's rule) from bounce rr_depth on (render.rr_depth): survive
+ * with probability min(1, max throughput x eta^2); returns the factor to scale the
+ * throughput by on survival, 0 to end the path. */
+float path_roulette(const path_state *st, float max_beta, int depth, int rr_depth, sampler *smp);
 /* The end of a bounce of an RGB path: 0 when the throughput *beta is black or not
  * finite or Russian roulette (its dimension of this depth) ends the path; otherwise 1
  * with *beta divided by the survival probability. */
-static inline int path_survive(const path_state *st, rgb *beta, int depth, sampler *smp) {
+static inline int path_survive(const path_state *st, rgb *beta, int depth, int rr_depth, sampler *smp) {
   if (c3_black(*beta) || !c3_finite(*beta)) return 0;
   sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
-  float survive = path_roulette(st, c3_max(*beta), depth, smp);
+  float survive = path_roulette(st, c3_max(*beta), depth, rr_depth, smp);
   if (survive == 0) return 0;
   *beta = c3_scale(*beta, survive);
   return 1;

@@ -159,7 +159,7 @@ spec4 path_media_walk(const render_ctx *c, ray r, sampler *smp, thread_stats *ts
     }
     if (spec_black(beta) || !finite4(beta)) break;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
-    float survive = path_roulette(&st, spec_max(beta), depth, smp);
+    float survive = path_roulette(&st, spec_max(beta), depth, c->rr_depth, smp);
     if (survive == 0) break;
     beta = spec_scale(beta, survive);
   }

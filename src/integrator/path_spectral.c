@@ -77,7 +77,7 @@ static rgb path_spectral_li(const render_ctx *c, ray r, sampler *smp, thread_sta
     if (nk) beta = spec_mul(beta, nk_fresnel(nk, wo, r.d, &wl));
     if (spec_black(beta)) break;
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_ROULETTE));
-    float survive = path_roulette(&st, spec_max(beta), depth, smp);
+    float survive = path_roulette(&st, spec_max(beta), depth, c->rr_depth, smp);
     if (survive == 0) break;
     beta = spec_scale(beta, survive);
   }

@@ -23,6 +23,14 @@
  *    cell's distribution with probability 1 - LIGHT_GRID_POWER, else by power, and the
  *    pmf is that mixture, so every light that can reach the point keeps a positive
  *    probability (unbiased whatever the bound misjudges).
+ * Infinite lights (the environment, directional lights) are not ranked against the
+ * others by power (pi^2 R^2 L for the environment, R the scene's radius, outweighs a lamp
+ * that lights most of the scene): as pbrt-v4's BVH light sampler does, each of the n
+ * infinite lights is picked with probability 1 / (n + 1) and the finite lights share the
+ * rest (the infinite lights take it all when no finite light has power). On a floor lit by a constant sky and a
+ * rectangle lamp (the hide scene of tests/data/mitsuba-xml without its mirror and ball)
+ * this cut the relMSE at 64 spp (independent sampler) to 0.28x of the power rule's.
+ * light_select_power, which photon and VPL tracing use, stays by power over all lights.
  * light_select and light_select_pmf make the same choice. */
 #define LIGHT_LOCAL_MAX 64
 #define LIGHT_GRID_CELLS 4096
@@ -46,6 +54,10 @@ typedef struct light_sampler {
   float *grid_cdf;      /* per cell, nu running sums normalised to 1 (cells with nothing: all 0) */
   int gdim[3];
   vec3 glo, ginv;       /* grid origin and cells per unit length */
+  uint32_t ninf, *inf;  /* the infinite lights of positive power (none: NULL) */
+  float p_inf;          /* their share of the choice */
+  alias_table ftable;   /* with inf: the finite lights' table (units' power, infinite 0) */
+  int has_finite;       /* with inf: ftable was built (some finite light has power) */
 } light_sampler;
 
 /* sphere_cones: sample emitting spheres by their cones (light_sphere_at). */

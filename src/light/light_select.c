@@ -29,7 +29,6 @@ static int grid_build(light_sampler *ls, const scene *s) {
   grid_light *gl = malloc(n * sizeof *gl);
   float *cdf = malloc(cells * n * sizeof *cdf);
   if (!gl || !cdf) { free(gl); free(cdf); return -1; }
-  float R2 = PI_F * s->radius * s->radius;
   for (uint32_t i = 0; i < n; i++) {
     grid_light *g = &gl[i];
     memset(g, 0, sizeof *g);
@@ -57,7 +56,7 @@ static int grid_build(light_sampler *ls, const scene *s) {
       break;
     }
     case LIGHT_POINT: case LIGHT_SPOT: g->c = l->p; g->w_far = pw / (4 * PI_F); g->local = 1; break;
-    case LIGHT_DIRECTIONAL: case LIGHT_ENV: g->w_far = pw / R2; break;
+    case LIGHT_DIRECTIONAL: case LIGHT_ENV: g->w_far = 0; break; /* their own share (light.h) */
     }
   }
   vec3 cell = v3(e[0] / ls->gdim[0], e[1] / ls->gdim[1], e[2] / ls->gdim[2]);
@@ -128,6 +127,28 @@ static int units_build(light_sampler *ls, const scene *s) {
   return 0;
 }
 
+static int is_infinite(const light *l) { return l->type == LIGHT_ENV || l->type == LIGHT_DIRECTIONAL; }
+
+/* The infinite lights' share (light.h) and the table of the finite ones. */
+static int infinite_build(light_sampler *ls, const scene *s) {
+  uint32_t ninf = 0;
+  for (uint32_t i = 0; i < ls->n; i++) ninf += is_infinite(&s->lights[i]) && ls->power[i] > 0;
+  if (ninf == 0) return 0;
+  ls->inf = malloc(ninf * sizeof *ls->inf);
+  float *fw = malloc(ls->nu * sizeof *fw);
+  if (!ls->inf || !fw) { free(fw); return -1; }
+  for (uint32_t i = 0; i < ls->n; i++)
+    if (is_infinite(&s->lights[i]) && ls->power[i] > 0) ls->inf[ls->ninf++] = i;
+  for (uint32_t u = 0; u < ls->nu; u++) {
+    uint32_t li = ls->unit0 ? ls->unit0[u] : u;
+    fw[u] = is_infinite(&s->lights[li]) ? 0 : (ls->unit0 ? ls->upower[u] : ls->power[li]);
+  }
+  ls->has_finite = alias_build(&ls->ftable, fw, ls->nu) == 0;
+  free(fw);
+  ls->p_inf = ls->has_finite ? (float)ninf / (float)(ninf + 1) : 1.0f;
+  return 0;
+}
+
 int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode, int sphere_cones) {
   memset(ls, 0, sizeof *ls);
   ls->env_index = -1;
@@ -149,11 +170,18 @@ int light_sampler_init(light_sampler *ls, const scene *s, light_select_mode mode
     light_sampler_free(ls);
     return 0;
   }
+  if (infinite_build(ls, s)) { light_sampler_free(ls); return -1; }
   if (!ls->local && mode == LIGHT_SELECT_GRID && grid_build(ls, s)) { light_sampler_free(ls); return -1; }
   return 0;
 }
 void light_sampler_free(light_sampler *ls) {
   alias_free(&ls->table);
+  if (ls->inf) alias_free(&ls->ftable);
+  free(ls->inf);
+  ls->inf = NULL;
+  ls->ninf = 0;
+  ls->p_inf = 0;
+  ls->has_finite = 0;
   free(ls->power);
   free(ls->grid_cdf);
   free(ls->power_cdf);
@@ -179,9 +207,16 @@ static int light_faces(const light *l, vec3 p) {
  * has no units: it is used only up to LIGHT_LOCAL_MAX lights.) */
 static float facing_weights(const light_sampler *ls, const scene *s, vec3 p, float w[LIGHT_LOCAL_MAX]) {
   float total = 0;
-  for (uint32_t i = 0; i < ls->n; i++) { w[i] = light_faces(&s->lights[i], p) ? ls->power[i] : 0; total += w[i]; }
+  for (uint32_t i = 0; i < ls->n; i++) {
+    const light *l = &s->lights[i];
+    w[i] = light_faces(l, p) && !(ls->ninf && is_infinite(l)) ? ls->power[i] : 0;
+    total += w[i];
+  }
   return total;
 }
+
+/* The table next-event estimation picks finite lights from (by power). */
+static inline const alias_table *nee_table(const light_sampler *ls) { return ls->ninf ? &ls->ftable : &ls->table; }
 
 /* The grid cell's running sums for point p (NULL when the cell has no light). */
 static const float *grid_row(const light_sampler *ls, vec3 p) {
@@ -198,7 +233,7 @@ static const float *grid_row(const light_sampler *ls, vec3 p) {
 /* The mixture's probability of unit i at a point whose cell has running sums row: one
  * expression for light_select and light_select_pmf, so they agree to the bit. */
 static inline float grid_mix_pmf(const light_sampler *ls, const float *row, uint32_t i) {
-  return LIGHT_GRID_POWER * alias_pmf(&ls->table, i) + (1 - LIGHT_GRID_POWER) * (i ? row[i] - row[i - 1] : row[0]);
+  return LIGHT_GRID_POWER * alias_pmf(nee_table(ls), i) + (1 - LIGHT_GRID_POWER) * (i ? row[i] - row[i - 1] : row[0]);
 }
 
 light_site light_locate(const light_sampler *ls, vec3 p) {
@@ -233,12 +268,16 @@ static uint32_t unit_light(const light_sampler *ls, uint32_t un, float pu, float
   return lo;
 }
 
+/* A light by power from table t (over the units). */
+static uint32_t power_pick(const light_sampler *ls, const alias_table *t, float u, float *pmf) {
+  if (!ls->unit0) return alias_sample(t, u, pmf);
+  float pu, rest;
+  uint32_t un = alias_sample_rest(t, u, &pu, &rest);
+  return unit_light(ls, un, pu, rest, pmf);
+}
 uint32_t light_select_power(const light_sampler *ls, float u, float *pmf) {
   if (ls->table.n == 0) return UINT32_MAX;
-  if (!ls->unit0) return alias_sample(&ls->table, u, pmf);
-  float pu, rest;
-  uint32_t un = alias_sample_rest(&ls->table, u, &pu, &rest);
-  return unit_light(ls, un, pu, rest, pmf);
+  return power_pick(ls, &ls->table, u, pmf);
 }
 
 /* The grid's choice at `at` (row not NULL): the unit, its mixture pmf *pu and, with
@@ -250,7 +289,7 @@ static uint32_t grid_select(const light_sampler *ls, const float *row, float u, 
   if (u < a) {
     float power_pmf; /* not the answer: the mixture's pmf is */
     float v = fminf(u / a, 0x1.fffffep-1f);
-    i = ls->unit0 ? alias_sample_rest(&ls->table, v, &power_pmf, rest) : alias_sample(&ls->table, v, &power_pmf);
+    i = ls->unit0 ? alias_sample_rest(nee_table(ls), v, &power_pmf, rest) : alias_sample(nee_table(ls), v, &power_pmf);
   } else {
     float v = fminf((u - a) / (1 - a), 0x1.fffffep-1f);
     uint32_t lo = 0, hi = ls->nu - 1; /* the first i with row[i] > v */
@@ -271,22 +310,36 @@ static uint32_t grid_select(const light_sampler *ls, const float *row, float u, 
 /* The unit picked at `at` (a sampler with units): *pu and *rest as grid_select. */
 static uint32_t unit_select(const light_sampler *ls, const light_site *at, float u, float *pu, float *rest) {
   if (ls->grid_cdf && at->row) return grid_select(ls, at->row, u, pu, rest);
-  return alias_sample_rest(&ls->table, u, pu, rest);
+  return alias_sample_rest(nee_table(ls), u, pu, rest);
 }
 
-uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
-  if (ls->table.n == 0) return UINT32_MAX;
+/* The infinite lights' share of u (light.h): an infinite light when u falls in it (its pmf
+ * in *pmf), else UINT32_MAX with u rescaled to the finite lights' share, *keep. */
+static uint32_t infinite_pick(const light_sampler *ls, float *u, float *pmf, float *keep) {
+  *keep = 1;
+  if (!ls->ninf) return UINT32_MAX;
+  if (*u < ls->p_inf) {
+    uint32_t k = (uint32_t)(*u / ls->p_inf * (float)ls->ninf);
+    *pmf = ls->p_inf / (float)ls->ninf;
+    return ls->inf[k < ls->ninf ? k : ls->ninf - 1];
+  }
+  *keep = 1 - ls->p_inf;
+  *u = fminf((*u - ls->p_inf) / *keep, 0x1.fffffep-1f);
+  return UINT32_MAX;
+}
+
+static uint32_t finite_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
   if (ls->unit0) {
     float pu, rest;
     uint32_t un = unit_select(ls, at, u, &pu, &rest);
     return unit_light(ls, un, pu, rest, pmf);
   }
   if (ls->grid_cdf) {
-    if (!at->row) return light_select_power(ls, u, pmf);
+    if (!at->row) return power_pick(ls, nee_table(ls), u, pmf);
     float rest;
     return grid_select(ls, at->row, u, pmf, &rest);
   }
-  if (!ls->local) return light_select_power(ls, u, pmf);
+  if (!ls->local) return power_pick(ls, nee_table(ls), u, pmf);
   float w[LIGHT_LOCAL_MAX], total = facing_weights(ls, s, at->p, w);
   if (!(total > 0)) return UINT32_MAX;
   float target = u * total, acc = 0;
@@ -301,14 +354,26 @@ uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_si
   return last;
 }
 
+uint32_t light_select_at(const light_sampler *ls, const scene *s, const light_site *at, float u, float *pmf) {
+  if (ls->table.n == 0) return UINT32_MAX;
+  float keep;
+  uint32_t li = infinite_pick(ls, &u, pmf, &keep);
+  if (li != UINT32_MAX || !(keep > 0)) return li;
+  li = finite_select_at(ls, s, at, u, pmf);
+  if (li != UINT32_MAX) *pmf *= keep;
+  return li;
+}
+
 /* The probability of unit un at p. */
 static float unit_pmf(const light_sampler *ls, uint32_t un, vec3 p) {
   const float *row = ls->grid_cdf ? grid_row(ls, p) : NULL;
-  return row ? grid_mix_pmf(ls, row, un) : alias_pmf(&ls->table, un);
+  return row ? grid_mix_pmf(ls, row, un) : alias_pmf(nee_table(ls), un);
 }
 
-float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
-  if (ls->table.n == 0) return 0;
+/* The share of the finite lights in the choice (light.h). */
+static inline float finite_share(const light_sampler *ls) { return ls->ninf ? 1 - ls->p_inf : 1; }
+
+static float finite_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
   if (ls->unit0) {
     uint32_t un = ls->unit_of[li];
     return unit_share(ls, un, li, unit_pmf(ls, un, p));
@@ -318,11 +383,19 @@ float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec
   return total > 0 ? w[li] / total : 0;
 }
 
+float light_select_pmf(const light_sampler *ls, const scene *s, uint32_t li, vec3 p) {
+  if (ls->table.n == 0 || li >= ls->n) return 0;
+  if (ls->ninf && is_infinite(&s->lights[li])) return ls->power[li] > 0 ? ls->p_inf / (float)ls->ninf : 0;
+  float keep = finite_share(ls);
+  return keep > 0 ? keep * finite_pmf(ls, s, li, p) : 0;
+}
+
 float light_range_pmf(const light_sampler *ls, uint32_t l0, uint32_t l1, vec3 p) {
   if (ls->table.n == 0 || !ls->unit0 || l1 <= l0 || l1 > ls->n) return 0;
   uint32_t un = ls->unit_of[l0];
   if (ls->unit0[un] != l0 || ls->unit0[un + 1] != l1) return 0;
-  return unit_pmf(ls, un, p);
+  float keep = finite_share(ls);
+  return keep > 0 ? keep * unit_pmf(ls, un, p) : 0;
 }
 
 /* The cone of emitting sphere sp from p, when p lies outside it by the margin. */
@@ -349,9 +422,13 @@ uint32_t light_select_cone(const light_sampler *ls, const scene *s, vec3 p, floa
   k->sp = NULL;
   if (!ls->unit0 || !ls->sphere_cones) return light_select(ls, s, p, u, pmf);
   if (ls->table.n == 0) return UINT32_MAX;
+  float keep;
+  uint32_t li = infinite_pick(ls, &u, pmf, &keep);
+  if (li != UINT32_MAX || !(keep > 0)) return li;
   light_site at = light_locate(ls, p);
   float pu, rest;
   uint32_t un = unit_select(ls, &at, u, &pu, &rest), l0 = ls->unit0[un];
+  pu *= keep;
   if (light_sphere_at(ls, s, l0, p, k)) { *pmf = pu; return l0; }
   k->sp = NULL;
   return unit_light(ls, un, pu, rest, pmf);

@@ -184,10 +184,10 @@ static valo_status read_integrator(mctx *c, xml_node *n) {
   const char *type = xml_attr_get(n, "type");
   cJSON *render = put_obj(c->out, "render");
   if (!render) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
-  int depth = -1, direct = type && !strcmp(type, "direct");
+  int depth = -1, rr = -1, direct = type && !strcmp(type, "direct");
   if (type && (!strcmp(type, "path") || !strcmp(type, "volpath") || !strcmp(type, "volpathmis") || !strcmp(type, "prb") || direct)) {
     TRY(mi_int(c, n, "max_depth", &depth));
-    (void)mi_prop(c, n, "rr_depth");
+    TRY(mi_int(c, n, "rr_depth", &rr));
     int hide = 0;
     TRY(mi_bool(c, n, "hide_emitters", &hide));
     if (hide && !cJSON_AddTrueToObject(render, "hide_emitters")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
@@ -195,12 +195,14 @@ static valo_status read_integrator(mctx *c, xml_node *n) {
   } else {
     mi_warn(c, n, "not an integrator valo has: rendered by path (valo render --integrator chooses another)");
     (void)mi_int(c, n, "max_depth", &depth);
+    (void)mi_int(c, n, "rr_depth", &rr);
     for (xml_node *k = n->child; k; k = k->next) k->used = 1;
   }
   /* Mitsuba counts the camera ray as a depth (max_depth 2 = direct light); valo counts bounces. */
   if (depth == 0) mi_warn(c, n, "max_depth 0 renders nothing in Mitsuba; valo renders the emitters seen directly");
   if (!cJSON_AddStringToObject(render, "integrator", "path")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   if (depth >= 0) TRY(put_num(c, render, "max_depth", depth > 0 ? depth - 1 : 0));
+  if (rr >= 0) TRY(put_num(c, render, "rr_depth", rr > 0 ? rr - 1 : 0)); /* the same count */
   mi_warn_unused(c, n);
   return VALO_OK;
 }

@@ -66,6 +66,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->ctx.s = s;
   ss->ctx.acc = ss->acc;
   ss->ctx.max_depth = o.max_depth;
+  ss->ctx.rr_depth = o.rr_depth;
   ss->ctx.hide_emitters = o.hide_emitters > 0;
   ss->ctx.param = ss->param;
   ss->ctx.seed = (uint64_t)o.seed;
