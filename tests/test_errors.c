@@ -792,12 +792,12 @@ static int sigint_writes_image(void) {
 
 
 /* The declared options (valo_option_at, one table) and the docs agree: every flag is in
- * the README's list and in --help, every scene-file key in docs/scene-format.md, and every
- * `--flag` the README or the docs name is a real one (or the CLI's own -o, -q, --help,
+ * the user guide's list (docs/guide.md) and in --help, every scene-file key in
+ * docs/scene-format.md, and every `--flag` the README or the docs name is a real one (or the CLI's own -o, -q, --help,
  * --help-integrators, --version). */
 static int options_docs(void) {
-  char *readme = read_text_file(VALO_SOURCE_DIR "/README.md"), *fmt = read_text_file(VALO_SOURCE_DIR "/docs/scene-format.md");
-  CHECK(readme && fmt, "README.md or docs/scene-format.md missing");
+  char *readme = read_text_file(VALO_SOURCE_DIR "/docs/guide.md"), *fmt = read_text_file(VALO_SOURCE_DIR "/docs/scene-format.md");
+  CHECK(readme && fmt, "docs/guide.md or docs/scene-format.md missing");
   const char *const args[] = {"render", "--help", NULL};
   CHECK(run_valo(args) == 0, "--help failed");
   int flags = 0, keys = 0;
@@ -806,7 +806,7 @@ static int options_docs(void) {
     char want[80];
     if (o->flag) {
       snprintf(want, sizeof want, "`%s", o->flag);
-      CHECK(strstr(readme, want), "README.md does not list %s", o->flag);
+      CHECK(strstr(readme, want), "docs/guide.md does not list %s", o->flag);
       snprintf(want, sizeof want, "  %s ", o->flag);
       CHECK(strstr(g_out, want), "--help does not list %s", o->flag);
       flags++;
@@ -820,12 +820,12 @@ static int options_docs(void) {
   }
   /* and the other way: every --flag named in README.md and the docs exists */
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
-  const char *docs[] = {"README.md", "docs/scene-format.md", "docs/integrators.md"};
+  const char *docs[] = {"README.md", "docs/guide.md", "docs/scene-format.md", "docs/integrators.md"};
   static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume",
                                         "--integrators", "--reference", "--crop", /* valo compare's */
                                         "--benchmark", NULL};                      /* valo view's */
   int named = 0;
-  for (int k = 0; k < 3; k++) {
+  for (int k = 0; k < 4; k++) {
     char path[600];
     snprintf(path, sizeof path, "%s/%s", VALO_SOURCE_DIR, docs[k]);
     char *t = read_text_file(path);

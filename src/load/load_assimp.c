@@ -435,7 +435,7 @@ void mesh_cache_free(mesh_cache *mc) {
 static valo_status import_file(const char *path, int mesh_flags, imported *im, valo_error *err) {
   memset(im, 0, sizeof *im);
   /* Loading and building peak at a multiple of the file's size (MESH_MEMORY_FACTOR; 7-11
-   * measured on the bunny, the dragon and Sponza: README.md); a file that would not fit
+   * measured on the bunny, the dragon and Sponza: docs/guide.md, "Limits"); a file that would not fit
    * is refused before it is read. */
   struct stat sb;
   if (stat(path, &sb) == 0 && sb.st_size > 0) {
