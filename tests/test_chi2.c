@@ -136,7 +136,7 @@ static int run_chi2(const char *what, void *ctx, sample_fn sf, pdf_fn pf) {
 }
 
 /* ---- BSDFs */
-typedef struct bsdf_ctx { bsdf b; vec3 wo; } bsdf_ctx;
+typedef struct bsdf_ctx { bsdf b, second; vec3 wo; } bsdf_ctx;
 static int bsdf_sf(void *c, sampler *s, vec3 *d);
 static int test_bsdf_wo(const char *name, material m, vec3 wo);
 static int test_bsdf(const char *name, material m, float theta_o_deg);
@@ -604,6 +604,46 @@ static int phong(void) {
   rc |= test_bsdf("phong specular only n=30", m, 45);
   return rc;
 }
+/* A blend of two BSDFs (bsdf.mix, Mitsuba's blendbsdf): the directions sampled by the
+ * pick of one and then its own sampling against the blend's pdf, and their weights against
+ * the blend's f |cos| / pdf (bsdf_sf): diffuse with rough gold, a rough plastic with an
+ * anisotropic rough conductor, and diffuse with a smooth conductor (its delta samples are
+ * left out; the rest must follow (1 - w) of the diffuse density). */
+static int blend_mixture(void) {
+  struct { int kind; float w, th; } cfg[3] = {{0, 0.3f, 30}, {1, 0.6f, 65}, {2, 0.5f, 40}};
+  int rc = 0;
+  for (int i = 0; i < 3; i++) {
+    material a = material_default(), b = material_default();
+    a.kd = c3(0.2f, 0.5f, 0.8f);
+    b.type = MAT_CONDUCTOR;
+    conductor_preset("Au", &b.eta, &b.k);
+    b.roughness = cfg[i].kind == 2 ? 0 : 0.4f;
+    if (cfg[i].kind == 1) {
+      a.type = MAT_PLASTIC; a.roughness = 0.3f; a.ks = c3(1, 1, 1);
+      b.roughness_v = 0.8f; b.anisotropic = 1;
+    }
+    bsdf_ctx c;
+    c.b = bsdf_from_material(&a);
+    c.second = bsdf_from_material(&b);
+    c.b.mix = &c.second;
+    c.b.mix_w = cfg[i].w;
+    float th = cfg[i].th * (float)M_PI / 180;
+    c.wo = v3(sinf(th) * 0.8f, sinf(th) * 0.6f, cosf(th));
+    static const char *const what[3] = {"diffuse + rough gold", "rough plastic + anisotropic rough gold", "diffuse + smooth gold"};
+    char name[128];
+    snprintf(name, sizeof name, "blend %s, weight %.1f, theta_o %.0f deg", what[i], cfg[i].w, cfg[i].th);
+    rc |= run_chi2(name, &c, bsdf_sf, bsdf_pf);
+    /* and the blend is the weighted sum of the two */
+    vec3 wi = v3_norm(v3(-0.3f, 0.2f, 0.9f));
+    bsdf ba = bsdf_from_material(&a), bb = bsdf_from_material(&b);
+    float w = cfg[i].w;
+    rgb f = bsdf_eval(&c.b, c.wo, wi), fa = bsdf_eval(&ba, c.wo, wi), fb = bsdf_eval(&bb, c.wo, wi);
+    float want = (1 - w) * fa.g + w * fb.g, p = bsdf_pdf(&c.b, c.wo, wi), pwant = (1 - w) * bsdf_pdf(&ba, c.wo, wi) + w * bsdf_pdf(&bb, c.wo, wi);
+    CHECK(fabsf(f.g - want) <= 1e-5f * want && fabsf(p - pwant) <= 1e-5f * pwant, "blend f %g pdf %g, want %g and %g", f.g, p, want, pwant);
+  }
+  return rc;
+}
+
 static int mirror_mixture(void) {
   material m = material_default();
   m.type = MAT_MIRROR;
@@ -890,7 +930,7 @@ static int alias_table_chi2(void) {
 static double wrong_pf(void *c, vec3 d) { (void)c; return d.z > 0 ? 1 / (2 * M_PI) : 0; }
 static int chi2_rejects_wrong_pdf(void) {
   material m = material_default();
-  bsdf_ctx c = {bsdf_from_material(&m), v3(0, 0, 1)};
+  bsdf_ctx c = {.b = bsdf_from_material(&m), .wo = v3(0, 0, 1)};
   int rc = run_chi2("cosine samples vs uniform pdf (must fail)", &c, bsdf_sf, wrong_pf);
   CHECK(rc != 0, "chi-square accepted a wrong pdf");
   return 0;
@@ -1472,7 +1512,7 @@ int main(int argc, char **argv) {
                                     {"microfacet_furnace", microfacet_furnace}, {"ggx_albedo", ggx_albedo}, {"bsdf_reciprocity", bsdf_reciprocity},
                                     {"pbr_metallic_roughness", pbr_metallic_roughness}, {"pbr_sheen", pbr_sheen}, {"plastic", plastic}, {"principled", principled},
                                     {"sobol_sampler", sobol_sampler},
-                                    {"light_selection_facing", light_selection_facing}, {"light_selection_infinite", light_selection_infinite}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
+                                    {"blend_mixture", blend_mixture}, {"light_selection_facing", light_selection_facing}, {"light_selection_infinite", light_selection_infinite}, {"light_grid_selection", light_grid_selection}, {"light_units", light_units},
                                     {"pixel_filters", pixel_filters}, {"hg_phase", hg_phase}, {"free_flight", free_flight}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

@@ -23,7 +23,7 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
     if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
 
-    bsdf b = bsdf_at(s, &it);
+    bsdf b2, b = bsdf_at_blend(s, &it, &b2); /* a blend: both its BSDFs */
     frame fr = shading_frame(&it, &b, wo); /* opaque surfaces are two-sided */
     sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
     if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, estimate_direct(c, &it, &b, &fr, wo, smp, ts)));

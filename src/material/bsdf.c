@@ -100,6 +100,7 @@ bsdf bsdf_from_material(const material *m) {
 }
 
 int bsdf_has_smooth(const bsdf *b) {
+  if (b->mix && bsdf_has_smooth(b->mix)) return 1;
   switch (b->type) {
   case BSDF_DIFFUSE: case BSDF_PHONG: return 1;
   case BSDF_MIRROR: return b->p_first > 0;
@@ -415,21 +416,46 @@ static float map_shadowing(const bsdf *b, vec3 wi) {
   return isfinite(g) ? g : 0;
 }
 
-rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+static rgb one_eval(const bsdf *b, vec3 wo, vec3 wi) {
   if (!b->mapped) return model_eval(b, wo, wi);
   if (!map_sides_agree(b, wi)) return c3(0, 0, 0);
   return c3_scale(model_eval(b, wo, wi), map_shadowing(b, wi));
 }
-
-float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+static float one_pdf(const bsdf *b, vec3 wo, vec3 wi) {
   if (!b->mapped) return model_pdf(b, wo, wi);
   return map_sides_agree(b, wi) ? model_pdf(b, wo, wi) : 0;
 }
-
-int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
+static int one_sample(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
   if (!model_sample(b, wo, ulobe, u1, u2, s)) return 0;
   if (!b->mapped) return 1;
   if (!map_sides_agree(b, s->wi)) return 0;
   s->weight = c3_scale(s->weight, map_shadowing(b, s->wi));
+  return 1;
+}
+
+rgb bsdf_eval(const bsdf *b, vec3 wo, vec3 wi) {
+  if (!b->mix) return one_eval(b, wo, wi);
+  return c3_add(c3_scale(one_eval(b, wo, wi), 1 - b->mix_w), c3_scale(one_eval(b->mix, wo, wi), b->mix_w));
+}
+
+float bsdf_pdf(const bsdf *b, vec3 wo, vec3 wi) {
+  if (!b->mix) return one_pdf(b, wo, wi);
+  return (1 - b->mix_w) * one_pdf(b, wo, wi) + b->mix_w * one_pdf(b->mix, wo, wi);
+}
+
+int bsdf_sample_dir(const bsdf *b, vec3 wo, float ulobe, float u1, float u2, bsdf_sample *s) {
+  if (!b->mix) return one_sample(b, wo, ulobe, u1, u2, s);
+  float w = b->mix_w;
+  const bsdf *c = b;
+  if (ulobe < w) { c = b->mix; ulobe = ulobe / w; }
+  else ulobe = (ulobe - w) / (1 - w);
+  if (!one_sample(c, wo, fminf(ulobe, 0x1.fffffep-1f), u1, u2, s)) return 0;
+  if (s->delta) return 1;
+  float pdf = bsdf_pdf(b, wo, s->wi);
+  rgb f = bsdf_eval(b, wo, s->wi);
+  if (!(pdf > 0) || !isfinite(pdf)) return 0;
+  s->pdf = pdf;
+  s->weight = c3_scale(f, fabsf(s->wi.z) / pdf);
+  if (!c3_finite(s->weight)) { s->nonfinite = 1; return 0; }
   return 1;
 }

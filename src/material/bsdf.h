@@ -43,6 +43,8 @@ typedef struct bsdf {
   int mapped;         /* the frame's normal is a normal or bump map's under Mitsuba's conventions
                          (material.map_tangents 0): set by shading_frame, with */
   vec3 n0;            /* the surface's own shading normal in the frame (bsdf.c, "mapped normals") */
+  struct bsdf *mix;   /* a blend's second BSDF (shading.h, bsdf_at_blend), else NULL: this BSDF is then */
+  float mix_w;        /* (1 - mix_w) this one's model + mix_w mix's, in eval, pdf and sampling */
 } bsdf;
 
 typedef struct bsdf_sample {
@@ -56,6 +58,11 @@ typedef struct bsdf_sample {
 } bsdf_sample;
 
 bsdf bsdf_from_material(const material *m);
+/* With b->mix, each of the three below is that of the blend (1 - w) f_b + w f_mix: eval
+ * and pdf the weighted sums; sampling picks one of the two with its weight (from ulobe,
+ * rescaled for the lobe choice that follows), and a non-delta direction gets the blend's
+ * pdf and f |cos| / pdf (a delta lobe keeps its own weight: the pick's probability
+ * cancels). So next-event estimation sees both, as Mitsuba's blendbsdf. */
 /* Non-delta part of f(wo, wi); with b->mapped, 0 where wi lies on different sides of the
  * mapped and the surface's own normal, else times the shadowing term for mapped normals
  * (the pdf and the samples likewise). */

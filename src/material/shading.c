@@ -123,6 +123,14 @@ static vec3 surface_dpdu(const scene *s, const isect *it, const uint32_t *ix) {
 /* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
  * of the ray and the triangle (as stochastic opacity is): over rays the hit scatters as
  * (1 - w) f0 + w f1. Blends inside blends are chosen in turn (at most 8 deep). */
+static float blend_weight(const scene *s, const material *m, const isect *it) {
+  float w = m->weight, px[4];
+  if (m->tex_weight >= 0 && (s->tri_flags[it->tri] & TRI_HAS_UVS)) {
+    texture_lookup(&s->tex[m->tex_weight], it->u, it->v, px);
+    w *= px[0];
+  }
+  return w;
+}
 static const material *blend_pick(const scene *s, const ray *r, const isect *it) {
   const material *m = it->m;
   uint64_t key = accel_ray_key(r->o, r->d) ^ ((uint64_t)it->tri * 0xD1B54A32D192ED03ull);
@@ -131,11 +139,7 @@ static const material *blend_pick(const scene *s, const ray *r, const isect *it)
       m = &s->mats[m->blend[v3_dot(r->d, it->ng) > 0]];
       continue;
     }
-    float w = m->weight, px[4];
-    if (m->tex_weight >= 0 && (s->tri_flags[it->tri] & TRI_HAS_UVS)) {
-      texture_lookup(&s->tex[m->tex_weight], it->u, it->v, px);
-      w *= px[0];
-    }
+    float w = blend_weight(s, m, it);
     key = rng_mix64(key + 0x9E3779B97F4A7C15ull);
     m = &s->mats[m->blend[rng_to_float((uint32_t)(key >> 32)) < w]];
   }
@@ -151,6 +155,7 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   it->b1 = h->b1;
   it->b2 = h->b2;
   it->m = &s->mats[s->tri_mat[h->tri]];
+  it->blend_a = it->blend_b = NULL;
   float b0 = 1 - h->b1 - h->b2;
   it->ns = it->ng;
   if (s->tri_flags[h->tri] & TRI_HAS_NORMALS) {
@@ -167,13 +172,27 @@ void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it) {
   it->mapped = 0;
   it->n0 = it->ns;
   if ((it->m->tex_normal >= 0 || it->m->tex_bump >= 0) && (s->tri_flags[h->tri] & TRI_HAS_UVS)) apply_maps(s, r, it, ix);
-  if (it->m->type == MAT_BLEND) it->m = blend_pick(s, r, it); /* after the blend's own maps */
+  int aniso = it->m->anisotropic;
+  if (it->m->type == MAT_BLEND) {
+    const material *bl = it->m;
+    it->m = blend_pick(s, r, it); /* after the blend's own maps */
+    if (!bl->blend_by_side) {
+      const material *a = &s->mats[bl->blend[0]], *b = &s->mats[bl->blend[1]];
+      float w = blend_weight(s, bl, it);
+      int back = v3_dot(r->d, it->ng) > 0;
+      if (a->type != MAT_BLEND && b->type != MAT_BLEND && w > 0 && w < 1 && !(back && (a->black_back || b->black_back))) {
+        it->blend_a = a;
+        it->blend_b = b;
+        it->blend_w = w;
+        aniso = a->anisotropic || b->anisotropic;
+      }
+    }
+  }
   if (it->m->black_back && v3_dot(r->d, it->ng) > 0) it->m = &s->black;
-  if (it->m->anisotropic) it->dpdu = surface_dpdu(s, it, ix);
+  if (aniso || it->m->anisotropic) it->dpdu = surface_dpdu(s, it, ix);
 }
 
-bsdf bsdf_at(const scene *s, const isect *it) {
-  const material *m = it->m;
+static bsdf bsdf_of(const scene *s, const isect *it, const material *m) {
   int vc = m->vertex_colors && s->col;
   if (!vc && m->tex_kd < 0 && m->tex_ks < 0 && m->tex_mr < 0 && m->tex_ns < 0 && m->tex_rough < 0 && m->tex_metal < 0 && m->tex_cc < 0 && m->tex_ccr < 0 &&
       m->tex_sheen < 0)
@@ -200,6 +219,17 @@ bsdf bsdf_at(const scene *s, const isect *it) {
   if (b.sh_E) b.sh_E = m->sheen_E; /* the material's table, not this copy's, which goes out of scope */
   return b;
 }
+bsdf bsdf_at(const scene *s, const isect *it) { return bsdf_of(s, it, it->m); }
+
+bsdf bsdf_at_blend(const scene *s, const isect *it, bsdf *second) {
+  if (!it->blend_a) return bsdf_of(s, it, it->m);
+  bsdf a = bsdf_of(s, it, it->blend_a);
+  *second = bsdf_of(s, it, it->blend_b);
+  if (bsdf_transmits(&a) != bsdf_transmits(second)) return bsdf_of(s, it, it->m); /* their frames differ: the pick */
+  a.mix = second;
+  a.mix_w = it->blend_w;
+  return a;
+}
 
 static int material_has_smooth(const scene *s, const material *m, int depth) {
   if (m->type != MAT_BLEND) {
@@ -217,7 +247,7 @@ frame shading_frame(isect *it, bsdf *b, vec3 wo) {
     if (v3_dot(ns, wo) < 0) { ns = v3_neg(ns); n0 = v3_neg(n0); }
   }
   frame f = frame_from_n(ns);
-  if (bsdf_anisotropic(b)) { /* s along the surface's u direction (Gram-Schmidt against ns) */
+  if (bsdf_anisotropic(b) || (b->mix && bsdf_anisotropic(b->mix))) { /* s along the surface's u direction (Gram-Schmidt against ns) */
     vec3 t = v3_sub(it->dpdu, v3_scale(ns, v3_dot(ns, it->dpdu)));
     if (v3_len2(t) > 1e-20f && v3_finite(t)) {
       f.s = v3_norm(t);
@@ -226,6 +256,7 @@ frame shading_frame(isect *it, bsdf *b, vec3 wo) {
   }
   b->mapped = it->mapped;
   if (it->mapped) b->n0 = frame_to_local(&f, n0);
+  if (b->mix) { b->mix->mapped = b->mapped; b->mix->n0 = b->n0; }
   return f;
 }
 

@@ -17,6 +17,8 @@ typedef struct isect {
   float b1, b2;       /* the hit's barycentrics in triangle tri (vertex colours) */
   uint32_t tri;
   const material *m;
+  const material *blend_a, *blend_b; /* a weighted blend's two materials (neither a blend), else NULL; */
+  float blend_w;      /* blend_b's weight there (m is the one picked, as every hit has) */
   vec3 dpdu;          /* an anisotropic material's u direction at the hit (shading_frame's s) */
   int mapped;         /* ns is a normal or bump map's under Mitsuba's conventions, and */
   vec3 n0;            /* the surface's own (interpolated) shading normal */
@@ -25,6 +27,10 @@ typedef struct isect {
 void isect_from_hit(const scene *s, const ray *r, const hit *h, isect *it);
 /* The BSDF at it, with the material's texture maps applied at its UV. */
 bsdf bsdf_at(const scene *s, const isect *it);
+/* The same, except where it is a weighted blend of two materials that both transmit or
+ * both do not: then the blend of both (bsdf.mix points to *second, which must outlive
+ * the result), which path's next-event estimation evaluates whole. */
+bsdf bsdf_at_blend(const scene *s, const isect *it, bsdf *second);
 /* 1 when triangle t's surface has a non-delta lobe whichever material a blend on it picks
  * (light paths store photons there whatever their own pick was). */
 int surface_has_smooth(const scene *s, uint32_t t);
