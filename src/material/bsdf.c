@@ -63,7 +63,7 @@ bsdf bsdf_from_material(const material *m) {
     float wd = c3_avg(m->kd), ws = c3_avg(m->ks);
     b.spec_w = wd + ws > 0 ? ws / (wd + ws) : 0.5f;
     b.coat_ri = m->coat_ri;
-    memcpy(b.coat_t, m->coat_t, sizeof b.coat_t);
+    b.coat_t = m->coat_t;
     return b;
   }
   case MAT_PBR: {

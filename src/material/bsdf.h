@@ -34,7 +34,8 @@ typedef struct bsdf {
   int metal_flat;     /* BSDF_PBR: the metal reflects kd at every angle (MTL illum 3), not Schlick */
   int nonlinear;      /* plastics: material.nonlinear */
   float spec_w;       /* plastics: the specular lobe's sampling weight, mean(ks) / (mean(kd) + mean(ks)) */
-  float coat_ri, coat_t[PLASTIC_RES]; /* plastics: the material's coat tables */
+  float coat_ri;       /* plastics: the coat's tables (coat_t: PLASTIC_RES values, the material's own, */
+  const float *coat_t; /* which must outlive the BSDF, as sh_E) */
   float roughness, spec_tint, sheen, sheen_tint, flatness, clearcoat, cc_alpha, spec_trans; /* BSDF_PRINCIPLED (kd, metallic, alpha, eta too) */
   const float *sh_E;  /* BSDF_PBR with a sheen (material/sheen.h): the material's albedo table, else NULL
                          (it points into the material given to bsdf_from_material, which must outlive it) */

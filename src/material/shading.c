@@ -216,7 +216,8 @@ static bsdf bsdf_of(const scene *s, const isect *it, const material *m) {
   if (m->tex_ccr >= 0) { texture_lookup(&s->tex[m->tex_ccr], it->u, it->v, px); mm.clearcoat_roughness *= px[1]; }
   if (m->tex_sheen >= 0) { texture_lookup(&s->tex[m->tex_sheen], it->u, it->v, px); mm.sheen_color = c3_mul(mm.sheen_color, c3(px[0], px[1], px[2])); }
   bsdf b = bsdf_from_material(&mm);
-  if (b.sh_E) b.sh_E = m->sheen_E; /* the material's table, not this copy's, which goes out of scope */
+  if (b.sh_E) b.sh_E = m->sheen_E; /* the material's tables, not this copy's, which goes out of scope */
+  if (b.coat_t) b.coat_t = m->coat_t;
   return b;
 }
 bsdf bsdf_at(const scene *s, const isect *it) { return bsdf_of(s, it, it->m); }
