@@ -35,11 +35,10 @@ ray camera_ray(const cam_lens *l, int px, int py, sampler *smp, float *weight) {
   vec3 d;
   cam_view_ray(v, fx, fy, &ry.o, &d);
   ry.tmax = INFINITY;
-  float lu, lv;
-  sampler_set_dim(smp, SDIM_LENS);
-  sampler_2d(smp, &lu, &lv);
-  sampler_set_dim(smp, SDIM_WAVELENGTH);
   if (l->aperture > 0) {
+    float lu, lv;
+    sampler_set_dim(smp, SDIM_LENS);
+    sampler_2d(smp, &lu, &lv);
     /* Thin lens: every ray through the lens meets at the plane of focus (an orthographic
      * camera's lens sits around the ray's own point of the camera plane). */
     float ft = l->focus / v3_dot(d, v->fwd);
@@ -49,6 +48,7 @@ ray camera_ray(const cam_lens *l, int px, int py, sampler *smp, float *weight) {
     ry.o = v3_add(ry.o, v3_add(v3_scale(v->right, dx * l->aperture), v3_scale(v->up, dy * l->aperture)));
     d = v3_norm(v3_sub(pf, ry.o));
   }
+  sampler_set_dim(smp, SDIM_WAVELENGTH); /* what follows draws from its own dimensions */
   ry.d = d;
   return ry;
 }
