@@ -7,7 +7,7 @@
 # its own error-vs-time curve, log-log). It can also make that reference (--make-ref).
 #
 # Optional tooling (Python is not needed to build, render or test valo). Runs inside
-# Blender's own Python, which has numpy:
+# Blender's Python, which needs numpy (Debian: apt install blender python3-numpy):
 #   blender -b --factory-startup --python bench/cycles_side_by_side.py -- \
 #       --obj ../shared/scenes/cornell/CornellBox-Original.obj \
 #       --ref ../shared/references/cornell-original.exr --valo build/valo
