@@ -987,6 +987,20 @@ static int light_selection_facing(void) {
   return rc;
 }
 
+/* ns selections at p (sampler seed and stream): each must pick a light and report
+ * light_select_pmf's pmf; counts added to obs. */
+static int count_selections(const light_sampler *ls, const scene *s, vec3 p, long ns, uint64_t seed, uint64_t stream, double *obs) {
+  for (long k = 0; k < ns; k++) {
+    sampler sm = sampler_make(seed, (uint64_t)k, stream);
+    float pmf;
+    uint32_t li = light_select(ls, s, p, sampler_1d(&sm), &pmf);
+    CHECK(li < s->nlights, "no light picked");
+    CHECK(pmf == light_select_pmf(ls, s, li, p), "light %u: select says %g, pmf %g", li, pmf, light_select_pmf(ls, s, li, p));
+    obs[li]++;
+  }
+  return 0;
+}
+
 /* ---- infinite lights (light.h): next-event estimation picks each of the n infinite
  * lights (the environment, a sun) with probability 1 / (n + 1), and the finite ones share
  * the rest by power (a bright lamp would get less than 1 % by the power rule here: the
@@ -1038,14 +1052,7 @@ static int light_selection_infinite(void) {
     CHECK(fabs(total - 1) < 1e-5, "pmfs sum to %g", total);
     CHECK(black || pw_inf / pw_all > 0.99, "the power rule would give the infinite lights only %.3f", pw_inf / pw_all);
     long ns = nsamples() / 10;
-    for (long k = 0; k < ns; k++) {
-      sampler sm = sampler_make(5, (uint64_t)k, (uint64_t)black);
-      float pmf;
-      uint32_t li = light_select(&ls, s, p, sampler_1d(&sm), &pmf);
-      CHECK(li < n, "no light picked");
-      CHECK(pmf == light_select_pmf(&ls, s, li, p), "light %u: select says %g, pmf %g", li, pmf, light_select_pmf(&ls, s, li, p));
-      obs[li]++;
-    }
+    CHECK(count_selections(&ls, s, p, ns, 5, (uint64_t)black, obs) == 0, "selection");
     double o[4], e[4];
     int m2 = 0;
     for (uint32_t i = 0; i < n; i++) {
@@ -1154,14 +1161,7 @@ static int light_grid_selection(void) {
     CHECK(gain > 5, "the nearest lamp facing the point (%.2f m) is picked only %.2f times as often as by power", dmin, gain);
     memset(obs, 0, n * sizeof *obs);
     long ns = nsamples();
-    for (long k = 0; k < ns; k++) {
-      sampler sm = sampler_make(7, (uint64_t)k, (uint64_t)q);
-      float pmf;
-      uint32_t li = light_select(&ls, s, p, sampler_1d(&sm), &pmf);
-      CHECK(li < n, "no light picked");
-      CHECK(pmf == light_select_pmf(&ls, s, li, p), "light %u: select says %g, pmf %g", li, pmf, light_select_pmf(&ls, s, li, p));
-      obs[li]++;
-    }
+    CHECK(count_selections(&ls, s, p, ns, 7, (uint64_t)q, obs) == 0, "selection");
     for (uint32_t i = 0; i < n; i++) ex[i] = ns * light_select_pmf(&ls, s, i, p);
     fprintf(stderr, "point %d: nearest lamp %.2f m, picked %.1fx as often as by power\n", q, dmin, gain);
     rc = chi2_check("light grid selection", obs, ex, (int)n);
