@@ -120,9 +120,7 @@ static vec3 surface_dpdu(const scene *s, const isect *it, const uint32_t *ix) {
   return v3_sub(s->pos[ix[1]], s->pos[ix[0]]);
 }
 
-/* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
- * of the ray and the triangle (as stochastic opacity is): over rays the hit scatters as
- * (1 - w) f0 + w f1. Blends inside blends are chosen in turn (at most 8 deep). */
+/* A weighted blend's weight at it (its weight map's first channel times its weight). */
 static float blend_weight(const scene *s, const material *m, const isect *it) {
   float w = m->weight, px[4];
   if (m->tex_weight >= 0 && (s->tri_flags[it->tri] & TRI_HAS_UVS)) {
@@ -131,6 +129,11 @@ static float blend_weight(const scene *s, const material *m, const isect *it) {
   }
   return w;
 }
+/* MAT_BLEND: one of its two materials, blend[1] with probability weight, chosen by a hash
+ * of the ray and the triangle (as stochastic opacity is): over rays the hit scatters as
+ * (1 - w) f0 + w f1. Blends inside blends are chosen in turn (at most 8 deep). Where both
+ * are plain materials, isect_from_hit also keeps the two and the weight (isect.blend_a),
+ * for bsdf_at_blend. */
 static const material *blend_pick(const scene *s, const ray *r, const isect *it) {
   const material *m = it->m;
   uint64_t key = accel_ray_key(r->o, r->d) ^ ((uint64_t)it->tri * 0xD1B54A32D192ED03ull);
