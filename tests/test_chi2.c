@@ -26,7 +26,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 86
+#define CHI2_TESTS 87
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -873,8 +873,7 @@ static int light_sampling(void) {
   rc |= run_chi2("constant environment", &c, light_sf, light_pf);
   /* An equirectangular map with a bright spot, a dark hole and a gradient, upright,
    * turned by 30 degrees about y, turned any way (+y to +z, then 40 degrees about z: a
-   * frame), and so with Mitsuba's rows (which move lookups, not sampling: every direction
-   * keeps a density, envmap_init's floor). */
+   * frame), and so with Mitsuba's rows (which move the lookups and the density with them). */
   for (int rot = 0; rot < 4; rot++) {
     int w = 64, h = 32;
     float *px = malloc(sizeof(float) * w * h * 3);
@@ -892,7 +891,7 @@ static int light_sampling(void) {
       double ca = cos(40 * M_PI / 180), sa = sin(40 * M_PI / 180);
       const double fr[9] = {ca, 0, sa, sa, 0, -ca, 0, 1, 0}; /* Rz(40) Rx(90) */
       CHECK(envmap_set_frame(s->env_map, fr) == 0, "frame refused");
-      s->env_map->mitsuba_rows = rot == 3;
+      CHECK(envmap_set_mitsuba_rows(s->env_map, rot == 3) == 0, "mitsuba rows");
     }
     static const char *const names[4] = {"environment map", "environment map, rotated 30 deg", "environment map, turned by a frame",
                                          "environment map, turned by a frame, Mitsuba's rows"};
@@ -902,6 +901,77 @@ static int light_sampling(void) {
     s->env_map = NULL;
   }
   scene_free(s);
+  return rc;
+}
+
+/* ---- the piecewise-bilinear distribution that samples environment maps: points against
+ * the density's integral over each of 48x48 bins (non-uniform vertices, zero cells, a
+ * spike), each sample's pdf against bilin2d_pdf; then on a map with a one-texel lamp, the
+ * ratio of radiance (largest channel) to density, which is what sets next-event
+ * estimation's fireflies: at most 1.3x the map's integral (a piecewise-constant density
+ * over 3x3 maxima gives 12x here). */
+static double bilin_cell_mass(const bilin2d *d, double u0, double u1, double v0, double v1) {
+  double m = 0;
+  for (int a = 0; a < 24; a++)
+    for (int b = 0; b < 24; b++)
+      m += bilin2d_pdf(d, (float)(u0 + (u1 - u0) * (a + 0.5) / 24), (float)(v0 + (v1 - v0) * (b + 0.5) / 24));
+  return m * (u1 - u0) * (v1 - v0) / (24 * 24);
+}
+static int bilinear_distribution(void) {
+  const float xs[7] = {0, 0.05f, 0.2f, 0.5f, 0.55f, 0.9f, 1}, ys[5] = {0, 0.1f, 0.5f, 0.95f, 1};
+  float f[35];
+  for (int j = 0; j < 5; j++)
+    for (int i = 0; i < 7; i++) f[j * 7 + i] = 0.3f + 0.4f * (float)((i * 5 + j * 3) % 7);
+  for (int i = 0; i < 7; i++) f[1 * 7 + i] = 0; /* a whole row of zeros */
+  f[2 * 7 + 4] = 40; /* a spike */
+  f[4 * 7 + 6] = 0;
+  bilin2d d;
+  CHECK(bilin2d_init(&d, xs, 7, ys, 5, f) == 0, "init");
+  enum { B = 48 };
+  static double obs[B * B], ex[B * B];
+  memset(obs, 0, sizeof obs);
+  long n = nsamples();
+  double worst = 0;
+  for (long k = 0; k < n; k++) {
+    sampler sm = sampler_make(11, (uint64_t)k, 0);
+    float u, v, pdf, u1 = sampler_1d(&sm), u2 = sampler_1d(&sm);
+    bilin2d_sample(&d, u1, u2, &u, &v, &pdf);
+    CHECK(u >= 0 && u <= 1 && v >= 0 && v <= 1 && pdf > 0, "sample (%g, %g) pdf %g", u, v, pdf);
+    double rel = fabs(pdf - bilin2d_pdf(&d, u, v)) / pdf;
+    if (rel > worst) worst = rel;
+    int bu = (int)(u * B), bv = (int)(v * B);
+    obs[(bv < B ? bv : B - 1) * B + (bu < B ? bu : B - 1)] += 1;
+  }
+  for (int bv = 0; bv < B; bv++)
+    for (int bu = 0; bu < B; bu++) ex[bv * B + bu] = n * bilin_cell_mass(&d, (double)bu / B, (double)(bu + 1) / B, (double)bv / B, (double)(bv + 1) / B);
+  fprintf(stderr, "bilinear distribution: sample pdf against bilin2d_pdf, worst relative difference %.2e\n", worst);
+  CHECK(worst < 1e-3, "sample pdf and bilin2d_pdf disagree by %.2e", worst);
+  int rc = chi2_check("piecewise-bilinear 2D distribution", obs, ex, B * B);
+  bilin2d_free(&d);
+  /* L / pdf on a 64x32 map, uniform 0.05 with one texel at 5000 (and one at 500 on the seam). */
+  int w = 64, h = 32;
+  float *px = malloc(sizeof(float) * w * h * 3);
+  for (int i = 0; i < w * h * 3; i++) px[i] = 0.05f;
+  for (int c = 0; c < 3; c++) { px[3 * (12 * w + 40) + c] = 5000; px[3 * (20 * w + 63) + c] = 500; }
+  for (int mr = 0; mr < 2; mr++) {
+    envmap e;
+    CHECK(envmap_init(&e, w, h, memcpy(malloc(sizeof(float) * w * h * 3), px, sizeof(float) * w * h * 3), 1, 0) == 0, "env init");
+    CHECK(envmap_set_mitsuba_rows(&e, mr) == 0, "rows");
+    double integral = 0, ratio = 0;
+    int nu = 2048, nv = 1024;
+    for (int b = 0; b < nv; b++)
+      for (int a = 0; a < nu; a++) {
+        double th = M_PI * (b + 0.5) / nv, ph = 2 * M_PI * (a + 0.5) / nu;
+        vec3 dir = v3((float)(sin(th) * sin(ph)), (float)cos(th), (float)(-sin(th) * cos(ph)));
+        double L = c3_max(envmap_eval(&e, dir)), p = envmap_pdf(&e, dir);
+        integral += L * sin(th) * (M_PI / nv) * (2 * M_PI / nu);
+        if (L > 0 && p > 0 && L / p > ratio) ratio = L / p;
+      }
+    fprintf(stderr, "environment map with a one-texel lamp%s: largest L/pdf is %.3f x its integral\n", mr ? " (Mitsuba's rows)" : "", ratio / integral);
+    CHECK(ratio / integral < 1.3, "L/pdf reaches %.2f x the map's integral", ratio / integral);
+    envmap_free(&e);
+  }
+  free(px);
   return rc;
 }
 
@@ -1506,6 +1576,7 @@ int main(int argc, char **argv) {
                                     {"delta_lobes", delta_lobes},
                                     {"light_sampling", light_sampling}, {"sphere_cone", sphere_cone},
                                     {"alias_table", alias_table_chi2},
+                                    {"bilinear_distribution", bilinear_distribution},
                                     {"chi2_rejects_wrong_pdf", chi2_rejects_wrong_pdf},
                                     {"rough_conductor", rough_conductor},
                                     {"rough_dielectric", rough_dielectric},

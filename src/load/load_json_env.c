@@ -3,6 +3,7 @@
  * and turned. */
 #include "load/load_json_internal.h"
 #include "scene/envmap.h"
+#include "core/error.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -43,7 +44,9 @@ valo_status json_parse_environment(jctx *c, const cJSON *env) {
     json_resolve_path(c, file, full, sizeof full);
     TRY(envmap_create(full, (float)scale, (float)rot, &c->s->env_map, c->err));
     TRY(env_frame(c, env));
-    TRY(json_get_bool(c, env, "mitsuba_rows", "environment", &c->s->env_map->mitsuba_rows));
+    int mrows = 0;
+    TRY(json_get_bool(c, env, "mitsuba_rows", "environment", &mrows));
+    if (envmap_set_mitsuba_rows(c->s->env_map, mrows)) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   } else if (!strcmp(type, "cube")) {
     static const char *const ek[] = {"type", "faces", "scale", "rotation", "matrix", NULL};
     TRY(json_check_keys(c, env, "environment", ek));

@@ -62,6 +62,44 @@ static rgb lookup(const envmap *e, float u, float v) {
   return c3_add(c3_scale(top, 1 - fy), c3_scale(bot, fy));
 }
 
+/* The sampling density: the bilinear interpolant of each lookup's largest channel times
+ * sin(theta), given at the lookup's own vertices (the texel centres, plus the seam at
+ * u = 0 and 1 and the poles, where the lookup is clamped), so it is positive wherever the
+ * radiance is and the ratio of radiance to density stays bounded next to small bright
+ * texels. A floor of 1/1000 of the mean keeps every direction reachable. */
+static int build_dist(envmap *e) {
+  int w = e->w, h = e->h, mr = e->mitsuba_rows && h >= 2;
+  uint32_t nx = (uint32_t)w + 2, ny = mr ? (uint32_t)h : (uint32_t)h + 2;
+  float *xs = malloc(nx * sizeof(float)), *ys = malloc(ny * sizeof(float)), *f = malloc((size_t)nx * ny * sizeof(float));
+  int rc = -1;
+  if (xs && ys && f) {
+    xs[0] = 0; xs[nx - 1] = 1;
+    for (int x = 0; x < w; x++) xs[x + 1] = (x + 0.5f) / (float)w;
+    if (mr)
+      for (int y = 0; y < h; y++) ys[y] = y == h - 1 ? 1 : (float)y / (float)(h - 1);
+    else {
+      ys[0] = 0; ys[ny - 1] = 1;
+      for (int y = 0; y < h; y++) ys[y + 1] = (y + 0.5f) / (float)h;
+    }
+    double sum = 0;
+    for (uint32_t j = 0; j < ny; j++) {
+      float st = sinf(PI_F * ys[j]);
+      for (uint32_t i = 0; i < nx; i++) {
+        float m = c3_max(lookup(e, xs[i], ys[j])) * st;
+        f[(size_t)j * nx + i] = m;
+        sum += m;
+      }
+    }
+    float floor_w = (float)(sum / ((double)nx * ny) * 1e-3 + 1e-12);
+    for (uint32_t j = 0; j < ny; j++)
+      for (uint32_t i = 0; i < nx; i++) f[(size_t)j * nx + i] += floor_w * sinf(PI_F * ys[j]);
+    bilin2d_free(&e->dist);
+    rc = bilin2d_init(&e->dist, xs, nx, ys, ny, f);
+  }
+  free(xs); free(ys); free(f);
+  return rc;
+}
+
 int envmap_init(envmap *e, int w, int h, float *px, float scale, float rotation_deg) {
   memset(e, 0, sizeof *e);
   e->w = w; e->h = h; e->rgb = px; e->scale = scale;
@@ -69,29 +107,23 @@ int envmap_init(envmap *e, int w, int h, float *px, float scale, float rotation_
   e->rot_cos = cosf(r); e->rot_sin = sinf(r);
   for (size_t i = 0; i < (size_t)w * h * 3; i++)
     if (!(px[i] >= 0) || !isfinite(px[i])) px[i] = 0; /* negative/NaN texels carry no light */
-  float *wgt = malloc((size_t)w * h * sizeof(float));
-  if (!wgt) return -1;
-  double sum_w = 0, avg[3] = {0, 0, 0}, solid = 0;
+  double avg[3] = {0, 0, 0}, solid = 0;
   for (int y = 0; y < h; y++) {
     float st = sinf(PI_F * (y + 0.5f) / h);
     for (int x = 0; x < w; x++) {
-      float m = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) { float l = c3_max(texel(e, x + dx, y + dy)); if (l > m) m = l; }
-      wgt[(size_t)y * w + x] = m * st;
-      sum_w += m * st;
       rgb t = texel(e, x, y);
       avg[0] += t.r * st; avg[1] += t.g * st; avg[2] += t.b * st;
       solid += st;
     }
   }
-  /* A small floor keeps every direction reachable (robust to tiny bilinear tails). */
-  float floor_w = (float)(sum_w / ((double)w * h) * 1e-3 + 1e-12);
-  for (size_t i = 0; i < (size_t)w * h; i++) wgt[i] += floor_w * sinf(PI_F * ((float)(i / (size_t)w) + 0.5f) / h);
-  int rc = distrib2d_init(&e->dist, wgt, (uint32_t)w, (uint32_t)h);
-  free(wgt);
   e->average = solid > 0 ? c3((float)(avg[0] / solid) * scale, (float)(avg[1] / solid) * scale, (float)(avg[2] / solid) * scale) : c3(0, 0, 0);
-  return rc;
+  return build_dist(e);
+}
+
+int envmap_set_mitsuba_rows(envmap *e, int on) {
+  if (e->mitsuba_rows == !!on) return 0;
+  e->mitsuba_rows = !!on;
+  return build_dist(e);
 }
 
 /* The map's linear RGB: an HDR file (.exr, .hdr, .pfm) as it is, any other image (PNG,
@@ -185,7 +217,7 @@ valo_status envmap_load_cube(envmap *e, const char *const paths[6], float scale,
 void envmap_free(envmap *e) {
   free(e->rgb);
   e->rgb = NULL;
-  distrib2d_free(&e->dist);
+  bilin2d_free(&e->dist);
 }
 
 rgb envmap_eval(const envmap *e, vec3 dir) {
@@ -196,7 +228,7 @@ rgb envmap_eval(const envmap *e, vec3 dir) {
 
 int envmap_sample(const envmap *e, float u1, float u2, vec3 *dir, float *pdf) {
   float u, v, puv;
-  distrib2d_sample(&e->dist, u1, u2, &u, &v, &puv);
+  bilin2d_sample(&e->dist, u1, u2, &u, &v, &puv);
   float st = sinf(v * PI_F);
   if (!(st > 0) || !(puv > 0)) return 0;
   *dir = from_map(e, uv_to_dir(u, v));
@@ -209,7 +241,7 @@ float envmap_pdf(const envmap *e, vec3 dir) {
   dir_to_uv(to_map(e, dir), &u, &v);
   float st = sinf(v * PI_F);
   if (!(st > 0)) return 0;
-  return distrib2d_pdf(&e->dist, u, v) / (2 * PI_F * PI_F * st);
+  return bilin2d_pdf(&e->dist, u, v) / (2 * PI_F * PI_F * st);
 }
 
 static valo_status envmap_adopt(envmap *e, valo_status st, envmap **out) {

@@ -1,8 +1,7 @@
 /* envmap.h — owns equirectangular environment maps as lights: bilinear radiance lookup,
- * importance sampling by a 2D piecewise-constant distribution over the image (weights:
- * the largest luminance in each texel's bilinear footprint times sin(theta), so the
- * density is non-zero wherever the looked-up radiance is), and the matching solid-angle
- * density pdf(w) = pdf(u,v) / (2 pi^2 sin theta) (pbrt-v3 §14.2.4).
+ * importance sampling by the piecewise-bilinear density of the lookup's largest channel
+ * times sin(theta) (core/distrib.h, sampled exactly as Mitsuba's envmap does), and the
+ * matching solid-angle density pdf(w) = pdf(u,v) / (2 pi^2 sin theta) (pbrt-v3 §14.2.4).
  * Convention: y is up; direction -z maps to the image centre (u = 0.5); the top row is
  * straight up. `rotation` turns the map about +y (degrees); envmap_set_frame turns it any
  * way (an orthonormal matrix from the map's frame to the world's).
@@ -26,9 +25,9 @@ typedef struct envmap {
   float rot_cos, rot_sin;
   int has_frame;     /* 1: frame (row-major) turns map directions into world ones, not rotation */
   int mitsuba_rows;  /* 1: row y is looked up at v = y/(h - 1), as Mitsuba's envmap does, not (y + 1/2)/h
-                        (the sampling's 3x3 footprints still cover every row a lookup reads) */
+                        (set through envmap_set_mitsuba_rows, which moves the sampling with it) */
   float frame[9];
-  distrib2d dist;
+  bilin2d dist;
   rgb average;       /* mean radiance over the sphere (for light selection) */
 } envmap;
 
@@ -42,6 +41,8 @@ void envmap_free(envmap *e);
 /* Map directions become world ones by m (row-major, orthonormal within 1e-3: a turn or a
  * mirror), in place of the rotation; -1 (nothing set) when m is not orthonormal. */
 int envmap_set_frame(envmap *e, const double m[9]);
+/* Mitsuba's row convention on or off; rebuilds the sampling density (0, or -1 on OOM). */
+int envmap_set_mitsuba_rows(envmap *e, int on);
 /* The same as heap objects the scene owns: *out is a new map (NULL on error);
  * envmap_destroy frees one (NULL is fine). */
 valo_status envmap_create(const char *path, float scale, float rotation_deg, envmap **out, valo_error *err);
