@@ -15,6 +15,7 @@
 #include "light/light.h"
 #include "scene/envmap.h"
 #include "core/alias.h"
+#include "integrator/guide.h"
 #include "scene/filter.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -26,7 +27,7 @@
 
 #define NT 20
 #define NP 40
-#define CHI2_TESTS 87
+#define CHI2_TESTS 88
 
 /* Regularised upper incomplete gamma Q(a, x) (series for x < a+1, else Lentz's
  * continued fraction). */
@@ -975,6 +976,57 @@ static int bilinear_distribution(void) {
   return rc;
 }
 
+/* ---- path guiding's directional quadtrees (guide.h): directions drawn from a leaf's
+ * learned tree against guide_pdf, after two passes of records around three lobes (a
+ * narrow one, so the tree refines many levels deep) and a hemisphere of dim light; and
+ * the tree must have learned: the narrow lobe's cone gets far more than its solid angle. */
+static int guide_sf(void *c, sampler *s, vec3 *dir) {
+  float u1, u2, pdf;
+  sampler_2d(s, &u1, &u2);
+  *dir = guide_sample(c, u1, u2, &pdf);
+  return pdf > 0;
+}
+static double guide_pf(void *c, vec3 d) { return guide_pdf(c, d); }
+static int guide_quadtree(void) {
+  guide g;
+  bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
+  CHECK(guide_init(&g, box, 1000000, 1e9) == 0, "init");
+  guide_set_scale(&g, 100);
+  const vec3 lobes[3] = {v3_norm(v3(0.3f, 0.2f, 0.93f)), v3_norm(v3(-0.8f, 0.1f, -0.3f)), v3(0, -1, 0)};
+  const float widths[3] = {0.02f, 0.3f, 0.6f}, values[3] = {50, 5, 1};
+  for (int pass = 0; pass < 2; pass++) {
+    for (int k = 0; k < 200000; k++) {
+      sampler sm = sampler_make(21 + pass, (uint64_t)k, 0);
+      float u1, u2;
+      sampler_2d(&sm, &u1, &u2);
+      vec3 d = sample_uniform_sphere(u1, u2);
+      float v = d.y > 0 ? 0.1f : 0;
+      for (int l = 0; l < 3; l++) {
+        float c = v3_dot(d, lobes[l]);
+        if (c > 1 - widths[l]) v += values[l];
+      }
+      guide_record(&g, v3(0.1f, 0.2f, 0.3f), d, v * 4 * PI_F);
+    }
+    CHECK(guide_refine(&g) == 0, "refine");
+  }
+  const gleaf *l = guide_leaf(&g, v3(0.1f, 0.2f, 0.3f));
+  CHECK(guide_can_sample(l), "nothing learned");
+  int rc = run_chi2("guide quadtree (learned from three lobes)", (void *)l, guide_sf, guide_pf);
+  /* the narrow lobe: solid angle 2 pi 0.02 (0.32 % of the sphere), the recorded flux's
+   * share 2 pi 0.02 50 over the total (about 38 %); its directions must be drawn often */
+  long in = 0, n = 100000;
+  for (long k = 0; k < n; k++) {
+    sampler sm = sampler_make(5, (uint64_t)k, 0);
+    vec3 d;
+    guide_sf((void *)l, &sm, &d);
+    in += v3_dot(d, lobes[0]) > 1 - widths[0];
+  }
+  fprintf(stderr, "guide quadtree: %.1f %% of directions in the narrow lobe (0.3 %% of the sphere)\n", 100.0 * in / n);
+  CHECK(in > n / 10, "the narrow lobe got %.1f %% of the directions", 100.0 * in / n);
+  guide_free(&g);
+  return rc;
+}
+
 static int alias_table_chi2(void) {
   float w[7] = {1, 0, 3.5f, 0.01f, 7, 2, 0.5f};
   alias_table t;
@@ -1577,6 +1629,7 @@ int main(int argc, char **argv) {
                                     {"light_sampling", light_sampling}, {"sphere_cone", sphere_cone},
                                     {"alias_table", alias_table_chi2},
                                     {"bilinear_distribution", bilinear_distribution},
+                                    {"guide_quadtree", guide_quadtree},
                                     {"chi2_rejects_wrong_pdf", chi2_rejects_wrong_pdf},
                                     {"rough_conductor", rough_conductor},
                                     {"rough_dielectric", rough_dielectric},

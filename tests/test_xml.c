@@ -546,6 +546,20 @@ static int convert_to_json(void) {
   text = read_text_file(out);
   CHECK(text && strstr(text, "\"spp\":\t7"), "--define did not reach the JSON");
   free(text);
+  /* the path-guiding lab's integrator (and 0.6's guided_path) is valo's guided, its depths read */
+  static const char *const guided_types[2] = {"path_guiding_integrator", "guided_path"};
+  for (int g = 0; g < 2; g++) {
+    char *gx = malloc(strlen(XML_SCENE) + 64), *at = strstr(XML_SCENE, "<integrator type=\"path\">");
+    CHECK(gx && at, "the scene's integrator");
+    snprintf(gx, strlen(XML_SCENE) + 64, "%.*s<integrator type=\"%s\">%s", (int)(at - XML_SCENE), XML_SCENE, guided_types[g],
+             at + strlen("<integrator type=\"path\">"));
+    CHECK(valo_scene_convert(scratch_file("guided.xml", gx), NULL, out, &err) == VALO_OK, "%s", err.message);
+    free(gx);
+    text = read_text_file(out);
+    CHECK(text && strstr(text, "\"integrator\":\t\"guided\"") && strstr(text, "\"max_depth\":\t4"), "%s not read as guided: %s",
+          guided_types[g], text ? text : "(no file)");
+    free(text);
+  }
   CHECK(valo_scene_convert(scratch_file("s.json", "{}"), NULL, out, &err) != VALO_OK && strstr(err.message, "Mitsuba scene files"), "%s", err.message);
   CHECK(valo_scene_convert(scratch_file("c2.xml", XML_SCENE), NULL, scratch_path("x.png"), &err) != VALO_OK && strstr(err.message, ".json"), "%s",
         err.message);

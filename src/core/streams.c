@@ -27,4 +27,4 @@ const stream_use stream_uses[] = {
     {"restir pixel", "spatial reuse", RDIM_SPATIAL, RDIM_SPATIAL + 256 * 8 + 8},
     {NULL, NULL, 0, 0}};
 
-const uint64_t stream_keys[] = {STREAM_VPL, STREAM_VPL_PILOT, STREAM_PHOTON, STREAM_RESTIR_PIXEL, 0};
+const uint64_t stream_keys[] = {STREAM_VPL, STREAM_VPL_PILOT, STREAM_PHOTON, STREAM_RESTIR_PIXEL, STREAM_GUIDE, 0};

@@ -14,6 +14,8 @@
  *                 cones (vsl), compensation and sampled shadow rays (vpl), RIS
  *                 candidates (restir), restir-gi's path from its sample point
  *   restir pixel  sampler_make(seed ^ STREAM_RESTIR_PIXEL, pixel, frame): reservoir choices
+ *   guide pixel   sampler_make_kind(seed ^ STREAM_GUIDE, pixel, training sample): guided's
+ *                 training paths (the pixel stream's layout)
  *   light paths   sampler_make_kind(key, 0, path index) with key from the pass:
  *                 rng_mix64(seed * GOLDEN + sample index + STREAM_VPL / STREAM_PHOTON),
  *                 the photon caustic map rng_mix64(that + 1), the VPL pilot
@@ -28,6 +30,7 @@
 #define STREAM_VPL_PILOT 0x70696c6f74ULL /* "pilot": the VPL pilot set (clamping scale) */
 #define STREAM_PHOTON 0x70686f746f6eULL  /* "photon": a pass's photon paths */
 #define STREAM_RESTIR_PIXEL 0x5bd1e995u  /* restir's reservoir choices, xor the seed */
+#define STREAM_GUIDE 0x6775696465ULL     /* "guide": guided's training paths, xor the seed */
 
 /* Dimensions of the pixel stream beyond the path layout (rng.h: SDIM_FILM, SDIM_LENS,
  * SDIM_WAVELENGTH, then SDIM_PER_BOUNCE per bounce from SDIM_BOUNCE0; SDIM_AOV). */

@@ -98,6 +98,8 @@ int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b
   out->f_cos = c3_scale(f, fabsf(wi_l.z));
   out->Li = ls.L;
   out->scale = w / light_pdf;
+  out->light_pdf = light_pdf; /* pick x sample density (per steradian, or the delta light's weight) */
+  out->delta = ls.delta;
   out->wi = ls.wi;
   out->p_light = ls.p_light;
   out->n_light = ls.n_light;

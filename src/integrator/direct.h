@@ -41,7 +41,7 @@ rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const f
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
-typedef struct direct_sample { rgb f_cos, Li; float scale; vec3 wi, p_light, n_light; int far, visible; } direct_sample;
+typedef struct direct_sample { rgb f_cos, Li; float scale, light_pdf; vec3 wi, p_light, n_light; int far, visible, delta; } direct_sample;
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out);
 /* sample_direct without the shadow ray: the caller tests the segment to out->p_light

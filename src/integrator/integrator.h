@@ -42,6 +42,9 @@ typedef struct render_ctx {
   int sampler_kind;        /* sampler_kind of the render (Sobol or independent) */
   thread_stats *prep;      /* where create/prepare add the counters of their own rays
                               (light paths), from the calling thread; may be NULL */
+  const struct cam_lens *lens; /* the still camera (prepare's own camera paths: guided); may be NULL */
+  int spp;                 /* the render's samples per pixel (a time budget: its cap) */
+  double time_budget;      /* seconds, or 0 */
 } render_ctx;
 #define PATH_HARD_CAP 1024
 

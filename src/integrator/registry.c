@@ -10,7 +10,7 @@
 /* Adding an integrator: its file defines `const integrator_ops integrator_NAME`, and one
  * line here lists it. */
 #define INTEGRATORS(X) \
-  X(path) X(path_spectral) X(whitted) X(distribution) X(photon) X(vpl) X(vsl) X(ao) X(proximity_ao) X(restir_di) X(restir_gi)
+  X(path) X(guided) X(path_spectral) X(whitted) X(distribution) X(photon) X(vpl) X(vsl) X(ao) X(proximity_ao) X(restir_di) X(restir_gi)
 
 #define DECLARE(n) extern const integrator_ops integrator_##n;
 INTEGRATORS(DECLARE)

@@ -185,7 +185,18 @@ static valo_status read_integrator(mctx *c, xml_node *n) {
   cJSON *render = put_obj(c->out, "render");
   if (!render) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   int depth = -1, rr = -1, direct = type && !strcmp(type, "direct");
-  if (type && (!strcmp(type, "path") || !strcmp(type, "volpath") || !strcmp(type, "volpathmis") || !strcmp(type, "prb") || direct)) {
+  /* the path-guiding lab's integrator and Müller's Mitsuba 0.6 guided_path: valo's guided
+   * (their other parameters -- budgets, tree thresholds -- are not read) */
+  int guided = type && (!strcmp(type, "path_guiding_integrator") || !strcmp(type, "guided_path"));
+  if (guided) {
+    TRY(mi_int(c, n, "max_depth", &depth));
+    (void)mi_int(c, n, "rr_depth", &rr);
+    (void)mi_int(c, n, "rrDepth", &rr);
+    (void)mi_int(c, n, "maxDepth", &depth);
+    for (xml_node *k = n->child; k; k = k->next)
+      if (!k->used) mi_warn(c, k, "guided does not read this parameter of %s", type);
+    for (xml_node *k = n->child; k; k = k->next) k->used = 1;
+  } else if (type && (!strcmp(type, "path") || !strcmp(type, "volpath") || !strcmp(type, "volpathmis") || !strcmp(type, "prb") || direct)) {
     TRY(mi_int(c, n, "max_depth", &depth));
     TRY(mi_int(c, n, "rr_depth", &rr));
     int hide = 0;
@@ -200,7 +211,7 @@ static valo_status read_integrator(mctx *c, xml_node *n) {
   }
   /* Mitsuba counts the camera ray as a depth (max_depth 2 = direct light); valo counts bounces. */
   if (depth == 0) mi_warn(c, n, "max_depth 0 renders nothing in Mitsuba; valo renders the emitters seen directly");
-  if (!cJSON_AddStringToObject(render, "integrator", "path")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
+  if (!cJSON_AddStringToObject(render, "integrator", guided ? "guided" : "path")) return err_set(c->err, VALO_ERR_NOMEM, "out of memory");
   if (depth >= 0) TRY(put_num(c, render, "max_depth", depth > 0 ? depth - 1 : 0));
   if (rr >= 0) TRY(put_num(c, render, "rr_depth", rr > 0 ? rr - 1 : 0)); /* the same count */
   mi_warn_unused(c, n);

@@ -75,6 +75,9 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->ctx.height = o.height;
   ss->ctx.sampler_kind = ss->sampler_kind;
   ss->ctx.prep = &ss->prep;
+  ss->ctx.lens = &ss->lens;
+  ss->ctx.spp = o.spp;
+  ss->ctx.time_budget = o.time_budget > 0 ? o.time_budget : 0;
   /* Camera basis; an automatic camera is fitted to this film's aspect first. */
   ss->cam_still = scene_camera_fit(s, (float)frame_w / (float)frame_h);
   const camera *c = &ss->cam_still;

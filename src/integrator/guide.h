@@ -1,0 +1,68 @@
+/* guide.h — owns the SD-tree of path guiding (Müller, Gross, Novák 2017, "Practical Path
+ * Guiding"): a binary tree over the scene's box (split at the middle, axes in turn) whose
+ * leaves each hold two quadtrees over the sphere of directions (the square
+ * [0,1]^2 of (cos theta + 1)/2 and phi/2pi, an equal-area map: density on the sphere =
+ * density on the square / 4 pi). A pass samples from the `sampling` quadtrees and records
+ * incident radiance / pdf into the `building` ones; guide_refine then makes the building
+ * trees the sampling ones, splits leaves that saw more than c sqrt(2^k) records in pass k,
+ * and gives each leaf a new building tree whose quadrants are split where the last pass
+ * put more than 1 % of the leaf's flux (to depth 20).
+ * Records are added as 64-bit fixed-point integers (a quantum of guide->scale * 2^-36,
+ * each record at most 16 x scale, sums saturating), so the trees do not depend on the
+ * order in which threads add them: a pass gives the same trees for any thread count.
+ * The node count is capped (guide->max_nodes over all quadtrees); past it no quadtree
+ * grows further. */
+#ifndef VALO_GUIDE_H
+#define VALO_GUIDE_H
+#include "core/vec.h"
+#include "scene/scene.h"
+#include <stdatomic.h>
+#include <stdint.h>
+
+typedef struct qnode {
+  uint32_t child[4];          /* 0: none (quadrant q: bit 0 u >= 1/2, bit 1 v >= 1/2) */
+  _Atomic uint64_t sum[4];    /* flux recorded in each quadrant (fixed point) */
+} qnode;
+typedef struct qtree { qnode *n; uint32_t count, cap; } qtree;
+
+typedef struct gleaf {
+  qtree sampling, building;
+  _Atomic uint32_t records;   /* records in this pass */
+} gleaf;
+typedef struct gsnode { vec3 lo, hi; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at the middle of axis; child 0: a leaf */
+
+typedef struct guide {
+  bbox box;
+  gsnode *sn; uint32_t nsn, capsn;
+  gleaf *leaves; uint32_t nleaves, capleaves;
+  double scale;               /* the fixed point's unit; 0 until guide_set_scale */
+  uint64_t nodes;             /* quadtree nodes held (sampling + building) */
+  uint64_t max_nodes;
+  int full;                   /* the cap stopped a quadtree from growing */
+  int pass;                   /* passes refined so far */
+  double spatial_c;           /* leaves split past spatial_c sqrt(2^pass) records */
+} guide;
+
+int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c);
+void guide_free(guide *g);
+void guide_set_scale(guide *g, double scale);
+/* The leaf holding p (points outside the box go to the nearest leaf). */
+const gleaf *guide_leaf(const guide *g, vec3 p);
+/* Directions <-> the quadtrees' square. */
+void guide_dir_to_square(vec3 d, float *u, float *v);
+vec3 guide_square_to_dir(float u, float v);
+/* Whether the leaf's sampling tree holds anything to sample. */
+int guide_can_sample(const gleaf *l);
+/* Samples a direction from the leaf's sampling tree; *pdf per steradian. */
+vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf);
+float guide_pdf(const gleaf *l, vec3 d);
+/* Adds value (radiance / pdf, >= 0) at direction d to the building tree of p's leaf. */
+void guide_record(guide *g, vec3 p, vec3 d, float value);
+/* Ends a pass (serial): the building trees become the sampling ones, leaves split, new
+ * building trees refined. Returns -1 when out of memory. */
+int guide_refine(guide *g);
+
+/* The quadtree alone (tests): sample and pdf on the square. */
+void qtree_sample(const qtree *t, float u1, float u2, float *u, float *v, float *pdf);
+float qtree_pdf(const qtree *t, float u, float v);
+#endif
