@@ -1005,7 +1005,7 @@ static int guide_quadtree(void) {
         float c = v3_dot(d, lobes[l]);
         if (c > 1 - widths[l]) v += values[l];
       }
-      guide_record(&g, v3(0.1f, 0.2f, 0.3f), d, v * 4 * PI_F);
+      guide_record(&g, (gleaf *)guide_leaf(&g, v3(0.1f, 0.2f, 0.3f)), d, v * 4 * PI_F);
     }
     CHECK(guide_refine(&g) == 0, "refine");
   }

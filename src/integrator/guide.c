@@ -6,10 +6,17 @@
 
 #define QT_RHO 0.01   /* a quadrant holding more of its leaf's flux than this is split */
 #define QT_DEPTH 20
-#define FIX_BITS 36
+#define FIX_BITS 32
 #define FIX_MAX_UNITS 16.0
 
 static void qtree_free(qtree *t) { free(t->n); memset(t, 0, sizeof *t); }
+static void stree_free(stree *t) { free(t->n); memset(t, 0, sizeof *t); }
+static double node_total_q(const qnode *n) {
+  double t = 0;
+  for (int q = 0; q < 4; q++) t += (double)atomic_load_explicit(&n->sum[q], memory_order_relaxed);
+  return t;
+}
+
 
 static uint32_t qtree_add(guide *g, qtree *t) { /* a zeroed node; UINT32_MAX when full */
   if (g->nodes + 1 > g->max_nodes) { g->full = 1; return UINT32_MAX; }
@@ -24,22 +31,37 @@ static uint32_t qtree_add(guide *g, qtree *t) { /* a zeroed node; UINT32_MAX whe
   return t->count++;
 }
 
-static int qtree_copy(guide *g, const qtree *src, qtree *dst) {
+static int stree_copy(guide *g, const stree *src, stree *dst) {
   memset(dst, 0, sizeof *dst);
   if (!src->count) return 0;
-  dst->n = malloc(src->count * sizeof(qnode));
+  dst->n = malloc(src->count * sizeof(snode));
   if (!dst->n) return -1;
-  memcpy(dst->n, src->n, src->count * sizeof(qnode));
-  dst->count = dst->cap = src->count;
+  memcpy(dst->n, src->n, src->count * sizeof(snode));
+  dst->count = src->count;
   g->nodes += src->count;
   return 0;
 }
 
-static double node_total(const qnode *n) {
-  double t = 0;
-  for (int q = 0; q < 4; q++) t += (double)atomic_load_explicit(&n->sum[q], memory_order_relaxed);
-  return t;
+/* The sampling tree of a building tree's flux: each node's quadrant shares (a node whose
+ * quadrants got nothing keeps uniform shares, never reached by sampling or pdf as its
+ * parent's share is 0); no tree when nothing was recorded. */
+static int stree_from(guide *g, const qtree *b, stree *t) {
+  memset(t, 0, sizeof *t);
+  if (!b->count || !(node_total_q(&b->n[0]) > 0)) return 0;
+  t->n = malloc(b->count * sizeof(snode));
+  if (!t->n) return -1;
+  t->count = b->count;
+  g->nodes += b->count;
+  for (uint32_t i = 0; i < b->count; i++) {
+    double tot = node_total_q(&b->n[i]);
+    for (int q = 0; q < 4; q++) {
+      t->n[i].child[q] = b->n[i].child[q];
+      t->n[i].p[q] = tot > 0 ? (float)((double)atomic_load_explicit(&b->n[i].sum[q], memory_order_relaxed) / tot) : 0.25f;
+    }
+  }
+  return 0;
 }
+
 
 int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c) {
   memset(g, 0, sizeof *g);
@@ -57,7 +79,7 @@ int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c) {
 }
 
 void guide_free(guide *g) {
-  for (uint32_t i = 0; i < g->nleaves; i++) { qtree_free(&g->leaves[i].sampling); qtree_free(&g->leaves[i].building); }
+  for (uint32_t i = 0; i < g->nleaves; i++) { stree_free(&g->leaves[i].sampling); qtree_free(&g->leaves[i].building); }
   free(g->leaves);
   free(g->sn);
   memset(g, 0, sizeof *g);
@@ -87,29 +109,26 @@ vec3 guide_square_to_dir(float u, float v) {
   return v3(r * cosf(phi), r * sinf(phi), z);
 }
 
-/* ---- one quadtree ---- */
-void qtree_sample(const qtree *t, float u1, float u2, float *u, float *v, float *pdf) {
+/* ---- sampling trees ---- */
+void stree_sample(const stree *t, float u1, float u2, float *u, float *v, float *pdf) {
   float x0 = 0, y0 = 0, size = 1, p = 1;
   uint32_t i = 0;
   for (int depth = 0; t->count && depth <= QT_DEPTH + 1; depth++) {
-    const qnode *n = &t->n[i];
-    double s[4], tot = 0;
-    for (int q = 0; q < 4; q++) tot += s[q] = (double)atomic_load_explicit(&n->sum[q], memory_order_relaxed);
-    if (!(tot > 0)) break;
-    /* u-half by the columns' sums, then the v-half within it; each number remapped */
-    double left = s[0] + s[2], pl = left / tot;
+    const snode *n = &t->n[i];
+    /* the u-half by the columns' shares, then the v-half within it; each number remapped */
+    float pl = n->p[0] + n->p[2];
     int qx = u1 >= pl;
-    u1 = qx ? (float)((u1 - pl) / (1 - pl)) : (float)(u1 / pl);
-    double a = s[qx], b = s[qx + 2], pa = a / (a + b);
+    u1 = qx ? (u1 - pl) / (1 - pl) : u1 / pl;
+    float a = n->p[qx], b = n->p[qx + 2], pa = a / (a + b);
     int qy = u2 >= pa;
-    u2 = qy ? (float)((u2 - pa) / (1 - pa)) : (float)(u2 / pa);
+    u2 = qy ? (u2 - pa) / (1 - pa) : u2 / pa;
     u1 = clampf(u1, 0, 0x1.fffffep-1f);
     u2 = clampf(u2, 0, 0x1.fffffep-1f);
     int q = qx | qy << 1;
-    p *= (float)(4 * s[q] / tot);
+    p *= 4 * n->p[q];
     size *= 0.5f;
-    x0 += qx * size;
-    y0 += qy * size;
+    x0 += (float)qx * size;
+    y0 += (float)qy * size;
     if (!n->child[q]) break;
     i = n->child[q];
   }
@@ -118,30 +137,26 @@ void qtree_sample(const qtree *t, float u1, float u2, float *u, float *v, float 
   *pdf = p;
 }
 
-float qtree_pdf(const qtree *t, float u, float v) {
+float stree_pdf(const stree *t, float u, float v) {
   float p = 1;
   uint32_t i = 0;
   for (int depth = 0; t->count && depth <= QT_DEPTH + 1; depth++) {
-    const qnode *n = &t->n[i];
-    double tot = node_total(n);
-    if (!(tot > 0)) break;
+    const snode *n = &t->n[i];
     int qx = u >= 0.5f, qy = v >= 0.5f, q = qx | qy << 1;
-    double s = (double)atomic_load_explicit(&n->sum[q], memory_order_relaxed);
-    if (!(s > 0)) return 0;
-    p *= (float)(4 * s / tot);
+    p *= 4 * n->p[q];
+    if (!n->child[q] || p == 0) break;
     u = 2 * u - (float)qx;
     v = 2 * v - (float)qy;
-    if (!n->child[q]) break;
     i = n->child[q];
   }
   return p;
 }
 
-int guide_can_sample(const gleaf *l) { return l->sampling.count && node_total(&l->sampling.n[0]) > 0; }
+int guide_can_sample(const gleaf *l) { return l->sampling.count > 0; }
 
 vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf) {
   float u, v, p;
-  qtree_sample(&l->sampling, u1, u2, &u, &v, &p);
+  stree_sample(&l->sampling, u1, u2, &u, &v, &p);
   *pdf = p * (0.25f * INV_PI_F);
   return guide_square_to_dir(u, v);
 }
@@ -149,22 +164,14 @@ vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf) {
 float guide_pdf(const gleaf *l, vec3 d) {
   float u, v;
   guide_dir_to_square(d, &u, &v);
-  return qtree_pdf(&l->sampling, u, v) * (0.25f * INV_PI_F);
+  return stree_pdf(&l->sampling, u, v) * (0.25f * INV_PI_F);
 }
 
-static void sat_add(_Atomic uint64_t *a, uint64_t x) {
-  uint64_t old = atomic_load_explicit(a, memory_order_relaxed), nw;
-  do {
-    nw = old + x < old ? UINT64_MAX : old + x;
-  } while (!atomic_compare_exchange_weak_explicit(a, &old, nw, memory_order_relaxed, memory_order_relaxed));
-}
-
-void guide_record(guide *g, vec3 p, vec3 d, float value) {
+void guide_record(const guide *g, gleaf *l, vec3 d, float value) {
+  atomic_fetch_add_explicit(&l->records, 1, memory_order_relaxed); /* every vertex counts, lit or not */
   if (!(value > 0) || !(g->scale > 0)) return;
   double units = value / g->scale;
   uint64_t fx = (uint64_t)(fmin(units, FIX_MAX_UNITS) * (double)(1ULL << FIX_BITS));
-  gleaf *l = (gleaf *)guide_leaf(g, p);
-  atomic_fetch_add_explicit(&l->records, 1, memory_order_relaxed);
   if (!fx) return;
   float u, v;
   guide_dir_to_square(d, &u, &v);
@@ -172,7 +179,7 @@ void guide_record(guide *g, vec3 p, vec3 d, float value) {
   uint32_t i = 0;
   for (int depth = 0; t->count && depth <= QT_DEPTH + 1; depth++) {
     int qx = u >= 0.5f, qy = v >= 0.5f, q = qx | qy << 1;
-    sat_add(&t->n[i].sum[q], fx);
+    atomic_fetch_add_explicit(&t->n[i].sum[q], fx, memory_order_relaxed);
     u = 2 * u - (float)qx;
     v = 2 * v - (float)qy;
     if (!t->n[i].child[q]) break;
@@ -188,7 +195,7 @@ static int qtree_refined(guide *g, const qtree *src, qtree *dst) {
   uint32_t root = qtree_add(g, dst);
   if (root == UINT32_MAX - 1) return -1;
   if (root == UINT32_MAX) return 0; /* the cap: no tree, nothing recorded here */
-  double tot = src->count ? node_total(&src->n[0]) : 0;
+  double tot = src->count ? node_total_q(&src->n[0]) : 0;
   if (!(tot > 0)) return 0;
   qwork *stack = malloc(sizeof *stack * (4 * (QT_DEPTH + 2)));
   if (!stack) return -1;
@@ -235,32 +242,51 @@ static int grow_spatial(guide *g) {
   return 0;
 }
 
+void guide_stop(guide *g) {
+  for (uint32_t i = 0; i < g->nleaves; i++) {
+    g->nodes -= g->leaves[i].building.count;
+    qtree_free(&g->leaves[i].building);
+  }
+}
+
 static float axis_of(vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 static void set_axis(vec3 *p, int axis, float x) {
   if (axis == 0) p->x = x; else if (axis == 1) p->y = x; else p->z = x;
 }
 
 int guide_refine(guide *g) {
+  /* each leaf: the pass's flux becomes the sampling tree and shapes the next building tree */
   for (uint32_t i = 0; i < g->nleaves; i++) {
     gleaf *l = &g->leaves[i];
     g->nodes -= l->sampling.count;
-    qtree_free(&l->sampling);
-    l->sampling = l->building;
-    memset(&l->building, 0, sizeof l->building);
+    stree_free(&l->sampling);
+    qtree nb;
+    if (qtree_refined(g, &l->building, &nb) || stree_from(g, &l->building, &l->sampling)) { qtree_free(&nb); return -1; }
+    g->nodes -= l->building.count;
+    qtree_free(&l->building);
+    l->building = nb;
   }
   /* Split leaves that saw too many records; the children (appended, so visited by this
-   * same loop) start from their parent's count halved and its sampling tree. */
+   * same loop) start from their parent's count halved and its trees. */
   double thresh = g->spatial_c * sqrt(ldexp(1, g->pass));
   for (uint32_t i = 0; i < g->nsn; i++) {
     if (g->sn[i].child) continue;
     uint32_t li = g->sn[i].leaf, rec = atomic_load(&g->leaves[li].records);
-    if (rec <= thresh || g->nodes + g->leaves[li].sampling.count > g->max_nodes / 2) continue;
+    if (rec <= thresh || g->nodes + g->leaves[li].sampling.count + g->leaves[li].building.count > g->max_nodes) continue;
     if (grow_spatial(g)) return -1;
     uint32_t nl = g->nleaves, c = g->nsn;
-    if (qtree_copy(g, &g->leaves[li].sampling, &g->leaves[nl].sampling)) return -1;
-    memset(&g->leaves[nl].building, 0, sizeof g->leaves[nl].building);
-    atomic_store(&g->leaves[nl].records, rec / 2);
-    atomic_store(&g->leaves[li].records, rec / 2);
+    gleaf *src = &g->leaves[li], *dst = &g->leaves[nl];
+    memset(dst, 0, sizeof *dst);
+    if (stree_copy(g, &src->sampling, &dst->sampling)) return -1;
+    if (src->building.count) {
+      dst->building.n = malloc(src->building.count * sizeof(qnode));
+      if (!dst->building.n) return -1;
+      memcpy(dst->building.n, src->building.n, src->building.count * sizeof(qnode));
+      dst->building.count = dst->building.cap = src->building.count;
+      g->nodes += src->building.count;
+    }
+    atomic_store(&dst->records, rec / 2);
+    atomic_store(&src->records, rec / 2);
     g->nleaves++;
     gsnode n = g->sn[i];
     int axis = n.axis, next = (axis + 1) % 3;
@@ -273,10 +299,7 @@ int guide_refine(guide *g) {
     g->sn[i].child = c;
     g->nsn += 2;
   }
-  for (uint32_t i = 0; i < g->nleaves; i++) {
-    if (qtree_refined(g, &g->leaves[i].sampling, &g->leaves[i].building)) return -1;
-    atomic_store(&g->leaves[i].records, 0);
-  }
+  for (uint32_t i = 0; i < g->nleaves; i++) atomic_store(&g->leaves[i].records, 0);
   g->pass++;
   return 0;
 }

@@ -4,12 +4,13 @@
  * [0,1]^2 of (cos theta + 1)/2 and phi/2pi, an equal-area map: density on the sphere =
  * density on the square / 4 pi). A pass samples from the `sampling` quadtrees and records
  * incident radiance / pdf into the `building` ones; guide_refine then makes the building
- * trees the sampling ones, splits leaves that saw more than c sqrt(2^k) records in pass k,
- * and gives each leaf a new building tree whose quadrants are split where the last pass
- * put more than 1 % of the leaf's flux (to depth 20).
- * Records are added as 64-bit fixed-point integers (a quantum of guide->scale * 2^-36,
- * each record at most 16 x scale, sums saturating), so the trees do not depend on the
- * order in which threads add them: a pass gives the same trees for any thread count.
+ * trees the sampling ones, splits leaves where more than c sqrt(2^k) path vertices fell
+ * in pass k, and gives each leaf a new building tree whose quadrants are split where the
+ * last pass put more than 1 % of the leaf's flux (to depth 20).
+ * Records are added as 64-bit fixed-point integers (a quantum of guide->scale * 2^-32,
+ * each record cut at 16 x scale: a sum wraps only past 2^28 such records), so the trees
+ * do not depend on the order in which threads add them: a pass gives the same trees for
+ * any thread count. Sampling trees hold each node's quadrant shares as floats.
  * The node count is capped (guide->max_nodes over all quadtrees); past it no quadtree
  * grows further. */
 #ifndef VALO_GUIDE_H
@@ -23,11 +24,14 @@ typedef struct qnode {
   uint32_t child[4];          /* 0: none (quadrant q: bit 0 u >= 1/2, bit 1 v >= 1/2) */
   _Atomic uint64_t sum[4];    /* flux recorded in each quadrant (fixed point) */
 } qnode;
-typedef struct qtree { qnode *n; uint32_t count, cap; } qtree;
+typedef struct qtree { qnode *n; uint32_t count, cap; } qtree;   /* a building tree */
+typedef struct snode { uint32_t child[4]; float p[4]; } snode;    /* p: the quadrants' shares */
+typedef struct stree { snode *n; uint32_t count; } stree;        /* a sampling tree; count 0: none */
 
 typedef struct gleaf {
-  qtree sampling, building;
-  _Atomic uint32_t records;   /* records in this pass */
+  stree sampling;
+  qtree building;
+  _Atomic uint32_t records;   /* path vertices recorded in this pass (lit or not) */
 } gleaf;
 typedef struct gsnode { vec3 lo, hi; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at the middle of axis; child 0: a leaf */
 
@@ -56,13 +60,16 @@ int guide_can_sample(const gleaf *l);
 /* Samples a direction from the leaf's sampling tree; *pdf per steradian. */
 vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf);
 float guide_pdf(const gleaf *l, vec3 d);
-/* Adds value (radiance / pdf, >= 0) at direction d to the building tree of p's leaf. */
-void guide_record(guide *g, vec3 p, vec3 d, float value);
+/* Adds value (radiance / pdf, >= 0) at direction d to the building tree of leaf l (of g). */
+void guide_record(const guide *g, gleaf *l, vec3 d, float value);
 /* Ends a pass (serial): the building trees become the sampling ones, leaves split, new
  * building trees refined. Returns -1 when out of memory. */
 int guide_refine(guide *g);
 
-/* The quadtree alone (tests): sample and pdf on the square. */
-void qtree_sample(const qtree *t, float u1, float u2, float *u, float *v, float *pdf);
-float qtree_pdf(const qtree *t, float u, float v);
+/* Ends learning: the building trees are freed; the sampling ones stay. */
+void guide_stop(guide *g);
+
+/* A sampling tree alone: sample and pdf on the square. */
+void stree_sample(const stree *t, float u1, float u2, float *u, float *v, float *pdf);
+float stree_pdf(const stree *t, float u, float v);
 #endif

@@ -1,14 +1,17 @@
 /* guided.c — owns the `guided` integrator: path tracing with next-event estimation and
  * MIS (path.c's estimator) whose direction sampling is a one-sample mixture of the BSDF
- * and a learned distribution of incident radiance (guide.h, Müller et al. 2017): with
+ * and a learned distribution of incident radiance (guide.h, Müller et al. 2017; each
+ * vertex learns the light that arrived along its sampled direction, less the emission its
+ * own next-event estimation could have found): with
  * probability 1 - bsdf_fraction the direction comes from the SD-tree leaf of the
  * shading point, and the mixture's pdf is the one every MIS weight uses (the emission a
  * sampled ray finds, and next-event estimation's light samples), so the estimate stays
- * unbiased. Learning happens before the first sample (prepare): passes of 1, 2, 4, ...
- * samples per pixel over the whole film, from their own random stream, each recording
- * into the tree that the next one samples; their images are not kept. The render then
- * samples the last tree, which no longer changes. Surfaces without a smooth lobe (mirrors,
- * smooth glass) and delta samples are not guided. Scenes with media take path's walk. */
+ * unbiased. The render's own samples learn, in passes of 1, 2, 4, ... samples per pixel:
+ * each pass records into the tree that the next one samples (refined between passes, in
+ * prepare, so a pass samples one fixed tree and every sample is unbiased; all of them are
+ * kept in the image), until train_spp; the later samples take the last tree without
+ * recording. Surfaces without a smooth lobe (mirrors, smooth glass) and delta samples are
+ * not guided. Scenes with media take path's walk. */
 #include "integrator/guide.h"
 #include "integrator/path_common.h"
 #include "integrator/direct.h"
@@ -26,7 +29,7 @@
 enum { P_TRAIN, P_FRACTION, P_SPATIAL, P_NODES };
 static const integrator_param guided_params[] = {
     {"train_spp", IPARAM_INT, -1, -1, 1 << 20,
-     "samples per pixel spent learning before the render, in passes of 1, 2, 4, ... (-1: about a quarter of the render's spp, or of its --time)"},
+     "samples per pixel that learn, in passes of 1, 2, 4, ... (-1: half the render's spp, or a quarter of its --time)"},
     {"bsdf_fraction", IPARAM_FLOAT, 0.5, 0.01, 1, "share of directions drawn from the BSDF rather than from the learned distribution"},
     {"spatial_threshold", IPARAM_FLOAT, 12000, 1, 1e9, "a spatial leaf splits past this many records times sqrt(2^pass)"},
     {"max_nodes", IPARAM_INT, 4000000, 1024, 1e9, "directional quadtree nodes at most, over all leaves (48 bytes each)"},
@@ -34,37 +37,38 @@ static const integrator_param guided_params[] = {
 
 typedef struct gstate {
   guide g;
-  int passes;        /* training passes run */
-  int train_spp;     /* samples per pixel they took */
-  double seconds;
+  int learning;      /* the render's samples record into the building trees */
+  int done;          /* learning is over (or never started) */
+  int next;          /* the sample index before which the current pass is refined */
+  int passes;        /* passes refined */
+  int train_spp;     /* learning stops at the first pass boundary at or past this */
+  double t0, seconds;
   _Atomic uint32_t probe_max; /* the largest record of the probe pass (float bits) */
 } gstate;
 
 #define MAXV 48
-typedef struct gvert { vec3 p, d; rgb beta, acc; float pdf; } gvert;
+typedef struct gvert { gleaf *l; vec3 d; rgb beta, L0, ex; float pdf; } gvert; /* L0: the path's radiance when it left; ex: what it does not learn */
 typedef struct recorder { guide *g; _Atomic uint32_t *probe; gvert v[MAXV]; int n; } recorder;
 
-static void rec_value(recorder *rc, vec3 p, vec3 d, float value) {
-  if (!(value > 0) || !isfinite(value)) return;
+static void rec_value(recorder *rc, gleaf *l, vec3 d, float value) {
+  if (!(value >= 0) || !isfinite(value)) return;
   if (rc->probe) {
     uint32_t bits, old = atomic_load_explicit(rc->probe, memory_order_relaxed);
     memcpy(&bits, &value, sizeof bits);
     while (bits > old && !atomic_compare_exchange_weak_explicit(rc->probe, &old, bits, memory_order_relaxed, memory_order_relaxed)) {}
     return;
   }
-  guide_record(rc->g, p, d, value);
-}
-static void add_contrib(rgb *L, recorder *rc, rgb x) {
-  *L = c3_add(*L, x);
-  if (rc)
-    for (int k = 0; k < rc->n; k++) rc->v[k].acc = c3_add(rc->v[k].acc, x);
+  if (l) guide_record(rc->g, l, d, value);
 }
 static float channel_ratio(float a, float b) { return b > 0 ? a / b : 0; }
-static void rec_flush(recorder *rc) {
+/* Each vertex's incident radiance along its sampled direction: what the path gathered
+ * after it left, over the throughput it left with. */
+static void rec_flush(recorder *rc, rgb L) {
   for (int k = 0; k < rc->n; k++) {
     const gvert *v = &rc->v[k];
-    rgb Lin = c3(channel_ratio(v->acc.r, v->beta.r), channel_ratio(v->acc.g, v->beta.g), channel_ratio(v->acc.b, v->beta.b));
-    rec_value(rc, v->p, v->d, c3_lum(Lin) / v->pdf);
+    rgb acc = c3_sub(c3_sub(L, v->L0), v->ex);
+    rgb Lin = c3(channel_ratio(acc.r, v->beta.r), channel_ratio(acc.g, v->beta.g), channel_ratio(acc.b, v->beta.b));
+    rec_value(rc, v->l, v->d, c3_lum(Lin) / v->pdf);
   }
   rc->n = 0;
 }
@@ -80,14 +84,20 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     rgb Le;
     float w;
     int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
-    if (!c3_black(Le) && (depth > 0 || !c->hide_emitters)) add_contrib(&L, rc, c3_scale(c3_mul(beta, Le), w));
+    if (!c3_black(Le) && (depth > 0 || !c->hide_emitters)) {
+      rgb e = c3_scale(c3_mul(beta, Le), w);
+      L = c3_add(L, e);
+      /* emission that next-event estimation at the vertex before could have found is not
+         learned there: the guide learns the light NEE misses (caustics, indirect light) */
+      if (rc && rc->n > 0 && !st.specular) rc->v[rc->n - 1].ex = c3_add(rc->v[rc->n - 1].ex, e);
+    }
     if (!surface || depth >= max_depth) break;
     vec3 wo = v3_neg(r.d);
     bsdf b2, b = bsdf_at_blend(s, &it, &b2);
     frame fr = shading_frame(&it, &b, wo);
     int smooth = bsdf_has_smooth(&b);
-    const gleaf *gl = smooth && g->pass > 0 ? guide_leaf(g, it.p) : NULL;
-    if (gl && !guide_can_sample(gl)) gl = NULL;
+    gleaf *lf = smooth && (g->pass > 0 || rc) ? (gleaf *)guide_leaf(g, it.p) : NULL; /* recording writes its building tree */
+    const gleaf *gl = lf && guide_can_sample(lf) ? lf : NULL;
     float ag = gl ? 1 - alpha_b : 0; /* probability of sampling the guide */
     vec3 wo_l = frame_to_local(&fr, wo);
     if (smooth) { /* next-event estimation, MIS against the mixture */
@@ -101,8 +111,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
           mw = power_heuristic(d.light_pdf, pm);
         }
         rgb Li = c3_scale(d.Li, mw / d.light_pdf);
-        add_contrib(&L, rc, c3_mul(beta, c3_mul(d.f_cos, Li)));
-        if (rc && !d.delta) rec_value(rc, it.p, d.wi, c3_lum(Li));
+        L = c3_add(L, c3_mul(beta, c3_mul(d.f_cos, Li)));
       }
     }
     /* the direction: guide with probability ag, else the BSDF */
@@ -153,10 +162,10 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     st.eta_acc /= eta_scale;
     r = spawn_ray(&it, wi);
     beta = c3_mul(beta, weight);
-    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){it.p, wi, beta, c3(0, 0, 0), pm};
+    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){lf, wi, beta, L, c3(0, 0, 0), pm};
     if (!path_survive(&st, &beta, depth, c->rr_depth, smp)) break;
   }
-  if (rc) rec_flush(rc);
+  if (rc) rec_flush(rc, L);
   return L;
 }
 
@@ -180,86 +189,77 @@ static void guided_destroy(void *state) {
   free(gs);
 }
 
-typedef struct train_job {
-  const render_ctx *c;
-  gstate *gs;
-  uint32_t first, count; /* training sample indices */
-  int probe;
-  thread_stats *ts;
-} train_job;
+typedef struct probe_job { const render_ctx *c; gstate *gs; thread_stats *ts; } probe_job;
 
-static void train_row(void *user, int64_t y, int thread) {
-  train_job *j = user;
+static void probe_row(void *user, int64_t y, int thread) {
+  probe_job *j = user;
   const render_ctx *c = j->c;
   recorder *rc = malloc(sizeof *rc);
   if (!rc) return;
   rc->g = &j->gs->g;
-  rc->probe = j->probe ? &j->gs->probe_max : NULL;
+  rc->probe = &j->gs->probe_max;
   rc->n = 0;
   for (int x = 0; x < c->width; x++) {
-    uint64_t pix = (uint64_t)y * (uint64_t)c->width + (uint64_t)x;
-    for (uint32_t k = 0; k < j->count; k++) {
-      sampler smp = sampler_make_kind(c->seed ^ STREAM_GUIDE, pix, j->first + k, (sampler_kind)c->sampler_kind);
-      float wt;
-      ray r = camera_ray(c->lens, x, (int)y, &smp, &wt);
-      (void)guided_walk(c, &j->gs->g, r, &smp, &j->ts[thread], rc);
-    }
+    sampler smp = sampler_make_kind(c->seed ^ STREAM_GUIDE, (uint64_t)y * (uint64_t)c->width + (uint64_t)x, 0, (sampler_kind)c->sampler_kind);
+    float wt;
+    ray r = camera_ray(c->lens, x, (int)y, &smp, &wt);
+    (void)guided_walk(c, &j->gs->g, r, &smp, &j->ts[thread], rc);
   }
   free(rc);
 }
 
-static valo_status run_pass(const render_ctx *c, gstate *gs, uint32_t first, uint32_t count, int probe, thread_stats *ts) {
-  train_job j = {c, gs, first, count, probe, ts};
-  parallel_for(c->threads, c->height, train_row, &j);
+/* Before sample 0: a probe pass (one path per pixel from the guide's own stream) whose
+ * largest record sets the fixed point's unit; learning starts. Before samples 1, 3, 7,
+ * ...: the pass that ends there is refined into the next one's tree. Learning stops at
+ * the first such boundary past train_spp (or, with a time budget, past a quarter of it);
+ * the tree sampled from then on no longer changes. */
+static valo_status guided_prepare(void *state, const render_ctx *c, int sample_index, valo_error *err) {
+  gstate *gs = state;
+  if (!c->lens || c->s->has_media) return VALO_OK;
+  if (sample_index == 0 && gs->passes == 0 && !gs->done) {
+    gs->t0 = now_seconds();
+    gs->train_spp = (int)c->param[P_TRAIN];
+    if (gs->train_spp < 0) gs->train_spp = c->time_budget > 0 ? 1 << 30 : c->spp / 2;
+    if (gs->train_spp < 1) { gs->done = 1; return VALO_OK; }
+    thread_stats *ts = thread_stats_alloc(c->threads);
+    if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+    probe_job j = {c, gs, ts};
+    parallel_for(c->threads, c->height, probe_row, &j);
+    for (int t = 0; t < c->threads && c->prep; t++) thread_stats_add(c->prep, &ts[t]);
+    free(ts);
+    uint32_t bits = atomic_load(&gs->probe_max);
+    float mx;
+    memcpy(&mx, &bits, sizeof mx);
+    guide_set_scale(&gs->g, mx);
+    gs->learning = 1;
+    gs->next = 1;
+    return VALO_OK;
+  }
+  if (!gs->learning || sample_index != gs->next) return VALO_OK;
+  if (guide_refine(&gs->g)) return err_set(err, VALO_ERR_NOMEM, "out of memory for the guide's trees");
+  gs->passes++;
+  int stop = 2 * sample_index + 1 > gs->train_spp || (c->time_budget > 0 && now_seconds() - gs->t0 > 0.25 * c->time_budget);
+  gs->next = 2 * gs->next + 1;
+  if (stop) {
+    gs->learning = 0;
+    gs->done = 1;
+    guide_stop(&gs->g);
+    gs->seconds = now_seconds() - gs->t0;
+    log_note("guided: learned in %d passes (%d spp); %u spatial leaves, %llu quadtree nodes%s", gs->passes, sample_index, gs->g.nleaves,
+             (unsigned long long)gs->g.nodes, gs->g.full ? " (the max_nodes cap was reached)" : "");
+  }
   return VALO_OK;
 }
 
-static valo_status guided_prepare(void *state, const render_ctx *c, int sample_index, valo_error *err) {
-  gstate *gs = state;
-  if (sample_index != 0 || gs->g.pass > 0 || !c->lens || c->s->has_media) return VALO_OK;
-  int train = (int)c->param[P_TRAIN];
-  double t_budget = -1;
-  if (train < 0) {
-    if (c->time_budget > 0) { train = 1 << 20; t_budget = 0.25 * c->time_budget; }
-    else train = c->spp / 4;
-  }
-  if (train < 1) return VALO_OK;
-  thread_stats *ts = thread_stats_alloc(c->threads);
-  if (!ts) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  double t0 = now_seconds();
-  /* the probe: the first pass's largest record sets the fixed point's unit */
-  run_pass(c, gs, 0, 1, 1, ts);
-  uint32_t bits = atomic_load(&gs->probe_max);
-  float mx;
-  memcpy(&mx, &bits, sizeof mx);
-  guide_set_scale(&gs->g, mx);
-  uint32_t first = 0, n = 1;
-  valo_status st = VALO_OK;
-  double last = 0;
-  while ((int)(first + n) <= train) {
-    double tp = now_seconds();
-    run_pass(c, gs, first, n, 0, ts);
-    if (guide_refine(&gs->g)) { st = err_set(err, VALO_ERR_NOMEM, "out of memory for the guide's trees"); break; }
-    last = now_seconds() - tp;
-    first += n;
-    n *= 2;
-    gs->passes++;
-    if (t_budget > 0 && now_seconds() - t0 + 2 * last > t_budget) break;
-  }
-  gs->train_spp = (int)first;
-  gs->seconds = now_seconds() - t0;
-  for (int t = 0; t < c->threads && c->prep; t++) thread_stats_add(c->prep, &ts[t]);
-  free(ts);
-  if (!st)
-    log_note("guided: %d training passes (%d spp) in %.2f s; %u spatial leaves, %llu quadtree nodes%s", gs->passes, gs->train_spp,
-             gs->seconds, gs->g.nleaves, (unsigned long long)gs->g.nodes, gs->g.full ? " (the max_nodes cap was reached)" : "");
-  return st;
-}
-
 static rgb guided_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) {
-  const gstate *gs = c->state;
+  gstate *gs = (gstate *)c->state;
   if (c->s->has_media) return path_radiance_media(c, r, smp, ts, !c->hide_emitters);
-  return guided_walk(c, &gs->g, r, smp, ts, NULL);
+  if (!gs->learning) return guided_walk(c, &gs->g, r, smp, ts, NULL);
+  recorder rc;
+  rc.g = &gs->g;
+  rc.probe = NULL;
+  rc.n = 0;
+  return guided_walk(c, &gs->g, r, smp, ts, &rc);
 }
 
 const integrator_ops integrator_guided = {
