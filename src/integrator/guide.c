@@ -58,6 +58,9 @@ static int stree_from(guide *g, const qtree *b, stree *t) {
       t->n[i].child[q] = b->n[i].child[q];
       t->n[i].p[q] = tot > 0 ? (float)((double)atomic_load_explicit(&b->n[i].sum[q], memory_order_relaxed) / tot) : 0.25f;
     }
+    const float *pq = t->n[i].p;
+    t->n[i].pu = pq[0] + pq[2];
+    for (int c = 0; c < 2; c++) t->n[i].pv[c] = pq[c] + pq[c + 2] > 0 ? pq[c] / (pq[c] + pq[c + 2]) : 0.5f;
   }
   return 0;
 }
@@ -74,6 +77,7 @@ int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c) {
   g->nsn = g->capsn = g->nleaves = g->capleaves = 1;
   g->sn[0].lo = box.lo;
   g->sn[0].hi = box.hi;
+  g->sn[0].mid = 0.5f * (box.lo.x + box.hi.x);
   if (qtree_add(g, &g->leaves[0].building) != 0) { guide_free(g); return -1; }
   return 0;
 }
@@ -89,12 +93,8 @@ void guide_set_scale(guide *g, double scale) { g->scale = scale > 0 && isfinite(
 
 const gleaf *guide_leaf(const guide *g, vec3 p) {
   uint32_t i = 0;
-  while (g->sn[i].child) {
-    const gsnode *n = &g->sn[i];
-    float lo = n->axis == 0 ? n->lo.x : n->axis == 1 ? n->lo.y : n->lo.z, hi = n->axis == 0 ? n->hi.x : n->axis == 1 ? n->hi.y : n->hi.z;
-    float x = n->axis == 0 ? p.x : n->axis == 1 ? p.y : p.z;
-    i = n->child + (x >= 0.5f * (lo + hi));
-  }
+  const float pc[3] = {p.x, p.y, p.z};
+  while (g->sn[i].child) i = g->sn[i].child + (pc[g->sn[i].axis] >= g->sn[i].mid);
   return &g->leaves[g->sn[i].leaf];
 }
 
@@ -116,10 +116,10 @@ void stree_sample(const stree *t, float u1, float u2, float *u, float *v, float 
   for (int depth = 0; t->count && depth <= QT_DEPTH + 1; depth++) {
     const snode *n = &t->n[i];
     /* the u-half by the columns' shares, then the v-half within it; each number remapped */
-    float pl = n->p[0] + n->p[2];
+    float pl = n->pu;
     int qx = u1 >= pl;
     u1 = qx ? (u1 - pl) / (1 - pl) : u1 / pl;
-    float a = n->p[qx], b = n->p[qx + 2], pa = a / (a + b);
+    float pa = n->pv[qx];
     int qy = u2 >= pa;
     u2 = qy ? (u2 - pa) / (1 - pa) : u2 / pa;
     u1 = clampf(u1, 0, 0x1.fffffep-1f);
@@ -291,9 +291,11 @@ int guide_refine(guide *g) {
     gsnode n = g->sn[i];
     int axis = n.axis, next = (axis + 1) % 3;
     float mid = 0.5f * (axis_of(n.lo, axis) + axis_of(n.hi, axis));
-    gsnode a = {n.lo, n.hi, next, 0, li}, b = {n.lo, n.hi, next, 0, nl};
+    gsnode a = {n.lo, n.hi, 0, next, 0, li}, b = {n.lo, n.hi, 0, next, 0, nl};
     set_axis(&a.hi, axis, mid);
     set_axis(&b.lo, axis, mid);
+    a.mid = 0.5f * (axis_of(a.lo, next) + axis_of(a.hi, next));
+    b.mid = 0.5f * (axis_of(b.lo, next) + axis_of(b.hi, next));
     g->sn[c] = a;
     g->sn[c + 1] = b;
     g->sn[i].child = c;

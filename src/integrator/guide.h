@@ -25,7 +25,10 @@ typedef struct qnode {
   _Atomic uint64_t sum[4];    /* flux recorded in each quadrant (fixed point) */
 } qnode;
 typedef struct qtree { qnode *n; uint32_t count, cap; } qtree;   /* a building tree */
-typedef struct snode { uint32_t child[4]; float p[4]; } snode;    /* p: the quadrants' shares */
+typedef struct snode {           /* p: the quadrants' shares; for sampling, the u-half's share  */
+  uint32_t child[4];             /* pu = p0 + p2 and each column's lower share pv[c] = p[c] / (p[c] + p[c+2]) */
+  float p[4], pu, pv[2];
+} snode;
 typedef struct stree { snode *n; uint32_t count; } stree;        /* a sampling tree; count 0: none */
 
 typedef struct gleaf {
@@ -33,7 +36,7 @@ typedef struct gleaf {
   qtree building;
   _Atomic uint32_t records;   /* path vertices recorded in this pass (lit or not) */
 } gleaf;
-typedef struct gsnode { vec3 lo, hi; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at the middle of axis; child 0: a leaf */
+typedef struct gsnode { vec3 lo, hi; float mid; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at mid (the middle of axis); child 0: a leaf */
 
 typedef struct guide {
   bbox box;

@@ -235,6 +235,10 @@ static valo_status guided_prepare(void *state, const render_ctx *c, int sample_i
     gs->next = 1;
     return VALO_OK;
   }
+  if (sample_index > 0 && gs->passes == 0 && !gs->learning && !gs->done) { /* a resumed render: no tree was kept */
+    log_warning("guided: a resumed render does not learn again; its remaining samples are path tracing (unguided)");
+    gs->done = 1;
+  }
   if (!gs->learning || sample_index != gs->next) return VALO_OK;
   if (guide_refine(&gs->g)) return err_set(err, VALO_ERR_NOMEM, "out of memory for the guide's trees");
   gs->passes++;
