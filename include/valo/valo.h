@@ -115,6 +115,7 @@ typedef struct valo_options {
 } valo_options;
 
 #define VALO_AOVS_AO 2
+#define VALO_AOVS_VARIANCE 4 /* also each pixel's sample variance (the "denoised:" output) */
 
 #define VALO_ADAPTIVE_ERROR 1
 #define VALO_ADAPTIVE_DIGEST 2

@@ -52,13 +52,15 @@ void usage_render(FILE *f) {
           "  --stats-json FILE      write the run's figures as JSON: load, build and render\n"
           "                         seconds, spp, rays, rays/s, peak memory, lost samples\n"
           "  --help-integrators     the integrators' parameters, with defaults and ranges\n"
+          "  --denoise              write the image outputs denoised (their raw images: leave\n"
+          "                         this out and name -o denoised:FILE beside them)\n"
           "  -q, --quiet            no progress or summary\n"
           "  -h, --help             this text\n");
 }
 
 /* Length of an output's AOV prefix ("albedo:", "normal:", "depth:", "spp:"), or 0. */
 size_t aov_prefix(const char *out) {
-  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
+  static const char *const prefixes[] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:", "denoised:"};
   for (size_t k = 0; k < sizeof prefixes / sizeof prefixes[0]; k++)
     if (!strncmp(out, prefixes[k], strlen(prefixes[k]))) return strlen(prefixes[k]);
   return 0;
@@ -102,6 +104,7 @@ int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err) 
       return 0;
     }
     if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) { ca->quiet = 1; continue; }
+    if (!strcmp(a, "--denoise")) { ca->denoise = 1; continue; }
     if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
       if (!val) { fprintf(err, "valo: %s needs a value\n", a); return EXIT_USAGE; }
       i++;
@@ -157,10 +160,16 @@ int cli_parse_render(int argc, char **argv, cli_args *ca, FILE *out, FILE *err) 
     snprintf(ca->default_out, sizeof ca->default_out, "%.*s.png", len, base);
     ca->outputs[ca->nout++] = ca->default_out;
   }
+  for (int i = 0; ca->denoise && i < ca->nout; i++) /* --denoise: each image output becomes a denoised one */
+    if (!aov_prefix(ca->outputs[i])) {
+      snprintf(ca->denoised[i], sizeof ca->denoised[i], "denoised:%s", ca->outputs[i]);
+      ca->outputs[i] = ca->denoised[i];
+    }
   int aovs = 0; /* the AOVs the outputs ask for */
   for (int i = 0; i < ca->nout; i++) {
     if (aov_prefix(ca->outputs[i]) && strncmp(ca->outputs[i], "spp:", 4)) aovs |= 1;
     if (!strncmp(ca->outputs[i], "ao:", 3) || !strncmp(ca->outputs[i], "bent:", 5)) aovs |= VALO_AOVS_AO;
+    if (!strncmp(ca->outputs[i], "denoised:", 9)) aovs |= VALO_AOVS_VARIANCE;
     int plen, pat = frame_pattern(ca->outputs[i], &plen);
     if (pat == -2) { fprintf(err, "valo: %s: a '%%' in an output name must be a frame pattern, %%d or %%04d\n", ca->outputs[i]); return EXIT_USAGE; }
     if (pat >= 0 && opt->frames == VALO_UNSET) { fprintf(err, "valo: %s: a frame pattern needs --frames\n", ca->outputs[i]); return EXIT_USAGE; }

@@ -25,6 +25,8 @@ typedef struct cli_args {
   const char *outputs[CLI_MAX_OUTPUTS]; /* -o, in order (the default name when none) */
   int nout;
   int quiet;
+  int denoise;                          /* --denoise: the image outputs are written denoised */
+  char denoised[CLI_MAX_OUTPUTS][1040]; /* their "denoised:" names */
   const char *stats_json, *ckpt, *resume;
   double ckpt_every;
   char default_out[1024];

@@ -4,7 +4,7 @@
 #include "render/aov.h"
 #include <string.h>
 
-const char *const aov_prefixes[AOV_KIND_COUNT] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:"};
+const char *const aov_prefixes[AOV_KIND_COUNT] = {"albedo:", "normal:", "depth:", "ao:", "bent:", "spp:", "denoised:"};
 
 int aov_kind_of(const char *output, size_t *plen) {
   for (int k = 0; k < AOV_KIND_COUNT; k++) {

@@ -6,7 +6,7 @@
 #define VALO_AOV_H
 #include "render/session.h"
 
-typedef enum aov_kind { AOV_KIND_ALBEDO, AOV_KIND_NORMAL, AOV_KIND_DEPTH, AOV_KIND_AO, AOV_KIND_BENT, AOV_KIND_SPP, AOV_KIND_COUNT } aov_kind;
+typedef enum aov_kind { AOV_KIND_ALBEDO, AOV_KIND_NORMAL, AOV_KIND_DEPTH, AOV_KIND_AO, AOV_KIND_BENT, AOV_KIND_SPP, AOV_KIND_DENOISED, AOV_KIND_COUNT } aov_kind;
 /* The output prefix of each kind ("albedo:" ...), AOV_KIND_COUNT of them. */
 extern const char *const aov_prefixes[AOV_KIND_COUNT];
 /* The kind an output name asks for (its prefix; *plen gets the prefix's length), or -1

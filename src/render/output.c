@@ -3,6 +3,7 @@
 #include "render/aov.h"
 #include "image/image_io.h"
 #include "image/tonemap.h"
+#include "image/denoise.h"
 #include "core/error.h"
 #include "core/strutil.h"
 #include "core/options.h"
@@ -48,6 +49,29 @@ static void aov_resolve(const session *ss, int k, float *px) {
   }
 }
 
+/* The denoised image (image/denoise.h) from the film's radiance, its per-pixel variance
+ * of the mean (when the film kept squares) and the AOVs. */
+static valo_status denoised_resolve(const session *ss, float *px, valo_error *err) {
+  const film *f = &ss->film;
+  size_t np = film_pixels(f);
+  float *buf = malloc(np * 3 * sizeof(float) * 4 + np * sizeof(float));
+  if (!buf) return err_set(err, VALO_ERR_NOMEM, "out of memory");
+  float *color = buf, *var = buf + 3 * np, *alb = buf + 6 * np, *nrm = buf + 9 * np, *dep = buf + 12 * np;
+  film_resolve(f, color);
+  aov_resolve(ss, AOV_KIND_ALBEDO, alb);
+  aov_resolve(ss, AOV_KIND_NORMAL, nrm);
+  for (size_t i = 0; i < np; i++) dep[i] = f->count[i] ? f->aov[AOV_FLOATS * i + AOV_DEPTH] / (float)f->count[i] : 0;
+  for (size_t i = 0; f->sq && i < np; i++)
+    for (int c = 0; c < 3; c++) {
+      double n = f->count[i], s = f->sum[3 * i + c];
+      var[3 * i + c] = n > 1 ? (float)(fmax(0, (f->sq[4 * i + c] - s * s / n) / (n - 1)) / n) : 0;
+    }
+  denoise_in in = {ss->opt.width, ss->opt.height, color, f->sq ? var : NULL, alb, nrm, dep};
+  int rc = denoise_image(&in, px, ss->opt.threads);
+  free(buf);
+  return rc ? err_set(err, VALO_ERR_NOMEM, "out of memory") : VALO_OK;
+}
+
 /* VALO_OK when the film holds layer k (-1: the image); name is what the message calls it. */
 static valo_status layer_check(const session *ss, int k, const char *name, valo_error *err) {
   if (k < 0 || k == AOV_KIND_SPP) return VALO_OK;
@@ -65,11 +89,12 @@ valo_status output_layer(const session *ss, const char *layer, float *px, valo_e
     size_t plen = 0;
     snprintf(prefix, sizeof prefix, "%s:", layer);
     k = aov_kind_of(prefix, &plen);
-    if (k < 0 || plen != strlen(prefix)) return err_set(err, VALO_ERR_INVALID, "unknown layer \"%s\" (albedo, normal, depth, ao, bent, spp)", layer);
+    if (k < 0 || plen != strlen(prefix)) return err_set(err, VALO_ERR_INVALID, "unknown layer \"%s\" (albedo, normal, depth, ao, bent, spp, denoised)", layer);
   }
   valo_status st = layer_check(ss, k, layer, err);
   if (st) return st;
   if (k < 0) film_resolve(&ss->film, px);
+  else if (k == AOV_KIND_DENOISED) return denoised_resolve(ss, px, err);
   else aov_resolve(ss, k, px);
   return VALO_OK;
 }
@@ -79,7 +104,7 @@ valo_status output_write(const session *ss, const char *path, const valo_output_
   int k = aov_kind_of(path, &plen);
   int w = ss->opt.width, h = ss->opt.height;
   size_t np = film_pixels(&ss->film);
-  if (k < 0) {
+  if (k < 0 || k == AOV_KIND_DENOISED) {
     tonemap_kind tk;
     if (tonemap_parse(o->tonemap, &tk)) return err_set(err, VALO_ERR_INVALID, "unknown tone mapper \"%s\" (clamp, log, reinhard, aces)", o->tonemap);
   }
@@ -92,6 +117,9 @@ valo_status output_write(const session *ss, const char *path, const valo_output_
   options_default_target(OPT_OUTPUT, &raw);
   if (k < 0) {
     film_resolve(&ss->film, px);
+  } else if (k == AOV_KIND_DENOISED) {
+    valo_status dst = denoised_resolve(ss, px, err);
+    if (dst) { free(px); return dst; }
   } else {
     aov_resolve(ss, k, px);
     int data = k == AOV_KIND_NORMAL || k == AOV_KIND_DEPTH || k == AOV_KIND_BENT || k == AOV_KIND_SPP;

@@ -41,9 +41,9 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   valo_status st = VALO_OK;
   /* the film's sums (double RGB), counts, the adaptive squares and AOV sums when asked,
    * an image integrator's frame, and the float pixels an output is made from */
-  uint64_t per_px = 3 * 8 + 4 + (o.adaptive ? 4 * 8 : 0) + (o.aovs ? AOV_FLOATS * 4 : 0) + (integ->kind == INTEGRATOR_IMAGE ? 12 : 0) + 12;
+  uint64_t per_px = 3 * 8 + 4 + (o.adaptive || (o.aovs > 0 && (o.aovs & VALO_AOVS_VARIANCE)) ? 4 * 8 : 0) + (o.aovs ? AOV_FLOATS * 4 : 0) + (integ->kind == INTEGRATOR_IMAGE ? 12 : 0) + 12;
   if ((st = mem_check_pixels((uint64_t)o.width, (uint64_t)o.height, per_px, "film", err))) goto fail;
-  if (film_init(&ss->film, o.width, o.height, o.adaptive != 0, o.aovs != 0) ||
+  if (film_init(&ss->film, o.width, o.height, o.adaptive != 0 || (o.aovs > 0 && (o.aovs & VALO_AOVS_VARIANCE)), o.aovs != 0) ||
       (integ->kind == INTEGRATOR_IMAGE && !(ss->frame_rgb = calloc((size_t)o.width * o.height * 3, sizeof(float))))) {
     st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
     goto fail;
