@@ -535,6 +535,17 @@ static int aovs(void) {
     if (k == 1) CHECK(fabsf(c[0] - 3 / expect) < 0.01f && corner[0] > 0.99f, "depth PNG centre %g (expected %g), corner %g", c[0], 3 / expect, corner[0]);
     if (k == 2) CHECK(c[0] > 0.99f, "spp PNG %g (every pixel has the largest count)", c[0]);
   }
+  /* The denoised image of the lit plane (variance estimated, the film kept no squares):
+   * the same light, the noise gone (the raw centre column's spread is the bound). */
+  image dn;
+  float raw[81 * 3];
+  valo_render_pixels(r, raw);
+  CHECK(read_aov(r, "denoised", &dn) == 0, "cannot write or read the denoised image");
+  double sr = 0, sd = 0;
+  for (int i = 0; i < 81 * 3; i++) { sr += raw[i]; sd += dn.rgb[i]; }
+  fprintf(stderr, "denoised plane: mean %.5f against the raw %.5f\n", sd / 243, sr / 243);
+  CHECK(fabs(sd / sr - 1) < 0.02, "the denoised plane's mean moved by %.2f %%", 100 * (sd / sr - 1));
+  image_free(&dn);
   /* The ao AOVs cost a ray per sample: without the VALO_AOVS_AO bit they were not
    * recorded, and asking for them is a clear error. */
   CHECK(valo_render_write(r, "ao:x.exr", NULL, &err) == VALO_ERR_INVALID && strstr(err.message, "VALO_AOVS_AO"), "ao AOV without the bit accepted");
@@ -542,6 +553,7 @@ static int aovs(void) {
   valo_render_destroy(r);
   CHECK(valo_render_create(sc, NULL, &r, &err) == VALO_OK, "%s", err.message);
   CHECK(valo_render_write(r, "albedo:x.exr", NULL, &err) == VALO_ERR_INVALID, "AOV without aovs accepted");
+  CHECK(valo_render_write(r, "denoised:x.exr", NULL, &err) == VALO_ERR_INVALID, "denoised without aovs accepted");
   valo_render_destroy(r);
   valo_scene_destroy(sc);
   return 0;

@@ -765,6 +765,12 @@ static int frames_cli(void) {
   SAID("radius");
   EXPECT_FAIL(1, "render", obj, "--integrator", "restir-di", "-o", "albedo:x.png");
   SAID("AOV");
+  /* --denoise writes the image outputs denoised; -o denoised: beside the raw one */
+  char dn1[1200], dn2[1200];
+  snprintf(dn1, sizeof dn1, "%s/dn1.png", scratch_dir());
+  snprintf(dn2, sizeof dn2, "denoised:%s/dn2.exr", scratch_dir());
+  EXPECT_FAIL(0, "render", obj, "--denoise", "--spp", "2", "--res", "16x12", "-o", dn1, "-o", dn2, "-q");
+  CHECK(access(dn1, F_OK) == 0 && access(dn2 + 9, F_OK) == 0, "the denoised outputs were not written");
   const char *bk = write_file("badkey.json", "{ \"camera\": {\"keyframes\": [{\"frame\": 1}, {\"frame\": 0}]},"
                                              " \"shapes\": [{\"file\": \"ok.obj\"}] }\n");
   EXPECT_FAIL(1, "render", bk);
@@ -821,7 +827,7 @@ static int options_docs(void) {
   /* and the other way: every --flag named in README.md and the docs exists */
   /* (docs/performance.md and docs/testing.md also name the benchmark programs' flags) */
   const char *docs[] = {"README.md", "docs/guide.md", "docs/scene-format.md", "docs/integrators.md"};
-  static const char *const cli_own[] = {"--output", "--quiet", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume",
+  static const char *const cli_own[] = {"--output", "--quiet", "--denoise", "--help", "--help-integrators", "--version", "--stats-json", "--checkpoint", "--checkpoint-every", "--resume",
                                         "--integrators", "--reference", "--crop", /* valo compare's */
                                         "--benchmark", NULL};                      /* valo view's */
   int named = 0;
