@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 
 static void usage_compare(FILE *f) {
@@ -84,7 +85,8 @@ static int on_progress(void *user, double frac, int spp, double seconds) {
 }
 
 /* Renders one integrator; fills run (pixels, figures, moments). 0 or an exit code. */
-static int render_one(valo_scene *sc, valo_options opt, const char *name, const char *dir, const float *ref, int index, int count, cmp_run *run) {
+static int render_one(valo_scene *sc, valo_options opt, const char *name, const char *dir, const float *ref, int index, int count, cmp_run *run,
+                      cmp_run *dn) {
   snprintf(opt.integrator, sizeof opt.integrator, "%s", name);
   snprintf(run->name, sizeof run->name, "%s", name);
   valo_error err;
@@ -143,6 +145,32 @@ static int render_one(valo_scene *sc, valo_options opt, const char *name, const 
     if (valo_render_write(r, path, &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); valo_render_destroy(r); return 1; }
   }
   fprintf(stderr, "valo: %s: %.2f s, %d spp, %.3g rays\n", name, run->seconds, run->spp, (double)run->rays);
+  if (dn) { /* --denoise: the same render denoised, an entry of its own (its time includes the filter's) */
+    *dn = *run;
+    memset(dn->snap, 0, sizeof dn->snap);
+    snprintf(dn->name, sizeof dn->name, "%.20s+denoised", name);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    dn->px = malloc(np * 3 * sizeof *dn->px);
+    if (!dn->px || valo_render_layer(r, "denoised", dn->px, &err)) {
+      fprintf(stderr, "valo: error: %s\n", dn->px ? err.message : "out of memory");
+      valo_render_destroy(r);
+      return 1;
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    dn->seconds += (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    dn->nsnap = 0;
+    dn->snap_t[0] = dn->seconds;
+    dn->snap_spp[0] = dn->spp;
+    if (ref) { dn->snap_err[0] = relmse(dn->px, ref, np, NULL); dn->nsnap = 1; }
+    else if ((dn->snap[0] = malloc(np * 3 * sizeof(float)))) { memcpy(dn->snap[0], dn->px, np * 3 * sizeof(float)); dn->nsnap = 1; }
+    for (int k = 0; k < 2; k++) {
+      char path[4400];
+      snprintf(path, sizeof path, "denoised:%s/%s.%s", dir, dn->name, ext[k]);
+      if (valo_render_write(r, path, &oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); valo_render_destroy(r); return 1; }
+    }
+    fprintf(stderr, "valo: %s: %.2f s\n", dn->name, dn->seconds);
+  }
   valo_render_destroy(r);
   return 0;
 }
@@ -235,7 +263,10 @@ int cmd_compare(int argc, char **argv) {
   for (const char *p = list; *p;) {
     const char *e = strchr(p, ',');
     size_t len = e ? (size_t)(e - p) : strlen(p);
-    if (rep.nruns == CMP_MAX_RUNS) { fprintf(stderr, "valo: at most %d integrators\n", CMP_MAX_RUNS); return EXIT_USAGE; }
+    if (rep.nruns == (ca.denoise ? CMP_MAX_RUNS / 2 : CMP_MAX_RUNS)) {
+      fprintf(stderr, "valo: at most %d integrators%s\n", ca.denoise ? CMP_MAX_RUNS / 2 : CMP_MAX_RUNS, ca.denoise ? " with --denoise" : "");
+      return EXIT_USAGE;
+    }
     int known = 0;
     for (const char *const *n = valo_integrator_names(); *n; n++) known |= strlen(*n) == len && !strncmp(*n, p, len);
     if (!known || len >= sizeof names[0]) {
@@ -264,15 +295,20 @@ int cmd_compare(int argc, char **argv) {
     if (valo_image_read(refpath, &rw, &rh, &ref, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
     snprintf(rep.reference, sizeof rep.reference, "%s", refpath);
   }
-  for (int k = 0; k < rep.nruns && !rc; k++) {
-    rep.runs[k].w = rw;
-    rep.runs[k].h = rh;
-    rc = render_one(sc, opt, names[k], dir, ref, k, rep.nruns, &rep.runs[k]);
+  int nint = rep.nruns, per = ca.denoise ? 2 : 1;
+  if (ca.denoise) opt.aovs = (opt.aovs > 0 ? opt.aovs : 1) | VALO_AOVS_VARIANCE;
+  rep.nruns = 0;
+  for (int k = 0; k < nint && !rc; k++) {
+    cmp_run *run = &rep.runs[per * k];
+    run->w = rw;
+    run->h = rh;
+    rc = render_one(sc, opt, names[k], dir, ref, k, nint, run, ca.denoise ? run + 1 : NULL);
+    if (!rc) rep.nruns += per;
   }
   valo_scene_destroy(sc);
   if (!rc && !refpath) {
     int longest = 0;
-    for (int k = 1; k < rep.nruns; k++)
+    for (int k = per; k < rep.nruns; k += per) /* a denoised image is never the reference */
       if (rep.runs[k].seconds > rep.runs[longest].seconds) longest = k;
     rep.ref_run = longest + 1;
   }
