@@ -983,10 +983,10 @@ static int bilinear_distribution(void) {
 static int guide_sf(void *c, sampler *s, vec3 *dir) {
   float u1, u2, pdf;
   sampler_2d(s, &u1, &u2);
-  *dir = guide_sample(c, u1, u2, &pdf);
+  *dir = guide_sample(c, 0, u1, u2, &pdf);
   return pdf > 0;
 }
-static double guide_pf(void *c, vec3 d) { return guide_pdf(c, d); }
+static double guide_pf(void *c, vec3 d) { return guide_pdf(c, 0, d); }
 static int guide_quadtree(void) {
   guide g;
   bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
@@ -1005,12 +1005,12 @@ static int guide_quadtree(void) {
         float c = v3_dot(d, lobes[l]);
         if (c > 1 - widths[l]) v += values[l];
       }
-      guide_record(&g, (gleaf *)guide_leaf(&g, v3(0.1f, 0.2f, 0.3f)), d, v * 4 * PI_F);
+      guide_record(&g, (gleaf *)guide_leaf(&g, v3(0.1f, 0.2f, 0.3f)), 0, d, v * 4 * PI_F);
     }
     CHECK(guide_refine(&g) == 0, "refine");
   }
   const gleaf *l = guide_leaf(&g, v3(0.1f, 0.2f, 0.3f));
-  CHECK(guide_can_sample(l), "nothing learned");
+  CHECK(guide_can_sample(l, 0) && !guide_can_sample(l, 1), "nothing learned, or in the wrong bin");
   int rc = run_chi2("guide quadtree (learned from three lobes)", (void *)l, guide_sf, guide_pf);
   /* the narrow lobe: solid angle 2 pi 0.02 (0.32 % of the sphere), the recorded flux's
    * share 2 pi 0.02 50 over the total (about 38 %); its directions must be drawn often */

@@ -11,6 +11,11 @@
 
 static void qtree_free(qtree *t) { free(t->n); memset(t, 0, sizeof *t); }
 static void stree_free(stree *t) { free(t->n); memset(t, 0, sizeof *t); }
+static uint64_t node_total_u(const qnode *n) {
+  uint64_t t = 0;
+  for (int q = 0; q < 4; q++) t += atomic_load_explicit(&n->sum[q], memory_order_relaxed);
+  return t;
+}
 static double node_total_q(const qnode *n) {
   double t = 0;
   for (int q = 0; q < 4; q++) t += (double)atomic_load_explicit(&n->sum[q], memory_order_relaxed);
@@ -78,12 +83,14 @@ int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c) {
   g->sn[0].lo = box.lo;
   g->sn[0].hi = box.hi;
   g->sn[0].mid = 0.5f * (box.lo.x + box.hi.x);
-  if (qtree_add(g, &g->leaves[0].building) != 0) { guide_free(g); return -1; }
+  for (int b = 0; b < GUIDE_BINS; b++)
+    if (qtree_add(g, &g->leaves[0].building[b]) != 0) { guide_free(g); return -1; }
   return 0;
 }
 
 void guide_free(guide *g) {
-  for (uint32_t i = 0; i < g->nleaves; i++) { stree_free(&g->leaves[i].sampling); qtree_free(&g->leaves[i].building); }
+  for (uint32_t i = 0; i < g->nleaves; i++)
+    for (int b = 0; b < GUIDE_BINS; b++) { stree_free(&g->leaves[i].sampling[b]); qtree_free(&g->leaves[i].building[b]); }
   free(g->leaves);
   free(g->sn);
   memset(g, 0, sizeof *g);
@@ -152,22 +159,29 @@ float stree_pdf(const stree *t, float u, float v) {
   return p;
 }
 
-int guide_can_sample(const gleaf *l) { return l->sampling.count > 0; }
+int guide_bin(vec3 n) {
+  float ax = fabsf(n.x), ay = fabsf(n.y), az = fabsf(n.z);
+  if (ax >= ay && ax >= az) return n.x < 0;
+  if (ay >= az) return 2 + (n.y < 0);
+  return 4 + (n.z < 0);
+}
 
-vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf) {
+int guide_can_sample(const gleaf *l, int b) { return l->sampling[b].count > 0; }
+
+vec3 guide_sample(const gleaf *l, int b, float u1, float u2, float *pdf) {
   float u, v, p;
-  stree_sample(&l->sampling, u1, u2, &u, &v, &p);
+  stree_sample(&l->sampling[b], u1, u2, &u, &v, &p);
   *pdf = p * (0.25f * INV_PI_F);
   return guide_square_to_dir(u, v);
 }
 
-float guide_pdf(const gleaf *l, vec3 d) {
+float guide_pdf(const gleaf *l, int b, vec3 d) {
   float u, v;
   guide_dir_to_square(d, &u, &v);
-  return stree_pdf(&l->sampling, u, v) * (0.25f * INV_PI_F);
+  return stree_pdf(&l->sampling[b], u, v) * (0.25f * INV_PI_F);
 }
 
-void guide_record(const guide *g, gleaf *l, vec3 d, float value) {
+void guide_record(const guide *g, gleaf *l, int b, vec3 d, float value) {
   atomic_fetch_add_explicit(&l->records, 1, memory_order_relaxed); /* every vertex counts, lit or not */
   if (!(value > 0) || !(g->scale > 0)) return;
   double units = value / g->scale;
@@ -175,16 +189,24 @@ void guide_record(const guide *g, gleaf *l, vec3 d, float value) {
   if (!fx) return;
   float u, v;
   guide_dir_to_square(d, &u, &v);
-  qtree *t = &l->building;
+  /* only the deepest quadrant takes the record (threads seldom meet there); guide_refine
+     sums the parents' */
+  qtree *t = &l->building[b];
   uint32_t i = 0;
   for (int depth = 0; t->count && depth <= QT_DEPTH + 1; depth++) {
     int qx = u >= 0.5f, qy = v >= 0.5f, q = qx | qy << 1;
-    atomic_fetch_add_explicit(&t->n[i].sum[q], fx, memory_order_relaxed);
+    if (!t->n[i].child[q]) { atomic_fetch_add_explicit(&t->n[i].sum[q], fx, memory_order_relaxed); break; }
     u = 2 * u - (float)qx;
     v = 2 * v - (float)qy;
-    if (!t->n[i].child[q]) break;
     i = t->n[i].child[q];
   }
+}
+
+/* Each quadrant with a child gets the child's total (children come after their parents). */
+static void qtree_sum_up(qtree *t) {
+  for (uint32_t i = t->count; i-- > 0;)
+    for (int q = 0; q < 4; q++)
+      if (t->n[i].child[q]) atomic_store_explicit(&t->n[i].sum[q], node_total_u(&t->n[t->n[i].child[q]]), memory_order_relaxed);
 }
 
 /* A new building tree from a sampling tree's flux: quadrants over QT_RHO of the total are
@@ -243,10 +265,11 @@ static int grow_spatial(guide *g) {
 }
 
 void guide_stop(guide *g) {
-  for (uint32_t i = 0; i < g->nleaves; i++) {
-    g->nodes -= g->leaves[i].building.count;
-    qtree_free(&g->leaves[i].building);
-  }
+  for (uint32_t i = 0; i < g->nleaves; i++)
+    for (int b = 0; b < GUIDE_BINS; b++) {
+      g->nodes -= g->leaves[i].building[b].count;
+      qtree_free(&g->leaves[i].building[b]);
+    }
 }
 
 static float axis_of(vec3 p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
@@ -256,34 +279,39 @@ static void set_axis(vec3 *p, int axis, float x) {
 
 int guide_refine(guide *g) {
   /* each leaf: the pass's flux becomes the sampling tree and shapes the next building tree */
-  for (uint32_t i = 0; i < g->nleaves; i++) {
-    gleaf *l = &g->leaves[i];
-    g->nodes -= l->sampling.count;
-    stree_free(&l->sampling);
-    qtree nb;
-    if (qtree_refined(g, &l->building, &nb) || stree_from(g, &l->building, &l->sampling)) { qtree_free(&nb); return -1; }
-    g->nodes -= l->building.count;
-    qtree_free(&l->building);
-    l->building = nb;
-  }
+  for (uint32_t i = 0; i < g->nleaves; i++)
+    for (int b = 0; b < GUIDE_BINS; b++) {
+      gleaf *l = &g->leaves[i];
+      g->nodes -= l->sampling[b].count;
+      stree_free(&l->sampling[b]);
+      qtree nb;
+      qtree_sum_up(&l->building[b]);
+      if (qtree_refined(g, &l->building[b], &nb) || stree_from(g, &l->building[b], &l->sampling[b])) { qtree_free(&nb); return -1; }
+      g->nodes -= l->building[b].count;
+      qtree_free(&l->building[b]);
+      l->building[b] = nb;
+    }
   /* Split leaves that saw too many records; the children (appended, so visited by this
    * same loop) start from their parent's count halved and its trees. */
   double thresh = g->spatial_c * sqrt(ldexp(1, g->pass));
   for (uint32_t i = 0; i < g->nsn; i++) {
     if (g->sn[i].child) continue;
     uint32_t li = g->sn[i].leaf, rec = atomic_load(&g->leaves[li].records);
-    if (rec <= thresh || g->nodes + g->leaves[li].sampling.count + g->leaves[li].building.count > g->max_nodes) continue;
+    uint64_t held = 0;
+    for (int b = 0; b < GUIDE_BINS; b++) held += g->leaves[li].sampling[b].count + g->leaves[li].building[b].count;
+    if (rec <= thresh || g->nodes + held > g->max_nodes) continue;
     if (grow_spatial(g)) return -1;
     uint32_t nl = g->nleaves, c = g->nsn;
     gleaf *src = &g->leaves[li], *dst = &g->leaves[nl];
     memset(dst, 0, sizeof *dst);
-    if (stree_copy(g, &src->sampling, &dst->sampling)) return -1;
-    if (src->building.count) {
-      dst->building.n = malloc(src->building.count * sizeof(qnode));
-      if (!dst->building.n) return -1;
-      memcpy(dst->building.n, src->building.n, src->building.count * sizeof(qnode));
-      dst->building.count = dst->building.cap = src->building.count;
-      g->nodes += src->building.count;
+    for (int b = 0; b < GUIDE_BINS; b++) {
+      if (stree_copy(g, &src->sampling[b], &dst->sampling[b])) return -1;
+      if (!src->building[b].count) continue;
+      dst->building[b].n = malloc(src->building[b].count * sizeof(qnode));
+      if (!dst->building[b].n) return -1;
+      memcpy(dst->building[b].n, src->building[b].n, src->building[b].count * sizeof(qnode));
+      dst->building[b].count = dst->building[b].cap = src->building[b].count;
+      g->nodes += src->building[b].count;
     }
     atomic_store(&dst->records, rec / 2);
     atomic_store(&src->records, rec / 2);

@@ -1,6 +1,7 @@
 /* guide.h — owns the SD-tree of path guiding (Müller, Gross, Novák 2017, "Practical Path
  * Guiding"): a binary tree over the scene's box (split at the middle, axes in turn) whose
- * leaves each hold two quadtrees over the sphere of directions (the square
+ * leaves each hold, for each of six bins of the shading normal (its major axis: a floor
+ * and a ceiling in one leaf learn apart), two quadtrees over the sphere of directions (the square
  * [0,1]^2 of (cos theta + 1)/2 and phi/2pi, an equal-area map: density on the sphere =
  * density on the square / 4 pi). A pass samples from the `sampling` quadtrees and records
  * incident radiance / pdf into the `building` ones; guide_refine then makes the building
@@ -31,9 +32,10 @@ typedef struct snode {           /* p: the quadrants' shares; for sampling, the 
 } snode;
 typedef struct stree { snode *n; uint32_t count; } stree;        /* a sampling tree; count 0: none */
 
+#define GUIDE_BINS 6 /* a leaf's quadtrees, one per major axis of the shading normal (+x, -x, +y, ...) */
 typedef struct gleaf {
-  stree sampling;
-  qtree building;
+  stree sampling[GUIDE_BINS];
+  qtree building[GUIDE_BINS];
   _Atomic uint32_t records;   /* path vertices recorded in this pass (lit or not) */
 } gleaf;
 typedef struct gsnode { vec3 lo, hi; float mid; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at mid (the middle of axis); child 0: a leaf */
@@ -58,13 +60,16 @@ const gleaf *guide_leaf(const guide *g, vec3 p);
 /* Directions <-> the quadtrees' square. */
 void guide_dir_to_square(vec3 d, float *u, float *v);
 vec3 guide_square_to_dir(float u, float v);
-/* Whether the leaf's sampling tree holds anything to sample. */
-int guide_can_sample(const gleaf *l);
-/* Samples a direction from the leaf's sampling tree; *pdf per steradian. */
-vec3 guide_sample(const gleaf *l, float u1, float u2, float *pdf);
-float guide_pdf(const gleaf *l, vec3 d);
-/* Adds value (radiance / pdf, >= 0) at direction d to the building tree of leaf l (of g). */
-void guide_record(const guide *g, gleaf *l, vec3 d, float value);
+/* The bin of a shading normal: its major axis and sign. */
+int guide_bin(vec3 n);
+/* Whether the leaf's sampling tree of bin b holds anything to sample. */
+int guide_can_sample(const gleaf *l, int b);
+/* Samples a direction from the leaf's sampling tree of bin b; *pdf per steradian. */
+vec3 guide_sample(const gleaf *l, int b, float u1, float u2, float *pdf);
+float guide_pdf(const gleaf *l, int b, vec3 d);
+/* Adds value (radiance / pdf, >= 0) at direction d to the building tree of bin b of leaf
+ * l (of g), and counts a vertex there. */
+void guide_record(const guide *g, gleaf *l, int b, vec3 d, float value);
 /* Ends a pass (serial): the building trees become the sampling ones, leaves split, new
  * building trees refined. Returns -1 when out of memory. */
 int guide_refine(guide *g);

@@ -47,10 +47,10 @@ typedef struct gstate {
 } gstate;
 
 #define MAXV 48
-typedef struct gvert { gleaf *l; vec3 d; rgb beta, L0, ex; float pdf; } gvert; /* L0: the path's radiance when it left; ex: what it does not learn */
+typedef struct gvert { gleaf *l; int bin; vec3 d; rgb beta, L0, ex; float pdf; } gvert; /* L0: the path's radiance when it left; ex: what it does not learn */
 typedef struct recorder { guide *g; _Atomic uint32_t *probe; gvert v[MAXV]; int n; } recorder;
 
-static void rec_value(recorder *rc, gleaf *l, vec3 d, float value) {
+static void rec_value(recorder *rc, gleaf *l, int bin, vec3 d, float value) {
   if (!(value >= 0) || !isfinite(value)) return;
   if (rc->probe) {
     uint32_t bits, old = atomic_load_explicit(rc->probe, memory_order_relaxed);
@@ -58,7 +58,7 @@ static void rec_value(recorder *rc, gleaf *l, vec3 d, float value) {
     while (bits > old && !atomic_compare_exchange_weak_explicit(rc->probe, &old, bits, memory_order_relaxed, memory_order_relaxed)) {}
     return;
   }
-  if (l) guide_record(rc->g, l, d, value);
+  if (l) guide_record(rc->g, l, bin, d, value);
 }
 static float channel_ratio(float a, float b) { return b > 0 ? a / b : 0; }
 /* Each vertex's incident radiance along its sampled direction: what the path gathered
@@ -68,7 +68,7 @@ static void rec_flush(recorder *rc, rgb L) {
     const gvert *v = &rc->v[k];
     rgb acc = c3_sub(c3_sub(L, v->L0), v->ex);
     rgb Lin = c3(channel_ratio(acc.r, v->beta.r), channel_ratio(acc.g, v->beta.g), channel_ratio(acc.b, v->beta.b));
-    rec_value(rc, v->l, v->d, c3_lum(Lin) / v->pdf);
+    rec_value(rc, v->l, v->bin, v->d, c3_lum(Lin) / v->pdf);
   }
   rc->n = 0;
 }
@@ -97,7 +97,8 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     frame fr = shading_frame(&it, &b, wo);
     int smooth = bsdf_has_smooth(&b);
     gleaf *lf = smooth && (g->pass > 0 || rc) ? (gleaf *)guide_leaf(g, it.p) : NULL; /* recording writes its building tree */
-    const gleaf *gl = lf && guide_can_sample(lf) ? lf : NULL;
+    int bin = guide_bin(fr.n);
+    const gleaf *gl = lf && guide_can_sample(lf, bin) ? lf : NULL;
     float ag = gl ? 1 - alpha_b : 0; /* probability of sampling the guide */
     vec3 wo_l = frame_to_local(&fr, wo);
     if (smooth) { /* next-event estimation, MIS against the mixture */
@@ -107,7 +108,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
         float mw = 1;
         if (!d.delta) {
           float pb = bsdf_pdf(&b, wo_l, frame_to_local(&fr, d.wi));
-          float pm = (1 - ag) * pb + (ag > 0 ? ag * guide_pdf(gl, d.wi) : 0);
+          float pm = (1 - ag) * pb + (ag > 0 ? ag * guide_pdf(gl, bin, d.wi) : 0);
           mw = power_heuristic(d.light_pdf, pm);
         }
         rgb Li = c3_scale(d.Li, mw / d.light_pdf);
@@ -126,7 +127,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     float eta_scale = 1;
     if (ag > 0 && ul < ag) {
       float pg;
-      wi = guide_sample(gl, u1, u2, &pg);
+      wi = guide_sample(gl, bin, u1, u2, &pg);
       vec3 wi_l = frame_to_local(&fr, wi);
       rgb f = bsdf_eval(&b, wo_l, wi_l);
       float pb = bsdf_pdf(&b, wo_l, wi_l);
@@ -152,7 +153,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
         weight = c3_scale(bs.weight, 1 / (1 - ag));
         pm = bs.pdf;
       } else {
-        pm = (1 - ag) * bs.pdf + (ag > 0 ? ag * guide_pdf(gl, wi) : 0);
+        pm = (1 - ag) * bs.pdf + (ag > 0 ? ag * guide_pdf(gl, bin, wi) : 0);
         weight = c3_scale(bs.weight, bs.pdf / pm);
       }
     }
@@ -162,7 +163,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     st.eta_acc /= eta_scale;
     r = spawn_ray(&it, wi);
     beta = c3_mul(beta, weight);
-    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){lf, wi, beta, L, c3(0, 0, 0), pm};
+    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){lf, bin, wi, beta, L, c3(0, 0, 0), pm};
     if (!path_survive(&st, &beta, depth, c->rr_depth, smp)) break;
   }
   if (rc) rec_flush(rc, L);
