@@ -210,6 +210,17 @@ static int vpl_sampled_shadow_rays(void) {
   return 0;
 }
 
+/* vsl's sampled lights (the default, shadow_rays 64) have the expectation of the sum over
+ * every light: the furnace's mean with them against the full gather's. */
+static int vsl_sampled_lights(void) {
+  double full, samp;
+  CHECK(furnace_mean(3, "vsl", "count=1024 shadow_rays=0", 16, &full) == 0 && furnace_mean(3, "vsl", "count=1024 shadow_rays=16", 16, &samp) == 0,
+        "render");
+  fprintf(stderr, "vsl furnace (rho 0.5, Le 1), 1 024 lights: every light %.4f, 16 drawn %.4f\n", full, samp);
+  CHECK(fabs(samp - full) < 0.01, "16 drawn lights %.4f against every light %.4f", samp, full);
+  return 0;
+}
+
 static int vpl_furnace(void) {
   /* 16x16 pixels: the image is uniform; what matters is the number of light paths (the
    * image's mean varies with each pass's total flux) */
@@ -348,7 +359,7 @@ static int vpl_threads(void) {
 int main(int argc, char **argv) {
   static const test_case cases[] = {{"vpl_unclamped_converges", vpl_unclamped_converges},
                                     {"vpl_clamping_and_compensation", vpl_clamping_and_compensation},
-                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"thin_wall_no_leak", thin_wall_no_leak}, {"vpl_furnace_clamped", vpl_furnace_clamped}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays},
+                                    {"vpl_furnace", vpl_furnace}, {"vsl_cornell_bias", vsl_cornell_bias}, {"thin_wall_no_leak", thin_wall_no_leak}, {"vpl_furnace_clamped", vpl_furnace_clamped}, {"vpl_sampled_shadow_rays", vpl_sampled_shadow_rays}, {"vsl_sampled_lights", vsl_sampled_lights},
                                     {"vsl_glossy", vsl_glossy},
                                     {"vpl_threads", vpl_threads},
                                     {NULL, NULL}};

@@ -22,6 +22,7 @@ const stream_use stream_uses[] = {
     {"vpl child 0 of 1", "compensation's path", SDIM_BOUNCE0, BOUNCES_END},
     {"vpl child 0 of 1", "sampled shadow rays", CDIM_VPL_SAMPLED, CDIM_VPL_SAMPLED + 1},
     {"vsl child i of n", "cone directions", CDIM_VSL_CONE, CDIM_VSL_CONE + 64},
+    {"vsl child 0 of 1", "sampled lights", CDIM_VSL_SAMPLED, CDIM_VSL_SAMPLED + 1},
     {"restir pixel", "candidate choice", RDIM_CAND, RDIM_CAND + 1024},
     {"restir pixel", "temporal reuse", RDIM_TEMPORAL, RDIM_TEMPORAL + 8},
     {"restir pixel", "spatial reuse", RDIM_SPATIAL, RDIM_SPATIAL + 256 * 8 + 8},

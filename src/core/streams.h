@@ -50,6 +50,7 @@ enum {
   CDIM_VPL_COMPENSATE = SDIM_EXTRA,      /* vpl: compensation's BSDF ray (1D + 2D), then its path
                                             from sdim_bounce(d, .) (child 0 of 1) */
   CDIM_VPL_SAMPLED = SDIM_EXTRA + 16,    /* vpl: the sampled shadow rays' offset (1D, child 0 of 1) */
+  CDIM_VSL_SAMPLED = SDIM_EXTRA + 96,    /* vsl: the sampled lights' offset (1D, child 0 of 1; n > 1) */
 };
 /* Dimensions of the restir pixel stream. */
 enum {

@@ -17,13 +17,15 @@
 
 typedef struct vsl_state { vlight_set set; } vsl_state;
 
-enum { S_COUNT, S_DIRECT, S_RADIUS, S_K, S_CONE };
+enum { S_COUNT, S_DIRECT, S_RADIUS, S_K, S_CONE, S_SHADOW };
 static const integrator_param vsl_params[] = {
     {"count", IPARAM_INT, 2048, 1, 1e6, "virtual spherical lights per pass"},
     {"direct", IPARAM_INT, 4, 1, 1024, "next-event samples of direct light per camera sample"},
     {"radius", IPARAM_FLOAT, 0, 0, 1e30, "sphere radius in scene units; 0 = automatic, the distance to the k-th nearest light"},
     {"k", IPARAM_INT, 2, 1, 256, "which nearest light sets the automatic radius"},
     {"cone_samples", IPARAM_INT, 1, 1, 64, "directions sampled in the cone per light and camera sample"},
+    {"shadow_rays", IPARAM_INT, 64, 0, 1e6,
+     "0: every light, a shadow ray each; S > 0: S lights drawn in proportion to power / max(d^2, r^2)"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 static void vsl_destroy(void *st) {
@@ -110,11 +112,52 @@ static rgb vsl_contrib(const render_ctx *c, const vlight_set *s, uint32_t i, con
   return c3_scale(c3_mul(acc, l->power), omega / ((float)cone * PI_F * r * r));
 }
 
+/* The lights' light at x: every light with a shadow ray each, or (shadow_rays = S > 0,
+ * fewer than the lights) S lights drawn by systematic sampling of the distribution
+ * proportional to a cheap bound of their reach, luminance of the power over
+ * max(d^2, r^2) (never 0, so every light that can contribute can be drawn), each weighted
+ * 1 / (S p): the same expectation as the sum over all, for S cone integrals and shadow
+ * rays in place of one per light. */
+#define VSL_SAMPLED_MAX 4096
+static rgb vsl_gather(const render_ctx *c, const vlight_set *s, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
+                      thread_stats *ts) {
+  int S = (int)c->param[S_SHADOW];
+  if (!(S > 0 && s->n > (uint32_t)S && s->n <= VSL_SAMPLED_MAX)) return vlight_gather_all(c, s, vsl_contrib, it, b, fr, wo, smp, ts);
+  float cdf[VSL_SAMPLED_MAX];
+  double total = 0;
+  for (uint32_t i = 0; i < s->n; i++) {
+    const vpl *l = &s->v[i];
+    float d2 = v3_len2(v3_sub(l->p, it->p)), r2 = l->radius * l->radius;
+    float w = c3_lum(l->power) / fmaxf(fmaxf(d2, r2), 1e-30f);
+    total += isfinite(w) && w > 0 ? w : 0;
+    cdf[i] = (float)total;
+  }
+  rgb sum = c3(0, 0, 0);
+  if (total > 0) {
+    vec3 wo_l = frame_to_local(fr, wo);
+    sampler us = sampler_child(smp, 0, 1);
+    sampler_set_dim(&us, CDIM_VSL_SAMPLED);
+    float u0 = sampler_1d(&us);
+    uint32_t i = 0;
+    for (int m = 0; m < S; m++) {
+      float target = (float)(((float)m + u0) / (float)S * total);
+      while (i + 1 < s->n && cdf[i] <= target) i++;
+      float p = (float)((cdf[i] - (i ? cdf[i - 1] : 0)) / total);
+      if (!(p > 0)) continue;
+      rgb ct = vsl_contrib(c, s, i, it, b, fr, wo_l, smp);
+      if (c3_black(ct) || !c3_finite(ct)) continue;
+      if (ctx_segment_blocked(c, it, s->v[i].p, s->v[i].ng, ts)) continue;
+      sum = c3_add(sum, c3_scale(ct, 1 / ((float)S * p)));
+    }
+  }
+  return sum;
+}
+
 static rgb vsl_shade(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,
                      thread_stats *ts) {
   const vsl_state *vs = c->state;
   rgb L = vlight_direct(c, (int)c->param[S_DIRECT], it, b, fr, wo, depth, smp, ts);
-  return c3_add(L, vlight_gather_all(c, &vs->set, vsl_contrib, it, b, fr, wo, smp, ts));
+  return c3_add(L, vsl_gather(c, &vs->set, it, b, fr, wo, smp, ts));
 }
 
 static rgb vsl_li(const render_ctx *c, ray r, sampler *smp, thread_stats *ts) { return li_shade_through_delta(c, r, smp, ts, vsl_shade); }
