@@ -115,8 +115,7 @@ static rgb gather(const render_ctx *c, const vpl_state *vs, const isect *it, con
   float u0 = sampler_1d(&us);
   uint32_t i = 0;
   for (int m = 0; m < S; m++) {
-    float target = (float)(((float)m + u0) / (float)S * total);
-    while (i + 1 < s->n && cdf[i] <= target) i++;
+    i = vlight_systematic(cdf, s->n, i, m, S, u0, total);
     float w = con[i].r + con[i].g + con[i].b, p = (float)(w / total);
     if (!(p > 0)) continue;
     if (ctx_segment_blocked(c, it, s->v[i].p, s->v[i].ng, ts)) continue;

@@ -37,6 +37,15 @@ typedef rgb (*vlight_contrib_fn)(const render_ctx *c, const vlight_set *s, uint3
 /* The sum over every light of its contribution, with a shadow ray each. */
 rgb vlight_gather_all(const render_ctx *c, const vlight_set *s, vlight_contrib_fn contrib, const isect *it, const bsdf *b, const frame *fr,
                       vec3 wo, sampler *smp, thread_stats *ts);
+/* Systematic sampling of S lights from the running sums cdf[0..n) of their weights (total
+ * the last): draw m of S (offset u0 in [0,1)) is the first i at or after `from` whose sum
+ * passes (m + u0) / S of the total. Draws come in increasing order, so each starts from
+ * the previous one's index. */
+static inline uint32_t vlight_systematic(const float *cdf, uint32_t n, uint32_t from, int m, int S, float u0, double total) {
+  float target = (float)(((float)m + u0) / (float)S * total);
+  while (from + 1 < n && cdf[from] <= target) from++;
+  return from;
+}
 /* Direct light at it: the mean of nd next-event samples, stratified together across the
  * pixel's samples. */
 rgb vlight_direct(const render_ctx *c, int nd, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int depth, sampler *smp,

@@ -140,8 +140,7 @@ static rgb vsl_gather(const render_ctx *c, const vlight_set *s, const isect *it,
     float u0 = sampler_1d(&us);
     uint32_t i = 0;
     for (int m = 0; m < S; m++) {
-      float target = (float)(((float)m + u0) / (float)S * total);
-      while (i + 1 < s->n && cdf[i] <= target) i++;
+      i = vlight_systematic(cdf, s->n, i, m, S, u0, total);
       float p = (float)((cdf[i] - (i ? cdf[i - 1] : 0)) / total);
       if (!(p > 0)) continue;
       rgb ct = vsl_contrib(c, s, i, it, b, fr, wo_l, smp);
