@@ -303,7 +303,7 @@ int cmd_compare(int argc, char **argv) {
     run->w = rw;
     run->h = rh;
     rc = render_one(sc, opt, names[k], dir, ref, k, nint, run, ca.denoise ? run + 1 : NULL);
-    if (!rc) rep.nruns += per;
+    rep.nruns += per; /* counted even when it failed or was interrupted: the cleanup frees what it holds */
   }
   valo_scene_destroy(sc);
   if (!rc && !refpath) {
