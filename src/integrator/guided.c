@@ -133,20 +133,12 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
       float pb = bsdf_pdf(&b, wo_l, wi_l);
       pm = ag * pg + (1 - ag) * pb;
       if (!c3_finite(f) || !isfinite(pb)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; break; }
-      if (c3_black(f) || !(pm > 0)) break;
-      int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it.ng) > 0) == (v3_dot(wo, it.ng) > 0);
-      if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; break; }
+      if (c3_black(f) || !(pm > 0) || !sides_agree(&it, wo_l, wi_l, wo, wi, ts)) break;
       weight = c3_scale(f, fabsf(wi_l.z) / pm);
     } else {
       bsdf_sample bs;
       float ub = ag > 0 ? fminf((ul - ag) / (1 - ag), 0x1.fffffep-1f) : ul;
-      if (!bsdf_sample_dir(&b, wo_l, ub, u1, u2, &bs)) {
-        if (bs.nonfinite) ts->lost[VALO_LOSS_BSDF_NONFINITE]++;
-        break;
-      }
-      wi = v3_norm(frame_to_world(&fr, bs.wi));
-      int refl_l = (bs.wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it.ng) > 0) == (v3_dot(wo, it.ng) > 0);
-      if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; break; }
+      if (!sample_bsdf_world_u(&it, &b, &fr, wo, ub, u1, u2, ts, &bs, &wi)) break;
       delta = bs.delta;
       eta_scale = bs.eta_scale;
       if (delta) { /* only the BSDF makes delta directions */

@@ -54,21 +54,28 @@ int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, t
   return 1;
 }
 
-int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi) {
-  float ul = sampler_1d(smp), u1, u2;
-  sampler_2d(smp, &u1, &u2);
+int sides_agree(const isect *it, vec3 wo_l, vec3 wi_l, vec3 wo, vec3 wi, thread_stats *ts) {
+  int refl_l = (wi_l.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
+  if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
+  return 1;
+}
+
+int sample_bsdf_world_u(const isect *it, const bsdf *b, const frame *fr, vec3 wo, float ul, float u1, float u2, thread_stats *ts, bsdf_sample *bs,
+                        vec3 *wi) {
   vec3 wo_l = frame_to_local(fr, wo);
-  ts->surface_samples++;
   if (!bsdf_sample_dir(b, wo_l, ul, u1, u2, bs)) {
     if (bs->nonfinite) ts->lost[VALO_LOSS_BSDF_NONFINITE]++;
     return 0;
   }
   *wi = v3_norm(frame_to_world(fr, bs->wi));
-  /* The sampled direction must agree with the geometric normal about reflection vs
-   * transmission, or shading normals would leak light. */
-  int refl_l = (bs->wi.z > 0) == (wo_l.z > 0), refl_g = (v3_dot(*wi, it->ng) > 0) == (v3_dot(wo, it->ng) > 0);
-  if (refl_l != refl_g) { ts->lost[VALO_LOSS_SHADING_NORMAL]++; return 0; }
-  return 1;
+  return sides_agree(it, wo_l, bs->wi, wo, *wi, ts);
+}
+
+int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi) {
+  float ul = sampler_1d(smp), u1, u2;
+  sampler_2d(smp, &u1, &u2);
+  ts->surface_samples++;
+  return sample_bsdf_world_u(it, b, fr, wo, ul, u1, u2, ts, bs, wi);
 }
 
 int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, path_state *st, rgb *weight,

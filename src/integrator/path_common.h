@@ -41,6 +41,14 @@ int path_continue(const isect *it, const bsdf *b, const frame *fr, vec3 wo, samp
  * returns 1 with *bs and the world direction *wi, or 0 when no direction came out or it
  * disagrees with the geometric normal about reflection vs transmission. */
 int sample_bsdf_world(const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp, thread_stats *ts, bsdf_sample *bs, vec3 *wi);
+/* The same from given numbers (lobe choice ul, direction u1 u2), without counting a
+ * surface sample. */
+int sample_bsdf_world_u(const isect *it, const bsdf *b, const frame *fr, vec3 wo, float ul, float u1, float u2, thread_stats *ts, bsdf_sample *bs,
+                        vec3 *wi);
+/* Whether direction wi (local wi_l) and the viewer wo (local wo_l) agree between the
+ * shading frame and the geometric normal about reflection vs transmission (else shading
+ * normals would leak light); counts the loss when not. */
+int sides_agree(const isect *it, vec3 wo_l, vec3 wi_l, vec3 wo, vec3 wi, thread_stats *ts);
 /* Russian roulette (pbrt-v4's rule) from bounce rr_depth on (render.rr_depth): survive
  * with probability min(1, max throughput x eta^2); returns the factor to scale the
  * throughput by on survival, 0 to end the path. */
