@@ -58,7 +58,7 @@ static const char *last_line(const char *s) {
 static int benchmark_frames(void) {
   NEED_VIEWER();
   /* path: a frame is one sample per pixel, the film started again */
-  const char *a[] = {"view", scene(), "--res", "64x48", "--benchmark", "3", "-o", scratch_path("path-frame.exr"), NULL};
+  const char *a[] = {"view", scene(), "--res", "64x48", "--benchmark", "3", "--no-denoise", "-o", scratch_path("path-frame.exr"), NULL};
   int rc = run_cli(a, 0, 300, g_out, sizeof g_out);
   CHECK(rc == 0, "valo view --benchmark exited %d", rc);
   double fps = 0;
@@ -70,7 +70,7 @@ static int benchmark_frames(void) {
    * (on a still camera: the default scene has no camera animation) */
   const char *ml = scene();
   const char *p = "candidates=4 iterations=1 spatial=2 unbiased=0";
-  const char *b[] = {"view", ml, "--integrator", "restir-di", "--param", p, "--res", "48x36", "--benchmark", "6", "-o", scratch_path("restir-frame.exr"), NULL};
+  const char *b[] = {"view", ml, "--integrator", "restir-di", "--param", p, "--res", "48x36", "--benchmark", "6", "--no-denoise", "-o", scratch_path("restir-frame.exr"), NULL};
   rc = run_cli(b, 0, 300, g_out, sizeof g_out);
   CHECK(rc == 0 && sscanf(last_line(g_out), "fps %lf", &fps) == 1 && fps > 0, "restir-di benchmark: exit %d, last line %s", rc, last_line(g_out));
   const char *s[] = {"render", ml, "--integrator", "restir-di", "--param", p, "--res", "48x36", "--spp", "1", "--frames", "6", "-q",
@@ -78,7 +78,27 @@ static int benchmark_frames(void) {
   CHECK(run_cli(s, 0, 300, g_out, sizeof g_out) == 0, "the restir-di sequence failed");
   CHECK(same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-5.exr")), "restir-di's sixth benchmark frame is not frame 5 of the sequence");
   CHECK(!same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-4.exr")), "frames 4 and 5 are equal: the test cannot tell them apart");
-  fprintf(stderr, "path and restir-di benchmark frames are the frames themselves (fps %.1f)\n", fps);
+  /* by default the frame is shown, and written, through the real-time denoiser: the
+   * third of three one-sample frames, as valo_render_denoise_live gives it */
+  const char *d[] = {"view", scene(), "--res", "64x48", "--benchmark", "3", "-o", scratch_path("path-denoised.exr"), NULL};
+  CHECK(run_cli(d, 0, 300, g_out, sizeof g_out) == 0, "the denoised benchmark failed: %s", g_out);
+  valo_error err;
+  valo_scene *sc;
+  CHECK(valo_scene_load(scene(), &sc, &err) == VALO_OK, "%s", err.message);
+  valo_options o;
+  valo_options_init(&o);
+  o.width = 64; o.height = 48; o.aovs = 1 | VALO_AOVS_VARIANCE;
+  valo_render *vr;
+  float *px = malloc(64 * 48 * 3 * sizeof *px);
+  CHECK(px && valo_render_create(sc, &o, &vr, &err) == VALO_OK, "%s", err.message);
+  for (int f = 0; f < 3; f++) CHECK(valo_render_step(vr, 1, 1, &err) == VALO_OK && valo_render_denoise_live(vr, px, &err) == VALO_OK, "%s", err.message);
+  CHECK(valo_image_write(scratch_path("api-denoised.exr"), 64, 48, px, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_render_destroy(vr);
+  valo_scene_destroy(sc);
+  free(px);
+  CHECK(same_bytes(scratch_path("path-denoised.exr"), scratch_path("api-denoised.exr")), "view's denoised frame is not valo_render_denoise_live's");
+  CHECK(!same_bytes(scratch_path("path-denoised.exr"), scratch_path("path-frame.exr")), "the denoised frame is the raw one");
+  fprintf(stderr, "path and restir-di benchmark frames are the frames themselves, raw and denoised (fps %.1f)\n", fps);
   return 0;
 }
 
@@ -279,7 +299,107 @@ static int step_api(void) {
   return 0;
 }
 
+/* valo_render_denoise_live through the public API: refused without AOVs; the same bytes
+ * for 1 and 2 threads (path, and restir-di's G-buffer AOVs); its frames lower the error of
+ * the raw ones against the converged image; after a jump to a camera that sees only the
+ * points behind the last camera (a closed room, turned round), the frame is exactly a fresh
+ * render's, where after a turn of a few degrees it is not. And a
+ * sequence's AOVs are its own frame's (film_clear empties them too). */
+static valo_status albedo_mean(void *user, const valo_render *r, int frame, valo_error *err) {
+  double *m = user;
+  float px[16 * 12 * 3];
+  valo_status st = valo_render_layer(r, "albedo", px, err);
+  for (int i = 0; !st && i < 16 * 12 * 3; i++) m[frame] += px[i];
+  return st;
+}
+static int live_denoise(void) {
+  valo_error err;
+  valo_scene *sc, *room;
+  CHECK(valo_scene_load(scene(), &sc, &err) == VALO_OK, "%s", err.message);
+  /* a closed room lit by a small lamp, diffuse walls */
+  const char *rp = scratch_file("live-room.json",
+                                "{\"camera\": {\"position\": [0, 0, 0], \"look_at\": [0.3, -0.2, -1], \"up\": [0, 1, 0], \"fov\": 60},\n"
+                                " \"materials\": {\"wall\": {\"type\": \"diffuse\", \"reflectance\": 0.6},\n"
+                                "   \"lamp\": {\"type\": \"diffuse\", \"reflectance\": 0, \"emission\": 20}},\n"
+                                " \"shapes\": [{\"type\": \"cube\", \"flip_normals\": true, \"transform\": {\"scale\": 3}, \"material\": \"wall\"},\n"
+                                "   {\"type\": \"cube\", \"transform\": {\"scale\": 0.8, \"translate\": [0.8, -2.2, -1.5]}, \"material\": \"wall\"},\n"
+                                "   {\"type\": \"sphere\", \"center\": [0, 2.2, 0], \"radius\": 0.3, \"material\": \"lamp\"}]}\n");
+  CHECK(valo_scene_load(rp, &room, &err) == VALO_OK, "%s", err.message);
+  enum { W = 96, H = 72 };
+  size_t n = W * H * 3;
+  float *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b), *ref = malloc(n * sizeof *ref);
+  valo_options o;
+  valo_render *r, *r1;
+  const char *integ[2] = {"path", "restir-di"};
+  for (int k = 0; k < 2; k++) {
+    /* the converged image (restir-di: direct light, as path --max-depth 1) */
+    valo_options_init(&o);
+    o.width = W; o.height = H; o.threads = 2; o.spp = 256; o.max_depth = k ? 1 : -1;
+    CHECK(valo_render_create(room, &o, &r, &err) == VALO_OK && valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+    valo_render_pixels(r, ref);
+    CHECK(valo_render_denoise_live(r, a, &err) == VALO_ERR_INVALID && strstr(err.message, "AOVs"), "denoised without AOVs: %s", err.message);
+    valo_render_destroy(r);
+    o.max_depth = -1;
+    snprintf(o.integrator, sizeof o.integrator, "%s", integ[k]);
+    o.aovs = k ? 1 : 1 | VALO_AOVS_VARIANCE;
+    CHECK(valo_render_create(room, &o, &r, &err) == VALO_OK, "%s", err.message);
+    o.threads = 1;
+    CHECK(valo_render_create(room, &o, &r1, &err) == VALO_OK, "%s", err.message);
+    o.threads = 2;
+    double e_raw = 0, e_dn = 0;
+    for (int f = 0; f < 4; f++) {
+      CHECK(valo_render_step(r, 1, k || !f, &err) == VALO_OK && valo_render_denoise_live(r, a, &err) == VALO_OK, "%s", err.message);
+      CHECK(valo_render_step(r1, 1, k || !f, &err) == VALO_OK && valo_render_denoise_live(r1, b, &err) == VALO_OK, "%s", err.message);
+      CHECK(!memcmp(a, b, n * sizeof *a), "%s: frame %d denoised differs between 1 and 2 threads", integ[k], f);
+    }
+    valo_render_destroy(r1);
+    valo_render_pixels(r, b);
+    for (size_t i = 0; i < n; i++) {
+      double t = ref[i] > 0.01 ? ref[i] : 0.01;
+      e_raw += (b[i] - ref[i]) * (b[i] - ref[i]) / (t * t);
+      e_dn += (a[i] - ref[i]) * (a[i] - ref[i]) / (t * t);
+    }
+    fprintf(stderr, "live_denoise: %s, the fourth frame's relMSE %.4f raw, %.4f denoised\n", integ[k], e_raw / n, e_dn / n);
+    CHECK(e_dn * 2 < e_raw, "%s: denoising brought relMSE only from %.4f to %.4f", integ[k], e_raw / n, e_dn / n);
+    if (k) { valo_render_destroy(r); continue; }
+    /* the jump: from looking one way to looking the other (every point then seen lies
+     * behind the last camera) */
+    valo_camera c;
+    valo_render_camera(r, &c);
+    c.look_at[0] = -0.3; c.look_at[2] = 1;
+    CHECK(valo_render_set_camera(r, &c, &err) == VALO_OK && valo_render_step(r, 1, 1, &err) == VALO_OK && valo_render_denoise_live(r, a, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_create(room, &o, &r1, &err) == VALO_OK && valo_render_set_camera(r1, &c, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_step(r1, 1, 1, &err) == VALO_OK && valo_render_denoise_live(r1, b, &err) == VALO_OK, "%s", err.message);
+    CHECK(!memcmp(a, b, n * sizeof *a), "after the jump the frame kept history");
+    double sum = 0;
+    for (size_t i = 0; i < n; i++) sum += a[i];
+    CHECK(sum > 0, "the room is black: the test shows nothing");
+    /* and a turn of a few degrees keeps most of it */
+    c.look_at[0] = -0.25;
+    CHECK(valo_render_set_camera(r, &c, &err) == VALO_OK && valo_render_step(r, 1, 1, &err) == VALO_OK && valo_render_denoise_live(r, a, &err) == VALO_OK, "%s", err.message);
+    CHECK(valo_render_set_camera(r1, &c, &err) == VALO_OK && valo_render_step(r1, 1, 1, &err) == VALO_OK, "%s", err.message);
+    valo_render_denoise_reset(r1);
+    CHECK(valo_render_denoise_live(r1, b, &err) == VALO_OK, "%s", err.message);
+    CHECK(memcmp(a, b, n * sizeof *a) != 0, "a small turn lost the whole history");
+    valo_render_destroy(r1);
+    valo_render_destroy(r);
+  }
+  valo_scene_destroy(room);
+  /* a sequence's AOVs */
+  valo_options_init(&o);
+  o.width = 16; o.height = 12; o.spp = 2; o.frames = 2; o.aovs = 1; o.threads = 2;
+  double m[2] = {0, 0};
+  CHECK(valo_render_create(sc, &o, &r, &err) == VALO_OK, "%s", err.message);
+  valo_render_on_frame(r, albedo_mean, m);
+  CHECK(valo_render_run(r, NULL, NULL, &err) == VALO_OK, "%s", err.message);
+  valo_render_destroy(r);
+  CHECK(m[0] > 0 && fabs(m[1] / m[0] - 1) < 0.05, "the second frame's albedo is %.3f of the first's", m[1] / m[0]);
+  valo_scene_destroy(sc);
+  free(a); free(b); free(ref);
+  return 0;
+}
+
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"step_api", step_api}, {"benchmark_frames", benchmark_frames}, {"refusals", refusals}, {"xvfb_drag_and_save", xvfb_drag_and_save}, {NULL, NULL}};
+  static const test_case cases[] = {{"step_api", step_api}, {"live_denoise", live_denoise}, {"benchmark_frames", benchmark_frames}, {"refusals", refusals}, {"xvfb_drag_and_save", xvfb_drag_and_save}, {NULL, NULL}};
   return test_main(argc, argv, cases);
 }

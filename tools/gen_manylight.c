@@ -8,6 +8,15 @@
  *   gen_manylight walls  DIR   -> DIR/manylight-walls.obj/.mtl  (1536 lamps 1/1000 of the room's
  *                                 width off its walls and ceiling, facing in; three radiance
  *                                 levels over 20x: light dominated by the nearest lamp)
+ *   gen_manylight heldout DIR SEED [overlap|apart] [boxes]
+ *                              -> DIR/heldout-SEED.obj/.mtl/.json: rooms of the walls room's kind
+ *                                 that nothing was tuned on: the same shell, 1536 lamps on the
+ *                                 ceiling, back and side walls 1/1000 of the width off them, 8
+ *                                 tints drawn per seed x 3 radiance levels over 20x, placed at
+ *                                 random (overlapping each other unless `apart`); the JSON puts
+ *                                 the Stanford bunny (../shared) on the floor, or three boxes
+ *                                 with `boxes`. Not committed (run by hand for bench_restir
+ *                                 and bench_view).
  * Colours: hue uniform, saturation 0.1..0.5 (tinted whites, as real lamps; fully saturated
  * random hues put a floor under any one-sample estimator's per-channel error, see
  * docs/integrators.md); radiance log-uniform over a factor 30, so
@@ -15,6 +24,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define PI 3.14159265358979323846
@@ -171,9 +181,94 @@ static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, dou
   }
 }
 
+/* The held-out rooms' lamps: like wall_lamps, but tints from a palette of 8 drawn per seed,
+ * and overlaps between lamps on one face allowed unless `apart`. */
+static void heldout_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, double L0, int apart) {
+  double pal[8][3];
+  for (int t = 0; t < 8; t++) {
+    double sat = 0.15 + 0.45 * rnd(), hue = rnd();
+    hsv(hue, sat, 1, &pal[t][0], &pal[t][1], &pal[t][2]);
+  }
+  static double placed[WALL_LAMPS_MAX][3][2];
+  static int face_of[WALL_LAMPS_MAX];
+  for (int i = 0; i < n && i < WALL_LAMPS_MAX; i++) {
+    v3 c, nn;
+    double rot, tri[3][2];
+    int face;
+    for (;;) {
+      double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd(), m = edge;
+      if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); face = 0; }
+      else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); face = 1; }
+      else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); face = 2; }
+      else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); face = 3; }
+      rot = 2 * PI * rnd();
+      if (!apart) break;
+      v3 p[3];
+      lamp_points(c, nn, edge, rot, p);
+      for (int k = 0; k < 3; k++) {
+        tri[k][0] = face == 2 || face == 3 ? p[k].z : p[k].x;
+        tri[k][1] = face == 0 ? p[k].z : p[k].y;
+      }
+      int clash = 0;
+      for (int j = 0; j < i && !clash; j++) clash = face_of[j] == face && tri2_overlap(tri, (const double(*)[2])placed[j]);
+      if (!clash) break;
+    }
+    if (apart) { memcpy(placed[i], tri, sizeof tri); face_of[i] = face; }
+    int t = (int)(8 * rnd()), level = (int)(3 * rnd());
+    double L = L0 * pow(20.0, 0.5 * level);
+    lamp(obj, mtl, i, c, nn, edge, rot, pal[t][0] * L, pal[t][1] * L, pal[t][2] * L);
+  }
+}
+
+static int heldout(const char *dir, const char *seed_s, int apart, int boxes) {
+  char *end;
+  unsigned long seed = strtoul(seed_s, &end, 10);
+  if (end == seed_s || *end) { fprintf(stderr, "gen_manylight: \"%s\" is not a seed\n", seed_s); return 2; }
+  st = 0x243f6a8885a308d3ULL ^ (0x9e3779b97f4a7c15ULL * (seed + 1));
+  char po[4096], pm[4096], pj[4096];
+  snprintf(po, sizeof po, "%s/heldout-%lu.obj", dir, seed);
+  snprintf(pm, sizeof pm, "%s/heldout-%lu.mtl", dir, seed);
+  snprintf(pj, sizeof pj, "%s/heldout-%lu.json", dir, seed);
+  FILE *obj = fopen(po, "w"), *mtl = fopen(pm, "w"), *js = fopen(pj, "w");
+  if (!obj || !mtl || !js) { fprintf(stderr, "gen_manylight: cannot write into %s\n", dir); return 1; }
+  fprintf(obj, "# made by tools/gen_manylight.c (heldout %lu%s%s)\nmtllib heldout-%lu.mtl\n", seed, apart ? " apart" : "", boxes ? " boxes" : "", seed);
+  fprintf(mtl, "newmtl white\nKd 0.7 0.7 0.7\n\nnewmtl red\nKd 0.6 0.1 0.08\n\nnewmtl green\nKd 0.12 0.5 0.15\n\nnewmtl grey\nKd 0.4 0.4 0.45\n\n");
+  quad(obj, mk(-2, 0, -2), mk(-2, 0, 2), mk(2, 0, 2), mk(2, 0, -2), "white");
+  quad(obj, mk(-2, 2.5, -2), mk(2, 2.5, -2), mk(2, 2.5, 2), mk(-2, 2.5, 2), "white");
+  quad(obj, mk(-2, 0, -2), mk(2, 0, -2), mk(2, 2.5, -2), mk(-2, 2.5, -2), "white");
+  quad(obj, mk(-2, 0, -2), mk(-2, 2.5, -2), mk(-2, 2.5, 2), mk(-2, 0, 2), "red");
+  quad(obj, mk(2, 0, -2), mk(2, 0, 2), mk(2, 2.5, 2), mk(2, 2.5, -2), "green");
+  if (boxes) {
+    box(obj, mk(-1.2, 0, -1.3), mk(-0.4, 1.1, -0.5), "grey");
+    box(obj, mk(0.4, 0, -0.8), mk(1.2, 0.6, 0.0), "white");
+  }
+  heldout_lamps(obj, mtl, 1536, 4.0 / 30, 0.004, 0.25, apart);
+  /* a camera of its own per seed, from the open side */
+  double cx = -1.2 + 2.4 * rnd(), cy = 0.9 + 0.8 * rnd(), lx = -0.5 + rnd(), ly = 0.5 + 0.5 * rnd();
+  fprintf(js, "{\n  \"camera\": { \"position\": [%.3f, %.3f, 4.6], \"look_at\": [%.3f, %.3f, -1], \"up\": [0, 1, 0], \"fov\": 48 },\n"
+              "  \"film\": { \"width\": 256, \"height\": 256 },\n  \"render\": { \"integrator\": \"restir-di\", \"spp\": 16 },\n"
+              "  \"shapes\": [ { \"file\": \"heldout-%lu.obj\" }%s ]\n}\n",
+          cx, cy, lx, ly, seed,
+          boxes ? "" : ",\n    { \"file\": \"/work/shared/scenes/models/stanford-bunny.obj\", \"transform\": { \"scale\": 7, \"translate\": [0.1, -0.23, -0.3] } }");
+  fclose(obj);
+  fclose(mtl);
+  fclose(js);
+  printf("wrote %s, %s and %s\n", po, pm, pj);
+  return 0;
+}
+
 int main(int argc, char **argv) {
+  if (argc >= 4 && !strcmp(argv[1], "heldout")) {
+    int apart = 0, boxes = 0;
+    for (int i = 4; i < argc; i++) {
+      if (!strcmp(argv[i], "apart")) apart = 1;
+      else if (!strcmp(argv[i], "boxes")) boxes = 1;
+      else if (strcmp(argv[i], "overlap")) { fprintf(stderr, "gen_manylight: unknown option \"%s\"\n", argv[i]); return 2; }
+    }
+    return heldout(argv[2], argv[3], apart, boxes);
+  }
   if (argc != 3 || (strcmp(argv[1], "room") && strcmp(argv[1], "sponza") && strcmp(argv[1], "walls"))) {
-    fprintf(stderr, "usage: gen_manylight room|sponza|walls DIR\n");
+    fprintf(stderr, "usage: gen_manylight room|sponza|walls DIR | heldout DIR SEED [overlap|apart] [boxes]\n");
     return 2;
   }
   int room = !strcmp(argv[1], "room"), walls = !strcmp(argv[1], "walls");

@@ -303,6 +303,18 @@ VALO_API valo_status valo_render_step(valo_render *r, int spp, int restart, valo
  * "normal", "depth", "ao", "bent", "spp") — the render must record it (VALO_ERR_INVALID
  * otherwise, saying why). */
 VALO_API valo_status valo_render_layer(const valo_render *r, const char *layer, float *rgb_out, valo_error *err);
+/* The real-time denoiser (what `valo view` shows): the film as it stands, filtered by
+ * spatiotemporal variance-guided filtering (Schied et al. 2017) into rgb_out
+ * (width*height*3). Each call is a frame of the filter: its history, kept in the render,
+ * goes on accumulating while the film does, and is reprojected to the current camera
+ * through the first hits' depth when the film has restarted since the last call (a step
+ * with restart, so every image-wide frame), kept only where depth and normal agree. The
+ * render must record AOVs (valo_options.aovs; with VALO_AOVS_VARIANCE the variance comes
+ * from the film's squares, else from the history or the neighbourhood): VALO_ERR_INVALID
+ * otherwise. Same bytes for any thread count. */
+VALO_API valo_status valo_render_denoise_live(valo_render *r, float *rgb_out, valo_error *err);
+/* Forgets the live denoiser's history: the next frame is filtered alone. */
+VALO_API void valo_render_denoise_reset(valo_render *r);
 
 /* Output settings for display-referred formats (PNG). EXR/PFM are always linear. */
 typedef struct valo_output_options {

@@ -8,6 +8,7 @@
 #include "api/options.h"
 #include "render/session.h"
 #include "render/output.h"
+#include "render/live.h"
 #include "render/checkpoint.h"
 #include "render/dist.h"
 #include "core/error.h"
@@ -17,6 +18,7 @@
 
 struct valo_render {
   session *ss;
+  live_state *live; /* valo_render_denoise_live's history, made on its first call */
   valo_frame_fn on_frame;
   void *on_frame_user;
   valo_log_fn warn_fn;
@@ -206,6 +208,16 @@ VALO_API valo_status valo_render_layer(const valo_render *r, const char *layer, 
   return output_layer(r->ss, layer, rgb_out, err);
 }
 
+VALO_API valo_status valo_render_denoise_live(valo_render *r, float *rgb_out, valo_error *err) {
+  clear_err(err);
+  if (!r || !rgb_out) return err_set(err, VALO_ERR_INVALID, "no render or buffer");
+  return live_denoise(&r->live, r->ss, rgb_out, err);
+}
+
+VALO_API void valo_render_denoise_reset(valo_render *r) {
+  if (r) live_reset(r->live);
+}
+
 VALO_API void valo_render_pixels(const valo_render *r, float *rgb_out) { film_resolve(&r->ss->film, rgb_out); }
 
 VALO_API valo_status valo_render_write(const valo_render *r, const char *path, const valo_output_options *o, valo_error *err) {
@@ -222,6 +234,7 @@ VALO_API valo_status valo_render_write(const valo_render *r, const char *path, c
 
 VALO_API void valo_render_destroy(valo_render *r) {
   if (!r) return;
+  live_free(r->live);
   session_destroy(r->ss);
   free(r);
 }

@@ -115,7 +115,8 @@ valo_status options_resolve(const valo_options *file, const valo_options *caller
   if (o.adaptive && o.frames > 0) return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with --frames");
   if (integ->kind == INTEGRATOR_IMAGE) {
     if (o.adaptive) return err_set(err, VALO_ERR_UNSUPPORTED, "adaptive sampling does not work with the %s integrator (it renders whole frames)", integ->name);
-    if (o.aovs) return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator records no AOVs (albedo:, normal:, depth:, ao:, bent: outputs)", integ->name);
+    if (o.aovs > 0 && (o.aovs & VALO_AOVS_AO))
+      return err_set(err, VALO_ERR_UNSUPPORTED, "the %s integrator records the albedo, normal and depth AOVs of its G-buffer, not ao: or bent:", integ->name);
   }
   out->o = o;
   out->integ = integ;

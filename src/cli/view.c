@@ -5,8 +5,10 @@
  * integrator, the layer (image, albedo, normal, depth, ao) and the exposure, and save the
  * image (EXR and PNG). Image-wide integrators (restir-di, restir-gi) run in real time:
  * each frame shown alone, with temporal reuse from the last, in the fast configuration
- * below. --benchmark N renders N frames on the still camera without waiting for input
- * (SDL's dummy video driver when there is no display) and prints "fps X" last.
+ * below. The image is shown through the real-time denoiser (valo_render_denoise_live:
+ * SVGF) unless --no-denoise or the F key turns it off. --benchmark N renders N frames on
+ * the still camera without waiting for input (SDL's dummy video driver when there is no
+ * display) and prints "fps X" last.
  * Built only when SDL2 is found; uses only the public API. */
 #include "cli/view.h"
 #include "cli/args.h"
@@ -30,9 +32,12 @@ static void usage_view(FILE *f) {
           "restir-di and restir-gi run in real time: each frame shown alone, with temporal\n"
           "reuse from the last, in a fast configuration that --param overrides:\n"
           "  %s\n\n"
+          "The image is shown through a real-time denoiser (spatiotemporal variance-guided\n"
+          "filtering, guided by the first hits' albedo, normal and depth); F turns it off and on.\n\n"
           "  --benchmark N          render N frames on the still camera without waiting for input\n"
           "                         (no window when there is no display), print \"fps X\" last\n"
-          "  -o FILE                --benchmark: write the last frame (.exr, .pfm, .hdr, .png, .jpg);\n"
+          "  --no-denoise           show the raw image (F turns the denoiser on)\n"
+          "  -o FILE                --benchmark: write the last frame as shown (.exr, .pfm, .hdr, .png, .jpg);\n"
           "                         otherwise the save key writes FILE's name with -0001.exr and\n"
           "                         -0001.png, ...\n"
           "                         (default: view-0001.exr, ...)\n"
@@ -40,7 +45,8 @@ static void usage_view(FILE *f) {
           "  --spp (where refining stops; default: never), --threads, --seed, --param, --exposure ...\n\n"
           "Mouse: left drag orbits, right or middle drag (or shift + left) pans, the wheel zooms.\n"
           "Keys:  W A S D move, Q E down and up; Tab / shift+Tab the next / previous integrator;\n"
-          "       V the layer (image, albedo, normal, depth, ao); + and - the exposure by half a stop;\n"
+          "       V the layer (image, albedo, normal, depth, ao); F the denoiser (on, off);\n"
+          "       + and - the exposure by half a stop;\n"
           "       P saves the layer shown (EXR and PNG); C prints the camera as scene-file JSON;\n"
           "       R restarts; H hides the overlay; Esc quits.\n",
           realtime_params);
@@ -69,6 +75,7 @@ typedef struct worker {
   int set_cam, n, restart;   /* in */
   valo_camera cam;
   view_layer layer;
+  int denoise;               /* the image through valo_render_denoise_live */
   valo_status st;            /* out: the first failure, and whether it was the camera's */
   int cam_refused;
   valo_error err;
@@ -89,6 +96,8 @@ typedef struct viewer {
   int dirty;               /* the camera moved: the next step restarts */
   view_layer layer;
   int aovs;                /* the current render records AOVs (with ao) */
+  int denoise;             /* the image is shown denoised (F) */
+  int shown_denoised;      /* the image in px was */
   int w, h, scale, overlay, quit, redraw;
   int step_spp, spp_cap, spp_done;
   int step_n, step_restart, step_cam; /* the step posted last */
@@ -122,7 +131,8 @@ static int make_render(viewer *v) {
   snprintf(o.integrator, sizeof o.integrator, "%s", v->integ[v->cur]);
   int image_wide = !strncmp(o.integrator, "restir", 6);
   view_layer layer = image_wide ? VIEW_LAYER_IMAGE : v->layer;
-  o.aovs = layer != VIEW_LAYER_IMAGE ? 1 | VALO_AOVS_AO : VALO_UNSET;
+  /* the denoiser reads albedo, normal and depth, and per-ray integrators' sample variance */
+  o.aovs = layer != VIEW_LAYER_IMAGE ? 1 | VALO_AOVS_AO | VALO_AOVS_VARIANCE : v->denoise ? (image_wide ? 1 : 1 | VALO_AOVS_VARIANCE) : VALO_UNSET;
   valo_error err;
   valo_render *r = NULL;
   if (valo_render_create(v->sc, &o, &r, &err)) {
@@ -140,7 +150,7 @@ static int make_render(viewer *v) {
   v->r = r;
   v->image_wide = image_wide;
   v->layer = layer;
-  v->aovs = layer != VIEW_LAYER_IMAGE;
+  v->aovs = o.aovs != VALO_UNSET;
   v->dirty = 1;
   return 0;
 }
@@ -224,7 +234,8 @@ static void print_camera(const valo_camera *c) {
   fflush(stdout);
 }
 
-/* The save key: the layer shown as STEM-NNNN.exr and .png (the PNG through the exposure). */
+/* The save key: the layer shown (the denoised image as shown) as STEM-NNNN.exr and .png
+ * (the PNG through the exposure). */
 static void save(viewer *v) {
   wait_idle(v);
   char stem[1024], names[2][1100];
@@ -235,7 +246,8 @@ static void save(viewer *v) {
   valo_error err;
   for (int k = 0; k < 2; k++) {
     snprintf(names[k], sizeof names[k], "%s%s%s-%04d.%s", layer_names[v->layer], *layer_names[v->layer] ? ":" : "", stem, v->saves, k ? "png" : "exr");
-    if (valo_render_write(v->r, names[k], &v->oo, &err)) { say(v, err.message); return; }
+    valo_status st = v->shown_denoised ? valo_image_write(names[k], v->w, v->h, v->px, &v->oo, &err) : valo_render_write(v->r, names[k], &v->oo, &err);
+    if (st) { say(v, err.message); return; }
   }
   char m[160];
   snprintf(m, sizeof m, "saved %s-%04d.exr and .png", stem, v->saves);
@@ -267,12 +279,18 @@ static void handle_key(viewer *v, const SDL_KeyboardEvent *k) {
       break;
     }
     case SDLK_v: {
-      if (v->image_wide) { say(v, "restir-di and restir-gi record no AOVs: the image only"); break; }
+      if (v->image_wide) { say(v, "restir-di and restir-gi: the viewer shows their image only"); break; }
       view_layer was = v->layer;
       v->layer = (view_layer)((v->layer + 1) % VIEW_LAYER_COUNT);
-      if (v->layer != VIEW_LAYER_IMAGE && !v->aovs && make_render(v)) v->layer = was;
+      if (v->layer != VIEW_LAYER_IMAGE && was == VIEW_LAYER_IMAGE && make_render(v)) v->layer = was; /* the ao AOV too */
       break;
     }
+    case SDLK_f:
+      v->denoise = !v->denoise;
+      if (v->denoise && !v->aovs && make_render(v)) v->denoise = 0;
+      v->dirty = 1;
+      say(v, v->denoise ? "denoiser on" : "denoiser off: the raw image");
+      break;
     default: break;
   }
 }
@@ -318,7 +336,8 @@ static void *render_thread(void *arg) {
     if (refused) st = err.status;
     if (!st) st = valo_render_step(v->r, w->n, w->restart, &err);
     double dt = cli_now() - t0;
-    if (!st) st = valo_render_layer(v->r, layer_names[w->layer], w->back, &err);
+    if (!st) st = w->layer == VIEW_LAYER_IMAGE && w->denoise ? valo_render_denoise_live(v->r, w->back, &err)
+                                                             : valo_render_layer(v->r, layer_names[w->layer], w->back, &err);
     valo_stats vs;
     valo_render_stats(v->r, &vs);
     pthread_mutex_lock(&w->mu);
@@ -357,6 +376,7 @@ static int post_step(viewer *v, int benchmark) {
   w->n = n;
   w->restart = restart;
   w->layer = v->layer;
+  w->denoise = v->denoise;
   w->posted = w->busy = 1;
   pthread_cond_broadcast(&w->cv);
   pthread_mutex_unlock(&w->mu);
@@ -388,6 +408,7 @@ static int collect(viewer *v, int benchmark) {
     return -1;
   }
   v->shown_layer = w->layer;
+  v->shown_denoised = w->layer == VIEW_LAYER_IMAGE && w->denoise;
   /* frames (real time) or steps since the camera last moved */
   v->frame = (v->image_wide ? v->step_cam : v->step_restart) ? 1 : v->frame + 1;
   double sdt = dt > 1e-9 ? dt : 1e-9, sps = (double)v->w * v->h * v->step_n / sdt;
@@ -412,7 +433,8 @@ static void show(viewer *v) {
     snprintf(l1, sizeof l1, "%s  frame %d  %.1f fps  %.2f msamples/s", v->integ[v->cur], v->frame, v->fps, v->sps * 1e-6);
   else
     snprintf(l1, sizeof l1, "%s  %d spp  %.2f msamples/s", v->integ[v->cur], v->spp_done, v->sps * 1e-6);
-  snprintf(l2, sizeof l2, "%s  exposure %+.1f", v->shown_layer ? layer_names[v->shown_layer] : "image", (double)v->oo.exposure);
+  snprintf(l2, sizeof l2, "%s%s  exposure %+.1f", v->shown_layer ? layer_names[v->shown_layer] : "image",
+           v->shown_layer ? "" : v->shown_denoised ? " (denoised)" : " (raw)", (double)v->oo.exposure);
   const char *lines[3] = {l1, l2, v->msg};
   int fs = v->w * v->scale >= 480 ? 2 : 1;
   if (v->overlay) view_draw_panel(v->ren, 4, 4, fs, lines, cli_now() < v->msg_until ? 3 : 2);
@@ -445,6 +467,14 @@ static int open_window(viewer *v, int benchmark) {
 int cmd_view(int argc, char **argv) {
   static const char *const own[] = {"-o", "--output", "--benchmark", NULL};
   const char *val[3] = {NULL, NULL, NULL};
+  int no_denoise = 0;
+  for (int i = 0; i < argc; i++) /* view's own flag, taken out before the render options */
+    if (!strcmp(argv[i], "--no-denoise")) {
+      no_denoise = 1;
+      memmove(&argv[i], &argv[i + 1], (size_t)(argc - i - 1) * sizeof *argv);
+      argc--;
+      i--;
+    }
   cli_args ca;
   int prc = cli_parse_with_own(argc, argv, own, val, &ca, stderr);
   if (prc == CLI_HELP) { usage_view(stdout); return 0; }
@@ -470,6 +500,7 @@ int cmd_view(int argc, char **argv) {
   pthread_cond_init(&v.wk.cv, NULL);
   v.oo = ca.oo;
   v.overlay = 1;
+  v.denoise = !no_denoise;
   v.save_stem = out ? out : "view";
   valo_error err;
   if (valo_scene_load_with(ca.scene_path, &ca.lo, &v.sc, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); return 1; }
@@ -546,7 +577,9 @@ int cmd_view(int argc, char **argv) {
   }
   if (!rc && bench) {
     double el = cli_now() - t0;
-    if (out && valo_render_write(v.r, out, &v.oo, &err)) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
+    /* the frame as shown: the denoised image, or the render's own */
+    valo_status wst = !out ? VALO_OK : v.shown_denoised ? valo_image_write(out, v.w, v.h, v.px, &v.oo, &err) : valo_render_write(v.r, out, &v.oo, &err);
+    if (wst) { fprintf(stderr, "valo: error: %s\n", err.message); rc = 1; }
     if (!rc) printf("fps %.2f\n", (double)bench / el);
   }
   free(v.wk.back);

@@ -52,6 +52,20 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
   if (w.hit_any) g->depth = cam_view_depth(&f->lens->view, w.first_p);
   g->Le = w.L;
   g->fw = fw;
+  if (f->gbuf) {
+    /* the AOVs of the surface the camera sees (through delta lobes: its albedo times the chain's throughput) */
+    float *o = &f->gbuf[FRAME_GBUF * pix];
+    memset(o, 0, FRAME_GBUF * sizeof *o);
+    if (!g->valid) return;
+    material tm = *g->it.m;
+    tm.kd = g->b.kd;
+    tm.ks = g->b.ks;
+    rgb a = c3_mul(material_albedo(&tm, v3_dot(g->it.ns, g->wo)), g->beta);
+    vec3 n = v3_faceforward(g->it.ns, g->wo);
+    o[0] = a.r; o[1] = a.g; o[2] = a.b;
+    o[3] = n.x; o[4] = n.y; o[5] = n.z;
+    o[6] = g->depth;
+  }
 }
 
 sampler restir_pixel_stream(const render_ctx *c, const frame_ctx *f, size_t pix, uint32_t dim) {

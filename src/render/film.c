@@ -31,6 +31,8 @@ void film_clear(film *f) {
   size_t np = film_pixels(f);
   memset(f->sum, 0, np * 3 * sizeof *f->sum);
   memset(f->count, 0, np * sizeof *f->count);
+  if (f->sq) memset(f->sq, 0, np * 4 * sizeof *f->sq);
+  if (f->aov) memset(f->aov, 0, np * AOV_FLOATS * sizeof *f->aov);
   if (f->wsum) memset(f->wsum, 0, np * sizeof *f->wsum);
 }
 

@@ -32,7 +32,8 @@ typedef struct film {
  * film is then freed). */
 int film_init(film *f, int width, int height, int with_sq, int with_aov);
 void film_free(film *f);
-/* Zeroes the radiance sums and counts (a new frame of a sequence). */
+/* Zeroes the film: sums, counts, squares, AOVs and splat weights (a new frame of a
+ * sequence, a restarted step). */
 void film_clear(film *f);
 /* Adds one sample's radiance to pixel pix times its filter weight w (camera_ray): NaN,
  * infinite and negative radiances count as taken but are dropped (counted by cause in

@@ -41,10 +41,11 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   valo_status st = VALO_OK;
   /* the film's sums (double RGB), counts, the adaptive squares and AOV sums when asked,
    * an image integrator's frame, and the float pixels an output is made from */
-  uint64_t per_px = 3 * 8 + 4 + (o.adaptive || (o.aovs > 0 && (o.aovs & VALO_AOVS_VARIANCE)) ? 4 * 8 : 0) + (o.aovs ? AOV_FLOATS * 4 : 0) + (integ->kind == INTEGRATOR_IMAGE ? 12 : 0) + 12;
+  uint64_t per_px = 3 * 8 + 4 + (o.adaptive || (o.aovs > 0 && (o.aovs & VALO_AOVS_VARIANCE)) ? 4 * 8 : 0) + (o.aovs ? AOV_FLOATS * 4 : 0) + (integ->kind == INTEGRATOR_IMAGE ? 12 + (o.aovs ? FRAME_GBUF * 4 : 0) : 0) + 12;
   if ((st = mem_check_pixels((uint64_t)o.width, (uint64_t)o.height, per_px, "film", err))) goto fail;
   if (film_init(&ss->film, o.width, o.height, o.adaptive != 0 || (o.aovs > 0 && (o.aovs & VALO_AOVS_VARIANCE)), o.aovs != 0) ||
-      (integ->kind == INTEGRATOR_IMAGE && !(ss->frame_rgb = calloc((size_t)o.width * o.height * 3, sizeof(float))))) {
+      (integ->kind == INTEGRATOR_IMAGE && !(ss->frame_rgb = calloc((size_t)o.width * o.height * 3, sizeof(float)))) ||
+      (integ->kind == INTEGRATOR_IMAGE && o.aovs && !(ss->frame_gbuf = calloc((size_t)o.width * o.height * FRAME_GBUF, sizeof(float))))) {
     st = err_set(err, VALO_ERR_NOMEM, "out of memory for a %dx%d film", o.width, o.height);
     goto fail;
   }
@@ -150,6 +151,7 @@ void session_destroy(session *ss) {
   film_free(&ss->film);
   free(ss->frame_rgb);
   free(ss->frame_wt);
+  free(ss->frame_gbuf);
   free(ss);
 }
 
@@ -157,14 +159,21 @@ void session_destroy(session *ss) {
  * pixel order: the film does not depend on the thread count). */
 static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
   frame_ctx f = {ss->image_frames, ss->image_frames ? ss->view_prev : ss->lens.view, ss->frame_rgb, ts, &ss->cancel,
-                 ss->opt.frames > 0 || ss->stepped, &ss->lens, ss->frame_wt};
+                 ss->opt.frames > 0 || ss->stepped, &ss->lens, ss->frame_wt, ss->frame_gbuf};
   valo_status st = ss->integ->render_frame(ss->istate, &ss->ctx, &f, err);
   if (st) return st;
   ss->image_frames++;
   ss->view_prev = ss->lens.view;
   size_t np = (size_t)ss->opt.width * ss->opt.height;
-  for (size_t i = 0; i < np; i++)
+  for (size_t i = 0; i < np; i++) {
     film_add(&ss->film, i, c3(ss->frame_rgb[3 * i], ss->frame_rgb[3 * i + 1], ss->frame_rgb[3 * i + 2]), ss->frame_wt ? ss->frame_wt[i] : 1, &ts[0]);
+    if (ss->frame_gbuf) {
+      const float *g = &ss->frame_gbuf[FRAME_GBUF * i];
+      float *a = &ss->film.aov[AOV_FLOATS * i];
+      for (int k = 0; k < 3; k++) { a[AOV_ALBEDO + k] += g[k]; a[AOV_NORMAL + k] += g[3 + k]; }
+      a[AOV_DEPTH] += g[6];
+    }
+  }
   return VALO_OK;
 }
 
@@ -178,6 +187,7 @@ static valo_status run_sequence(session *ss, valo_progress_fn progress, void *us
     if (tiles_set_view(ss, f)) return err_set(err, VALO_ERR_INVALID, "%s: the camera at frame %d has its up vector along the view direction", ss->s->path, f);
     film_clear(&ss->film);
     ss->spp_done = 0;
+    ss->restarts++;
     if (ss->integ->kind == INTEGRATOR_IMAGE) {
       for (int k = 0; k < ss->opt.spp; k++) {
         valo_status st = image_frame(ss, ts, err);
@@ -322,6 +332,7 @@ valo_status session_step(session *ss, int spp, int restart, valo_error *err) {
   if (restart) {
     film_clear(&ss->film);
     ss->spp_done = 0;
+    ss->restarts++;
   }
   valo_status st = VALO_OK;
   if (ss->integ->kind == INTEGRATOR_IMAGE) {

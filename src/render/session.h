@@ -55,6 +55,7 @@ struct session {
   int image_frames;        /* render_frame calls made (the integrator's frame index) */
   float *frame_rgb;        /* render_frame output, width*height*3 */
   float *frame_wt;         /* and its samples' filter weights when the filter has negative lobes */
+  float *frame_gbuf;       /* and its AOVs when the film keeps them (FRAME_GBUF per pixel) */
   session_frame_fn on_frame;
   void *on_frame_user;
   char ckpt_path[4096];    /* checkpoints to this file ("" for none), at pass boundaries */
@@ -69,6 +70,8 @@ struct session {
                               window at (crop_x, crop_y): the whole frame without a crop */
   int crop_x, crop_y;
   int stepped;             /* rendered by session_step (valo view): image-wide frames as a sequence's */
+  uint64_t restarts;       /* times the film was emptied for a new estimate (a step's restart, a
+                              sequence's frame): the live denoiser's history is reprojected then */
   const struct tile_source *work; /* this process's threads, or under MPI rank 0 handing tiles to every rank */
   struct dist_state *dist; /* rank 0 under MPI: the other ranks' state (render/dist.c) */
   rank_stats *ranks;       /* rank 0 under MPI, after a run: every rank's share, nranks of them */
