@@ -484,7 +484,7 @@ static int svgf_filter(void) {
     for (int c = 0; c < 3; c++) { alb[3 * i + c] = 0.5f; nrm[3 * i + c] = c == 2; col[3 * i + c] = 0.7f; }
     dep[i] = 2;
   }
-  svgf_frame f = {W, H, col, NULL, 1, alb, nrm, dep, 1, NULL, NULL};
+  svgf_frame f = {W, H, col, NULL, 1, alb, NULL, nrm, dep, 1, NULL, NULL};
   for (int k = 0; k < 3; k++) {
     CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
     for (int i = 0; i < 3 * N; i++) CHECK(fabsf(out[i] - 0.7f) < 1e-5f, "a constant frame changed: %g at %d (frame %d)", out[i], i, k);

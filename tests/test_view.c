@@ -79,7 +79,8 @@ static int benchmark_frames(void) {
   CHECK(same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-5.exr")), "restir-di's sixth benchmark frame is not frame 5 of the sequence");
   CHECK(!same_bytes(scratch_path("restir-frame.exr"), scratch_path("seq-4.exr")), "frames 4 and 5 are equal: the test cannot tell them apart");
   /* by default the frame is shown, and written, through the real-time denoiser: the
-   * third of three one-sample frames, as valo_render_denoise_live gives it */
+   * third of three one-sample frames (each with new sample indices), as
+   * valo_render_denoise_live gives it */
   const char *d[] = {"view", scene(), "--res", "64x48", "--benchmark", "3", "-o", scratch_path("path-denoised.exr"), NULL};
   CHECK(run_cli(d, 0, 300, g_out, sizeof g_out) == 0, "the denoised benchmark failed: %s", g_out);
   valo_error err;
@@ -91,7 +92,8 @@ static int benchmark_frames(void) {
   valo_render *vr;
   float *px = malloc(64 * 48 * 3 * sizeof *px);
   CHECK(px && valo_render_create(sc, &o, &vr, &err) == VALO_OK, "%s", err.message);
-  for (int f = 0; f < 3; f++) CHECK(valo_render_step(vr, 1, 1, &err) == VALO_OK && valo_render_denoise_live(vr, px, &err) == VALO_OK, "%s", err.message);
+  for (int f = 0; f < 3; f++)
+    CHECK(valo_render_step(vr, 1, VALO_STEP_FRESH, &err) == VALO_OK && valo_render_denoise_live(vr, px, &err) == VALO_OK, "%s", err.message);
   CHECK(valo_image_write(scratch_path("api-denoised.exr"), 64, 48, px, NULL, &err) == VALO_OK, "%s", err.message);
   valo_render_destroy(vr);
   valo_scene_destroy(sc);
@@ -288,6 +290,17 @@ static int step_api(void) {
   valo_render_camera(b, &now);
   CHECK(!memcmp(&now, &c0, sizeof now), "a refused camera changed the render's");
   CHECK(valo_render_step(b, 0, 0, &err) == VALO_ERR_INVALID, "a step of 0 samples was taken");
+  CHECK(valo_render_step(b, 1, 3, &err) == VALO_ERR_INVALID, "restart 3 was taken");
+  /* VALO_STEP_FRESH: a new film of samples no film before used; restart 1 starts at 0 again */
+  CHECK(valo_render_step(b, 4, 1, &err) == VALO_OK, "%s", err.message);
+  valo_render_pixels(b, pb);
+  CHECK(!memcmp(pa, pb, n * sizeof *pa), "restart 1 did not start at sample 0");
+  CHECK(valo_render_step(b, 4, VALO_STEP_FRESH, &err) == VALO_OK, "%s", err.message);
+  valo_render_pixels(b, pb);
+  CHECK(memcmp(pa, pb, n * sizeof *pa) != 0, "a fresh restart repeated samples 0-3");
+  CHECK(valo_render_step(b, 4, VALO_STEP_FRESH, &err) == VALO_OK, "%s", err.message);
+  valo_render_pixels(b, pc);
+  CHECK(memcmp(pc, pb, n * sizeof *pc) != 0, "two fresh restarts gave the same film");
   valo_render_destroy(a);
   valo_render_destroy(b);
   o.adaptive = VALO_ADAPTIVE_ERROR;

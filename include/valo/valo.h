@@ -294,9 +294,13 @@ VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c
  * samples per pixel to the film (sample indices going on from the film's count, so a
  * still camera converges to valo_render_run's image); image-wide integrators (restir-di,
  * restir-gi) render `spp` frames as frames of a sequence, with temporal reuse from the
- * previous step's frame reprojected to this camera. restart: empty the film first
- * (per-ray integrators start again at sample index 0). Not for sequences, adaptive
- * sampling or more than one MPI rank (VALO_ERR_INVALID). Budgets are the caller's. */
+ * previous step's frame reprojected to this camera. restart 1: empty the film first
+ * (per-ray integrators start again at sample index 0); VALO_STEP_FRESH: empty it and go on
+ * with sample indices no earlier film of this render used, so the new film's noise is
+ * independent of the last (what the live denoiser's temporal filter needs). Not for
+ * sequences, adaptive sampling or more than one MPI rank (VALO_ERR_INVALID). Budgets
+ * are the caller's. */
+#define VALO_STEP_FRESH 2
 VALO_API valo_status valo_render_step(valo_render *r, int spp, int restart, valo_error *err);
 /* Copies one layer of the film as linear RGB (width*height*3 floats): "" the image (as
  * valo_render_pixels), or an AOV by its output prefix without the colon ("albedo",

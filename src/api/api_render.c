@@ -195,9 +195,10 @@ VALO_API valo_status valo_render_set_camera(valo_render *r, const valo_camera *c
 VALO_API valo_status valo_render_step(valo_render *r, int spp, int restart, valo_error *err) {
   clear_err(err);
   if (!r) return err_set(err, VALO_ERR_INVALID, "no render");
+  if (restart < 0 || restart > VALO_STEP_FRESH) return err_set(err, VALO_ERR_INVALID, "restart %d: 0, 1 or VALO_STEP_FRESH", restart);
   log_scope scope;
   log_scope_enter(&scope, r->warn_fn, r->warn_user);
-  valo_status st = session_step(r->ss, spp, restart, err);
+  valo_status st = session_step(r->ss, spp, restart == VALO_STEP_FRESH ? SESSION_RESTART_FRESH : restart, err);
   log_scope_leave(&scope);
   return st;
 }

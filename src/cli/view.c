@@ -334,7 +334,8 @@ static void *render_thread(void *arg) {
     double t0 = cli_now();
     int refused = w->set_cam && valo_render_set_camera(v->r, &w->cam, &err);
     if (refused) st = err.status;
-    if (!st) st = valo_render_step(v->r, w->n, w->restart, &err);
+    /* with the denoiser, a restarted film takes new sample indices (independent noise for its history) */
+    if (!st) st = valo_render_step(v->r, w->n, w->restart && w->denoise ? VALO_STEP_FRESH : w->restart, &err);
     double dt = cli_now() - t0;
     if (!st) st = w->layer == VIEW_LAYER_IMAGE && w->denoise ? valo_render_denoise_live(v->r, w->back, &err)
                                                              : valo_render_layer(v->r, layer_names[w->layer], w->back, &err);

@@ -17,13 +17,13 @@
 
 struct svgf {
   int w, h, have;
-  /* history: the integrated demodulated colour, luminance moments (2), samples, normal, depth */
-  float *hcol, *hmom, *hlen, *hnrm, *hdep;
+  /* history: the integrated radiance and albedo, luminance moments (2), samples, normal, depth */
+  float *hcol, *halb, *hemi, *hmom, *hlen, *hnrm, *hdep;
   /* the prior: the history reprojected at the last fresh frame */
-  float *pcol, *pmom, *plen;
-  /* this frame: albedo used, demodulated colour, its moments, a-trous colour and variance
-   * (ping-pong), depth gradient */
-  float *alb, *irr, *cmom, *c[2], *v[2], *gz;
+  float *pcol, *palb, *pemi, *pmom, *plen;
+  /* this frame: the albedo divided out, its radiance (finite), its moments, a-trous colour
+   * and variance (ping-pong), depth gradient */
+  float *alb, *rad, *cmom, *c[2], *v[2], *gz, *sd;
   unsigned char *kind; /* 0 nothing hit, 1 a surface, 2 a lamp (no albedo): never mixed */
   float *kindf;        /* the same as floats (the vectorised a-trous loop) */
 };
@@ -52,14 +52,14 @@ svgf *svgf_create(int w, int h) {
   s->w = w;
   s->h = h;
   size_t np = (size_t)w * h;
-  /* one block: 3+2+1+3+1 history, 3+2+1 prior, 3+3+2+3+3+1+1+1 frame */
-  float *b = calloc(np * 33, sizeof(float));
+  /* one block: 3+3+3+2+1+3+1 history, 3+3+3+2+1 prior, 3+3+2+3+3+1+1+1+1 frame */
+  float *b = calloc(np * 46, sizeof(float));
   s->kind = calloc(np, 1);
   s->kindf = calloc(np, sizeof(float));
   if (!b || !s->kind || !s->kindf) { free(b); free(s->kind); free(s->kindf); free(s); return NULL; }
-  float **slot[] = {&s->hcol, &s->hmom, &s->hlen, &s->hnrm, &s->hdep, &s->pcol, &s->pmom, &s->plen, &s->alb, &s->irr, &s->cmom, &s->c[0], &s->c[1],
-                    &s->v[0], &s->v[1], &s->gz};
-  const int size[] = {3, 2, 1, 3, 1, 3, 2, 1, 3, 3, 2, 3, 3, 1, 1, 1};
+  float **slot[] = {&s->hcol, &s->halb, &s->hemi, &s->hmom, &s->hlen, &s->hnrm, &s->hdep, &s->pcol, &s->palb, &s->pemi, &s->pmom, &s->plen,
+                    &s->alb, &s->rad, &s->cmom, &s->c[0], &s->c[1], &s->v[0], &s->v[1], &s->gz, &s->sd};
+  const int size[] = {3, 3, 3, 2, 1, 3, 1, 3, 3, 3, 2, 1, 3, 3, 2, 3, 3, 1, 1, 1, 1};
   for (size_t k = 0; k < sizeof size / sizeof *size; k++) {
     *slot[k] = b;
     b += np * size[k];
@@ -85,8 +85,9 @@ typedef struct job {
   volatile int failed; /* a row's scratch could not be allocated */
 } job;
 
-/* Demodulation: albedo (lamps and misses keep 1), radiance over it, per-sample luminance moments. */
-static void st_demod(void *user, int64_t y, int thread) {
+/* The frame's radiance less its emission (non-finite and negative values as 0) and
+ * per-sample luminance moments. */
+static void st_moments(void *user, int64_t y, int thread) {
   (void)thread;
   job *j = user;
   svgf *s = j->s;
@@ -94,16 +95,12 @@ static void st_demod(void *user, int64_t y, int thread) {
   for (int x = 0; x < s->w; x++) {
     size_t p = (size_t)y * s->w + x;
     for (int c = 0; c < 3; c++) {
-      float a = f->albedo[3 * p + c], col = f->color[3 * p + c];
-      s->alb[3 * p + c] = a >= ALBEDO_MIN ? a : 1;
-      s->irr[3 * p + c] = isfinite(col) && col > 0 ? col / s->alb[3 * p + c] : 0;
+      float col = f->color[3 * p + c] - (f->emission ? f->emission[3 * p + c] : 0);
+      s->rad[3 * p + c] = isfinite(col) && col > 0 ? col : 0;
     }
-    float a = f->albedo[3 * p] + f->albedo[3 * p + 1] + f->albedo[3 * p + 2];
-    s->kind[p] = !(f->depth[p] > 0) ? 0 : a < ALBEDO_MIN ? 2 : 1;
-    s->kindf[p] = s->kind[p];
-    float li = lum3(&s->irr[3 * p]), lc = lum3(&f->color[3 * p]), r = lc > 0 ? li / lc : 1;
-    s->cmom[2 * p] = li;
-    s->cmom[2 * p + 1] = f->lum2 && isfinite(f->lum2[p]) ? fmaxf(f->lum2[p] * r * r, li * li) : li * li;
+    float l = lum3(&s->rad[3 * p]);
+    s->cmom[2 * p] = l;
+    s->cmom[2 * p + 1] = f->lum2 && isfinite(f->lum2[p]) ? fmaxf(f->lum2[p], l * l) : l * l;
   }
 }
 
@@ -117,7 +114,7 @@ static void st_reproject(void *user, int64_t y, int thread) {
   int w = s->w, h = s->h;
   for (int x = 0; x < w; x++) {
     size_t p = (size_t)y * w + x;
-    float d = f->depth[p], acc[6] = {0, 0, 0, 0, 0, 0}, wsum = 0;
+    float d = f->depth[p], acc[12] = {0}, wsum = 0;
     const float *n = &f->normal[3 * p];
     int taps = 0;
     int qx[4], qy[4];
@@ -149,6 +146,8 @@ static void st_reproject(void *user, int64_t y, int thread) {
       }
       float wt = qw[k];
       for (int c = 0; c < 3; c++) acc[c] += wt * s->hcol[3 * q + c];
+      for (int c = 0; c < 3; c++) acc[6 + c] += wt * s->halb[3 * q + c];
+      for (int c = 0; c < 3; c++) acc[9 + c] += wt * s->hemi[3 * q + c];
       acc[3] += wt * s->hmom[2 * q];
       acc[4] += wt * s->hmom[2 * q + 1];
       acc[5] += wt * s->hlen[q];
@@ -159,6 +158,8 @@ static void st_reproject(void *user, int64_t y, int thread) {
       continue;
     }
     for (int c = 0; c < 3; c++) s->pcol[3 * p + c] = acc[c] / wsum;
+    for (int c = 0; c < 3; c++) s->palb[3 * p + c] = acc[6 + c] / wsum;
+    for (int c = 0; c < 3; c++) s->pemi[3 * p + c] = acc[9 + c] / wsum;
     s->pmom[2 * p] = acc[3] / wsum;
     s->pmom[2 * p + 1] = acc[4] / wsum;
     float len = acc[5] / wsum, cap = SVGF_HISTORY_CAP * f->n;
@@ -177,15 +178,28 @@ static void st_integrate(void *user, int64_t y, int thread) {
   for (int x = 0; x < w; x++) {
     size_t p = (size_t)y * w + x;
     float n = f->n, pl = s->have ? s->plen[p] : 0, N = n + pl;
-    for (int c = 0; c < 3; c++) s->c[0][3 * p + c] = s->hcol[3 * p + c] = (n * s->irr[3 * p + c] + pl * s->pcol[3 * p + c]) / N;
+    /* radiance and albedo accumulate alike (each frame's camera rays hit where they hit:
+     * at an edge the albedo averages as the radiance does), then the one divides the other */
+    for (int c = 0; c < 3; c++) {
+      float col = (n * s->rad[3 * p + c] + pl * s->pcol[3 * p + c]) / N, a = (n * f->albedo[3 * p + c] + pl * s->palb[3 * p + c]) / N;
+      s->hcol[3 * p + c] = col;
+      s->halb[3 * p + c] = a;
+      float e = f->emission && isfinite(f->emission[3 * p + c]) ? f->emission[3 * p + c] : 0;
+      s->hemi[3 * p + c] = (n * e + pl * s->pemi[3 * p + c]) / N;
+      s->alb[3 * p + c] = a >= ALBEDO_MIN ? a : 1;
+      s->c[0][3 * p + c] = col / s->alb[3 * p + c];
+    }
     float m1 = (n * s->cmom[2 * p] + pl * s->pmom[2 * p]) / N, m2 = (n * s->cmom[2 * p + 1] + pl * s->pmom[2 * p + 1]) / N;
     s->hmom[2 * p] = m1;
     s->hmom[2 * p + 1] = m2;
     s->hlen[p] = N;
     for (int c = 0; c < 3; c++) s->hnrm[3 * p + c] = f->normal[3 * p + c];
-    float d = f->depth[p];
+    float d = f->depth[p], asum = s->halb[3 * p] + s->halb[3 * p + 1] + s->halb[3 * p + 2], la = lum3(&s->alb[3 * p]);
     s->hdep[p] = d;
-    s->v[0][p] = j->known && N >= MOMENTS_MIN ? fmaxf(0, m2 - m1 * m1) / N : -1;
+    s->kind[p] = !(d > 0) ? 0 : asum < ALBEDO_MIN ? 2 : 1;
+    s->kindf[p] = s->kind[p];
+    /* the variance of the estimate, divided by the albedo as the colour is */
+    s->v[0][p] = j->known && N >= MOMENTS_MIN ? fmaxf(0, m2 - m1 * m1) / N / (la * la) : -1;
     /* depth gradient: the smaller one-sided difference on each axis (edges do not count) */
     float g[2] = {0, 0};
     for (int a = 0; a < 2; a++) {
@@ -248,9 +262,38 @@ static void st_variance(void *user, int64_t y, int thread) {
       }
     a1 /= ws;
     a2 /= ws;
-    float var = (float)fmax(0, a2 - a1 * a1);
+    float la = lum3(&s->alb[3 * p]), var = (float)fmax(0, a2 - a1 * a1) / (la * la);
     s->v[1][p] = j->known ? var / s->hlen[p] : var;
   }
+}
+
+/* The luminance scale of each pixel for a round: SIGMA_L standard deviations, from the
+ * variance's 3x3 Gaussian blur (separable; the edge pixel stands in for the one outside).
+ * A pair of pixels is compared on the larger of their two scales, so weights are
+ * symmetric: a bright pixel among dim ones spreads as much as it gathers, rather than
+ * only darkening. */
+static void st_scale(void *user, int64_t yy, int thread) {
+  (void)thread;
+  job *j = user;
+  svgf *s = j->s;
+  int w = s->w, h = s->h, y = (int)yy;
+  const float *vi = s->v[(j->round + 1) & 1];
+  static const float k3[3] = {0.25f, 0.5f, 0.25f};
+  float *sd = s->sd + (size_t)y * w;
+  for (int x = 0; x < w; x++) sd[x] = 0;
+  float gy = 0;
+  for (int dy = -1; dy <= 1; dy++) {
+    int qy = y + dy;
+    if (qy < 0 || qy >= h) continue;
+    float ky = k3[dy + 1];
+    const float *vr = vi + (size_t)qy * w;
+    gy += ky;
+    for (int x = 0; x < w; x++) {
+      float l = x > 0 ? vr[x - 1] : vr[x], r = x + 1 < w ? vr[x + 1] : vr[x];
+      sd[x] += ky * (0.25f * l + 0.5f * vr[x] + 0.25f * r);
+    }
+  }
+  for (int x = 0; x < w; x++) sd[x] = SIGMA_L * sqrtf(sd[x] / gy);
 }
 
 /* Four pixels at a time (GCC/clang vector extensions: SSE2 on x86-64, NEON on arm64). */
@@ -276,7 +319,7 @@ static inline v4f exp_neg4(v4f x) {
  * at the tap). */
 typedef struct tap_row {
   const float *np, *nq, *dp, *dq, *cq, *vq, *kp, *kq; /* normals, depths, colours, variances, kinds */
-  const float *lp, *il, *iz, *sf;                     /* p's luminance, scales, surface flag */
+  const float *lp, *sdp, *sdq, *iz, *sf;              /* p's luminance, both luminance scales, p's depth scale, surface flag */
   float kw;
   float *ar, *ag, *ab, *ws, *vs;                      /* the sums */
 } tap_row;
@@ -286,7 +329,8 @@ static void tap_scalar(const tap_row *t, int x) {
   float wn = dot > 0 ? dot : 0;
   for (int k = 0; k < NORMAL_POW; k++) wn *= wn;
   float lq = 0.2126f * t->cq[3 * x] + 0.7152f * t->cq[3 * x + 1] + 0.0722f * t->cq[3 * x + 2];
-  float sf = t->sf[x], e = fabsf(t->lp[x] - lq) * t->il[x] + sf * fabsf(t->dp[x] - t->dq[x]) * t->iz[x];
+  float sf = t->sf[x], sl = t->sdp[x] > t->sdq[x] ? t->sdp[x] : t->sdq[x];
+  float e = fabsf(t->lp[x] - lq) / (sl + 1e-6f) + sf * fabsf(t->dp[x] - t->dq[x]) * t->iz[x];
   float wt = t->kw * (t->kp[x] == t->kq[x] ? 1.0f : 0.0f) * (sf * wn + (1 - sf)) * exp_neg(e < 20 ? e : 20);
   t->ar[x] += wt * t->cq[3 * x];
   t->ag[x] += wt * t->cq[3 * x + 1];
@@ -304,7 +348,8 @@ static void tap_run(const tap_row *t, int n) {
     for (int k = 0; k < NORMAL_POW; k++) wn *= wn;
     v4f cr = ld4c(cq, 0), cg = ld4c(cq, 1), cb = ld4c(cq, 2);
     v4f lq = 0.2126f * cr + 0.7152f * cg + 0.0722f * cb, sf = ld4(t->sf + x);
-    v4f e = abs4(ld4(t->lp + x) - lq) * ld4(t->il + x) + sf * abs4(ld4(t->dp + x) - ld4(t->dq + x)) * ld4(t->iz + x);
+    v4f sp = ld4(t->sdp + x), sq = ld4(t->sdq + x), sl = sel4(sp > sq, sp, sq);
+    v4f e = abs4(ld4(t->lp + x) - lq) / (sl + 1e-6f) + sf * abs4(ld4(t->dp + x) - ld4(t->dq + x)) * ld4(t->iz + x);
     e = sel4(e < 20.0f, e, (v4f){20, 20, 20, 20});
     v4f same = (v4f)((v4i)(v4f){1, 1, 1, 1} & (ld4(t->kp + x) == ld4(t->kq + x)));
     v4f wt = t->kw * same * (sf * wn + (1.0f - sf)) * exp_neg4(e);
@@ -330,31 +375,14 @@ static void st_atrous(void *user, int64_t yy, int thread) {
   const float *ci = s->c[j->round & 1], *vi = s->v[(j->round + 1) & 1];
   float *co = s->c[(j->round + 1) & 1], *vo = s->v[j->round & 1];
   static const float k3[3] = {0.25f, 0.5f, 0.25f};
-  float *row = malloc((size_t)w * 11 * sizeof *row);
+  float *row = malloc((size_t)w * 10 * sizeof *row);
   if (!row) { j->failed = 1; return; }
-  float *lp = row, *il = lp + w, *iz0 = il + w, *iz1 = iz0 + w, *ar = iz1 + w, *ag = ar + w, *ab = ag + w, *ws = ab + w, *vs = ws + w, *surf = vs + w;
+  float *lp = row, *iz0 = lp + w, *iz1 = iz0 + w, *ar = iz1 + w, *ag = ar + w, *ab = ag + w, *ws = ab + w, *vs = ws + w, *surf = vs + w;
   const float *kf = s->kindf;
   size_t p0 = (size_t)y * w;
-  /* the luminance scale: the variance's 3x3 Gaussian blur at each pixel (separable: rows
-   * first, then their weighted sum, each normalised by the weights inside the image) */
-  float *gv = ws; /* borrowed until the centre taps below */
-  for (int x = 0; x < w; x++) gv[x] = 0;
-  float gy = 0;
-  for (int dy = -1; dy <= 1; dy++) {
-    int qy = y + dy;
-    if (qy < 0 || qy >= h) continue;
-    float ky = k3[dy + 1];
-    const float *vr = vi + (size_t)qy * w;
-    gy += ky;
-    for (int x = 0; x < w; x++) {
-      float l = x > 0 ? vr[x - 1] : vr[x], r = x + 1 < w ? vr[x + 1] : vr[x]; /* the edge pixel stands in for the one outside */
-      gv[x] += ky * (0.25f * l + 0.5f * vr[x] + 0.25f * r);
-    }
-  }
   for (int x = 0; x < w; x++) {
     size_t p = p0 + x;
     lp[x] = lum3(&ci[3 * p]);
-    il[x] = 1.0f / (SIGMA_L * sqrtf(gv[x] / gy) + 1e-6f);
     iz0[x] = depth_scale(s, f, p, (float)step);
     iz1[x] = depth_scale(s, f, p, (float)step * 1.41421356f);
     surf[x] = kf[p] == 1;
@@ -374,7 +402,7 @@ static void st_atrous(void *user, int64_t yy, int thread) {
       /* every pointer at the first pixel the tap reaches */
       size_t a0 = p0 + x0, b0 = (size_t)qy * w + (size_t)(x0 + off);
       tap_row t = {f->normal + 3 * a0, f->normal + 3 * b0, f->depth + a0, f->depth + b0, ci + 3 * b0, vi + b0, kf + a0, kf + b0,
-                   lp + x0, il + x0, (dx && dy ? iz1 : iz0) + x0, surf + x0, k3[dx + 1] * k3[dy + 1], ar + x0, ag + x0, ab + x0, ws + x0, vs + x0};
+                   lp + x0, s->sd + a0, s->sd + b0, (dx && dy ? iz1 : iz0) + x0, surf + x0, k3[dx + 1] * k3[dy + 1], ar + x0, ag + x0, ab + x0, ws + x0, vs + x0};
       tap_run(&t, x1 - x0);
     }
   }
@@ -385,7 +413,7 @@ static void st_atrous(void *user, int64_t yy, int thread) {
     co[3 * p + 2] = ab[x] / ws[x];
     vo[p] = vs[x] / (ws[x] * ws[x]);
     if (j->round == ROUNDS - 1)
-      for (int c = 0; c < 3; c++) j->out[3 * p + c] = co[3 * p + c] * s->alb[3 * p + c];
+      for (int c = 0; c < 3; c++) j->out[3 * p + c] = co[3 * p + c] * s->alb[3 * p + c] + s->hemi[3 * p + c];
   }
   free(row);
 }
@@ -393,12 +421,15 @@ static void st_atrous(void *user, int64_t yy, int thread) {
 int svgf_run(svgf *s, const svgf_frame *f, float *out, int threads) {
   if (f->w != s->w || f->h != s->h) return -1;
   job j = {s, f, out, 0, f->lum2 != NULL || f->n <= 1, 0};
-  parallel_for(threads, s->h, st_demod, &j);
+  parallel_for(threads, s->h, st_moments, &j);
   if (!s->have) memset(s->plen, 0, (size_t)s->w * s->h * sizeof *s->plen);
   else if (f->fresh) parallel_for(threads, s->h, st_reproject, &j);
   parallel_for(threads, s->h, st_integrate, &j);
   s->have = 1;
   parallel_for(threads, s->h, st_variance, &j);
-  for (j.round = 0; j.round < ROUNDS; j.round++) parallel_for(threads, s->h, st_atrous, &j);
+  for (j.round = 0; j.round < ROUNDS; j.round++) {
+    parallel_for(threads, s->h, st_scale, &j);
+    parallel_for(threads, s->h, st_atrous, &j);
+  }
   return j.failed ? -1 : 0;
 }

@@ -1,15 +1,18 @@
 /* svgf.h — owns the real-time denoiser of `valo view`: spatiotemporal variance-guided
- * filtering (Schied et al. 2017). Each frame's radiance is divided by the first hit's
- * albedo and accumulated over time (the last frames' estimate, reprojected to this
- * frame's pixels and kept where depth and normal agree, weighted by its sample count up
- * to SVGF_HISTORY_CAP times this frame's), the per-pixel luminance variance of that
- * estimate is taken from the samples' moments (or, with few samples, from a 5x5
- * neighbourhood's), and an edge-aware a-trous wavelet (five 3x3 rounds, steps 1 to 16)
- * guided by normal, depth and that variance smooths it; then the albedo multiplies it
- * back. Every step reads its window and writes its pixel: images are the same for any
- * thread count. What it biases: light finer than the filter's footprint where the
- * features are flat (soft shadow edges, small caustics) is blurred, and a reprojected
- * history lags lighting that changes (valo's scenes are static: the camera moves). */
+ * filtering (Schied et al. 2017). Each frame's radiance and first-hit albedo are
+ * accumulated over time (the last frames' estimate, reprojected to this frame's pixels and
+ * kept where depth and normal agree, weighted by its sample count up to SVGF_HISTORY_CAP
+ * times this frame's), the one divided by the other (radiance and albedo averaged alike,
+ * so a pixel on an edge whose camera rays hit now one side, now the other, keeps its
+ * energy); the per-pixel luminance variance of that estimate comes from the samples'
+ * moments (or, with few samples, from a 5x5 neighbourhood's), and an edge-aware a-trous
+ * wavelet (four 3x3 rounds, steps 1 to 8) guided by normal, depth and that variance
+ * smooths it; then the albedo multiplies it back and the emission seen directly (kept
+ * apart from the start, accumulated the same way, never filtered) is added. Every step reads its window and writes
+ * its pixel: images are the same for any thread count. What it biases: light finer than
+ * the filter's footprint where the features are flat (soft shadow edges, small caustics)
+ * is blurred, radiance is averaged across a pixel's edges, and a reprojected history lags
+ * lighting that changes (valo's scenes are static: the camera moves). */
 #ifndef VALO_SVGF_H
 #define VALO_SVGF_H
 
@@ -24,6 +27,8 @@ typedef struct svgf_frame {
   const float *lum2;    /* 1 per pixel: the mean of the samples' squared luminance (NULL: unknown) */
   float n;              /* samples per pixel in color */
   const float *albedo;  /* 3 per pixel */
+  const float *emission; /* 3 per pixel: the part of color the first hit emits (left
+                           unfiltered, so lamps do not bleed into what they light), or NULL */
   const float *normal;  /* 3 per pixel, unit, facing the camera; zero where nothing was hit */
   const float *depth;   /* 1 per pixel: distance to the first hit, 0 where nothing was hit */
   int fresh;            /* 1: color shares no sample with the last frame's (a restart), so the

@@ -58,7 +58,7 @@ typedef struct render_ctx {
 /* One frame of an image-wide integrator (render_frame). The render loop calls it once per
  * frame of a sequence (--frames), or once per pass of a still image on the static
  * camera, whose frames are averaged. */
-enum { FRAME_GBUF = 7 };
+enum { FRAME_GBUF = 10 };
 typedef struct frame_ctx {
   int frame;            /* 0 for the first frame the integrator sees (no history yet) */
   cam_view prev;        /* the previous frame's camera (this frame's, lens->view, for frame 0) */
@@ -71,8 +71,9 @@ typedef struct frame_ctx {
   float *wt;            /* out when not NULL (a filter with negative lobes): width*height
                            filter weights of this frame's samples (camera_ray) */
   float *gbuf;          /* out when not NULL (the film keeps AOVs): FRAME_GBUF floats per
-                           pixel, its camera ray's albedo, shading normal facing the camera
-                           and distance to the first hit (the AOVs, render/aov.h) */
+                           pixel, its camera ray's albedo, shading normal facing the camera,
+                           distance to the first hit and the emission seen (the AOVs,
+                           render/aov.h) */
 } frame_ctx;
 
 /* Per-ray integrators give li() and get the tile loop; image-wide ones give render_frame. */

@@ -56,6 +56,7 @@ static void gbuffer_pixel(const render_ctx *c, const frame_ctx *f, int x, int y,
     /* the AOVs of the surface the camera sees (through delta lobes: its albedo times the chain's throughput) */
     float *o = &f->gbuf[FRAME_GBUF * pix];
     memset(o, 0, FRAME_GBUF * sizeof *o);
+    o[7] = g->Le.r; o[8] = g->Le.g; o[9] = g->Le.b;
     if (!g->valid) return;
     material tm = *g->it.m;
     tm.kd = g->b.kd;

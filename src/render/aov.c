@@ -32,6 +32,10 @@ void aov_record(const session *ss, ray ry, float *acc, sampler *smp, thread_stat
   acc[AOV_ALBEDO] += a.r; acc[AOV_ALBEDO + 1] += a.g; acc[AOV_ALBEDO + 2] += a.b;
   acc[AOV_NORMAL] += n.x; acc[AOV_NORMAL + 1] += n.y; acc[AOV_NORMAL + 2] += n.z;
   acc[AOV_DEPTH] += before + h.t * v3_len(ry.d);
+  if (!ss->ctx.hide_emitters) {
+    rgb e = emitted_along(&ss->ctx, &ry, &h, 1, &it);
+    acc[AOV_EMIT] += e.r; acc[AOV_EMIT + 1] += e.g; acc[AOV_EMIT + 2] += e.b;
+  }
   if (!(ss->opt.aovs & VALO_AOVS_AO)) return;
   vec3 dir;
   sampler_set_dim(smp, SDIM_AOV);

@@ -1,5 +1,6 @@
 /* aov.h — owns the AOVs of the first camera hit (albedo, shading normal facing the
- * camera, distance, and one ambient-occlusion ray: unoccluded fraction and bent normal)
+ * camera, distance, the radiance it emits, and one ambient-occlusion ray: unoccluded
+ * fraction and bent normal)
  * and their one table of output prefixes ("albedo:", ... "spp:"), which output.c and the
  * public API (valo_output_prefix) read. */
 #ifndef VALO_AOV_H

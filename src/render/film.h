@@ -16,7 +16,8 @@ enum {
   AOV_DEPTH = 6,    /* 1: hit distance */
   AOV_AO = 7,       /* 1: unoccluded ao rays */
   AOV_BENT = 8,     /* 3: sum of their directions (the bent normal) */
-  AOV_FLOATS = 11
+  AOV_EMIT = 11,    /* 3: radiance the hit emits toward the camera (the live denoiser leaves it unfiltered) */
+  AOV_FLOATS = 14
 };
 
 typedef struct film {

@@ -10,7 +10,7 @@ struct live_state {
   svgf *f;
   uint64_t restarts; /* the session's restarts at the last call */
   cam_view view;     /* and its camera */
-  float *buf;        /* color 3, albedo 3, normal 3, depth 1, lum2 1, prev_xy 2, prev_d 1 */
+  float *buf;        /* color 3, albedo 3, normal 3, depth 1, lum2 1, prev_xy 2, prev_d 1, emission 3 */
 };
 
 void live_reset(live_state *l) {
@@ -31,7 +31,7 @@ valo_status live_denoise(live_state **lp, const session *ss, float *out, valo_er
   size_t np = (size_t)w * h;
   live_state *l = *lp;
   if (!l) {
-    if (!(l = calloc(1, sizeof *l)) || !(l->f = svgf_create(w, h)) || !(l->buf = malloc(np * 14 * sizeof(float)))) {
+    if (!(l = calloc(1, sizeof *l)) || !(l->f = svgf_create(w, h)) || !(l->buf = malloc(np * 17 * sizeof(float)))) {
       live_free(l);
       return err_set(err, VALO_ERR_NOMEM, "out of memory");
     }
@@ -39,12 +39,13 @@ valo_status live_denoise(live_state **lp, const session *ss, float *out, valo_er
     l->view = ss->lens.view;
     *lp = l;
   }
-  float *color = l->buf, *alb = color + 3 * np, *nrm = alb + 3 * np, *dep = nrm + 3 * np, *lum2 = dep + np, *pxy = lum2 + np, *pd = pxy + 2 * np;
+  float *color = l->buf, *alb = color + 3 * np, *nrm = alb + 3 * np, *dep = nrm + 3 * np, *lum2 = dep + np, *pxy = lum2 + np, *pd = pxy + 2 * np, *emi = pd + np;
   film_resolve(fm, color);
   for (size_t i = 0; i < np; i++) {
     const float *a = &fm->aov[AOV_FLOATS * i];
     float n = (float)fm->count[i], inv = n > 0 ? 1 / n : 0;
     for (int c = 0; c < 3; c++) alb[3 * i + c] = a[AOV_ALBEDO + c] * inv;
+    for (int c = 0; c < 3; c++) emi[3 * i + c] = a[AOV_EMIT + c] * inv;
     float nx = a[AOV_NORMAL], ny = a[AOV_NORMAL + 1], nz = a[AOV_NORMAL + 2], len = sqrtf(nx * nx + ny * ny + nz * nz);
     float k = len > 0 ? 1 / len : 0;
     nrm[3 * i] = nx * k; nrm[3 * i + 1] = ny * k; nrm[3 * i + 2] = nz * k;
@@ -68,7 +69,7 @@ valo_status live_denoise(live_state **lp, const session *ss, float *out, valo_er
       pxy[2 * i + 1] = fy;
       pd[i] = cam_view_depth(was, p);
     }
-  svgf_frame f = {w, h, color, fm->sq ? lum2 : NULL, (float)ss->spp_done, alb, nrm, dep, fresh, moved ? pxy : NULL, moved ? pd : NULL};
+  svgf_frame f = {w, h, color, fm->sq ? lum2 : NULL, (float)ss->spp_done, alb, emi, nrm, dep, fresh, moved ? pxy : NULL, moved ? pd : NULL};
   if (!(f.n > 0)) f.n = 1;
   int rc = svgf_run(l->f, &f, out, ss->opt.threads);
   l->restarts = ss->restarts;

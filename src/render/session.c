@@ -170,7 +170,7 @@ static valo_status image_frame(session *ss, thread_stats *ts, valo_error *err) {
     if (ss->frame_gbuf) {
       const float *g = &ss->frame_gbuf[FRAME_GBUF * i];
       float *a = &ss->film.aov[AOV_FLOATS * i];
-      for (int k = 0; k < 3; k++) { a[AOV_ALBEDO + k] += g[k]; a[AOV_NORMAL + k] += g[3 + k]; }
+      for (int k = 0; k < 3; k++) { a[AOV_ALBEDO + k] += g[k]; a[AOV_NORMAL + k] += g[3 + k]; a[AOV_EMIT + k] += g[7 + k]; }
       a[AOV_DEPTH] += g[6];
     }
   }
@@ -333,13 +333,18 @@ valo_status session_step(session *ss, int spp, int restart, valo_error *err) {
     film_clear(&ss->film);
     ss->spp_done = 0;
     ss->restarts++;
+    /* a fresh restart takes sample indices no film of this render has used */
+    ss->step_base = restart == SESSION_RESTART_FRESH ? ss->step_next : 0;
   }
   valo_status st = VALO_OK;
   if (ss->integ->kind == INTEGRATOR_IMAGE) {
     for (int k = 0; k < spp && !st; k++)
       if (!(st = image_frame(ss, ts, err))) ss->spp_done++;
-  } else if (!(st = tiles_render(ss, ss->spp_done, ss->spp_done + spp, ts, err))) {
+  } else if (ss->step_base + ss->spp_done + spp > UINT32_MAX) {
+    st = err_set(err, VALO_ERR_INVALID, "the render's steps have used 2^32 sample indices");
+  } else if (!(st = tiles_render(ss, (int)(ss->step_base + ss->spp_done), (int)(ss->step_base + ss->spp_done + spp), ts, err))) {
     ss->spp_done += spp;
+    if (ss->step_base + ss->spp_done > ss->step_next) ss->step_next = ss->step_base + ss->spp_done;
   }
   return run_finish(ss, ts, t0, st);
 }

@@ -13,6 +13,7 @@
 #include <stdatomic.h>
 
 #define TILE 16 /* tiles of TILE x TILE pixels: the unit of work and of cancellation */
+#define SESSION_RESTART_FRESH 2 /* session_step's restart: with sample indices not used before */
 
 typedef struct session session;
 struct tile_source; /* render/tiles.h: where a pass's tiles are rendered */
@@ -70,6 +71,8 @@ struct session {
                               window at (crop_x, crop_y): the whole frame without a crop */
   int crop_x, crop_y;
   int stepped;             /* rendered by session_step (valo view): image-wide frames as a sequence's */
+  int64_t step_base;       /* steps: the sample index of the film's first sample */
+  int64_t step_next;       /* steps: one past the largest sample index used */
   uint64_t restarts;       /* times the film was emptied for a new estimate (a step's restart, a
                               sequence's frame): the live denoiser's history is reprojected then */
   const struct tile_source *work; /* this process's threads, or under MPI rank 0 handing tiles to every rank */
