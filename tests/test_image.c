@@ -528,6 +528,18 @@ static int svgf_filter(void) {
   CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
   CHECK(svgf_history(s, 10, 10) == 5 && svgf_history(s, W - 1, 10) == 1, "a shifted history: %g samples inside, %g at the edge it came from nothing",
         (double)svgf_history(s, 10, 10), (double)svgf_history(s, W - 1, 10));
+  /* a moved camera's history counts for at most SVGF_MOVING_CAP frames (16 still ones here) */
+  for (int k = 0; k < 16; k++) { f.prev_xy = NULL; CHECK(svgf_run(s, &f, out, 2) == 0, "svgf"); }
+  f.prev_xy = pxy;
+  CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
+  CHECK(svgf_history(s, 10, 10) == SVGF_MOVING_CAP + 1, "after a move the history holds %g samples", (double)svgf_history(s, 10, 10));
+  /* nor where the albedo differs by more than REPROJ_ALBEDO (a lamp beside a wall) */
+  for (int k = 0; k < 3; k++) { f.prev_xy = NULL; CHECK(svgf_run(s, &f, out, 2) == 0, "svgf"); }
+  for (int i = 0; i < 3 * N; i++) alb[i] = 0.7f;
+  f.prev_xy = pxy;
+  CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
+  CHECK(svgf_history(s, 10, 10) == 1, "history taken across an albedo change of 0.2 per channel");
+  for (int i = 0; i < 3 * N; i++) alb[i] = 0.5f;
   /* ... but not where the depth disagrees (another surface there now) */
   for (int k = 0; k < 3; k++) { f.prev_xy = NULL; CHECK(svgf_run(s, &f, out, 2) == 0, "svgf"); }
   for (int i = 0; i < N; i++) pd[i] = 2.5f;

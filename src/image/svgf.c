@@ -13,6 +13,7 @@
 #define NORMAL_POW 7      /* normals: max(0, n_p . n_q)^(2^7) */
 #define REPROJ_DEPTH 0.05f  /* a history pixel is the same surface within 5 % of depth */
 #define REPROJ_NORMAL 0.9f  /* and a normal within about 25 degrees */
+#define REPROJ_ALBEDO 0.3f  /* and an albedo within 0.3 (summed over r, g, b) */
 #define MOMENTS_MIN 4.0f    /* fewer samples: the variance from the 5x5 neighbourhood */
 
 struct svgf {
@@ -143,6 +144,11 @@ static void st_reproject(void *user, int64_t y, int thread) {
         if (fabsf(hd - dexp) > REPROJ_DEPTH * dexp) continue;
         const float *hn = &s->hnrm[3 * q];
         if (hn[0] * n[0] + hn[1] * n[1] + hn[2] * n[2] < REPROJ_NORMAL) continue;
+        /* after a move, nor a lamp's history for a wall beside it, nor the other way (on a
+         * still camera a pixel's rays hit either side of an edge, and radiance and albedo
+         * are averaged alike: that history is right) */
+        const float *ha = &s->halb[3 * q], *a = &f->albedo[3 * p];
+        if (f->prev_xy && fabsf(ha[0] - a[0]) + fabsf(ha[1] - a[1]) + fabsf(ha[2] - a[2]) > REPROJ_ALBEDO) continue;
       }
       float wt = qw[k];
       for (int c = 0; c < 3; c++) acc[c] += wt * s->hcol[3 * q + c];
@@ -162,7 +168,8 @@ static void st_reproject(void *user, int64_t y, int thread) {
     for (int c = 0; c < 3; c++) s->pemi[3 * p + c] = acc[9 + c] / wsum;
     s->pmom[2 * p] = acc[3] / wsum;
     s->pmom[2 * p + 1] = acc[4] / wsum;
-    float len = acc[5] / wsum, cap = SVGF_HISTORY_CAP * f->n;
+    /* a moving camera's history is resampled every frame (a blur): it counts for less */
+    float len = acc[5] / wsum, cap = (f->prev_xy ? SVGF_MOVING_CAP : SVGF_HISTORY_CAP) * f->n;
     s->plen[p] = len < cap ? len : cap;
   }
 }

@@ -1,8 +1,8 @@
 /* svgf.h — owns the real-time denoiser of `valo view`: spatiotemporal variance-guided
  * filtering (Schied et al. 2017). Each frame's radiance and first-hit albedo are
  * accumulated over time (the last frames' estimate, reprojected to this frame's pixels and
- * kept where depth and normal agree, weighted by its sample count up to SVGF_HISTORY_CAP
- * times this frame's), the one divided by the other (radiance and albedo averaged alike,
+ * kept where depth, normal and albedo agree, weighted by its sample count up to
+ * SVGF_HISTORY_CAP times this frame's, SVGF_MOVING_CAP after a move), the one divided by the other (radiance and albedo averaged alike,
  * so a pixel on an edge whose camera rays hit now one side, now the other, keeps its
  * energy); the per-pixel luminance variance of that estimate comes from the samples'
  * moments (or, with few samples, from a 5x5 neighbourhood's), and an edge-aware a-trous
@@ -17,6 +17,7 @@
 #define VALO_SVGF_H
 
 #define SVGF_HISTORY_CAP 32 /* the history counts for at most this many times the frame's samples */
+#define SVGF_MOVING_CAP 4   /* and after the camera moved (its history was resampled) */
 
 typedef struct svgf svgf;
 
