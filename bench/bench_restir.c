@@ -20,6 +20,8 @@
  * Mitsuba 3 here).
  * Usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params "K=V ..."]
  * [--stills di|gi|both] [--frames di|gi|both]
+ * [--scene FILE WxH REF_DIRECT.exr [REF_PATH.exr]] (another scene instead: the held-out
+ * rooms of tools/gen_manylight.c `heldout`, references made as docs/performance.md says)
  * (--params: restir parameters for every restir run, before each run's own; --stills:
  * only the accumulated stills, of restir-di, restir-gi or both; --frames: only the
  * per-frame measures) */
@@ -262,20 +264,28 @@ static int bench_scene(const scene_def *sd, int quick, double seconds) {
 int main(int argc, char **argv) {
   int quick = 0;
   const char *only = NULL;
+  scene_def own = {NULL, NULL, NULL, NULL, 0, 0};
   double seconds = 0;
   for (int i = 1; i < argc; i++) {
     if (!strcmp(argv[i], "--quick")) quick = 1;
     else if (!strcmp(argv[i], "--only") && i + 1 < argc) only = argv[++i];
     else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
     else if (!strcmp(argv[i], "--params") && i + 1 < argc) g_params = argv[++i];
+    else if (!strcmp(argv[i], "--scene") && i + 3 < argc) {
+      own.name = own.file = argv[++i];
+      if (sscanf(argv[++i], "%dx%d", &own.w, &own.h) != 2) { fprintf(stderr, "--scene: %s is not WxH\n", argv[i]); return 2; }
+      own.ref_direct = argv[++i];
+      if (i + 1 < argc && strncmp(argv[i + 1], "--", 2)) own.ref_path = argv[++i];
+    }
     else if ((!strcmp(argv[i], "--stills") || !strcmp(argv[i], "--frames")) && i + 1 < argc) {
       const char *w = argv[++i];
       int bits = !strcmp(w, "di") ? 1 : !strcmp(w, "gi") ? 2 : !strcmp(w, "both") ? 3 : 0;
       if (!bits) { fprintf(stderr, "%s: di, gi or both\n", argv[i - 1]); return 2; }
       *(!strcmp(argv[i - 1], "--stills") ? &g_stills : &g_frames) = bits;
     }
-    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params \"K=V ...\"] [--stills di|gi|both] [--frames di|gi|both]\n"); return 2; }
+    else { fprintf(stderr, "usage: bench_restir [--quick] [--only room|sponza|walls] [--seconds S] [--params \"K=V ...\"] [--stills di|gi|both] [--frames di|gi|both] [--scene FILE WxH REF_DIRECT.exr [REF_PATH.exr]]\n"); return 2; }
   }
+  if (own.file) return bench_scene(&own, quick, seconds) != 0;
   static const char *names[3] = {"room", "sponza", "walls"};
   const scene_def scenes[3] = {
       {"room (scenes/manylight.json, 1 024 lamps)", VALO_SOURCE_DIR "/scenes/manylight.json", VALO_SOURCE_DIR "/bench/references/manylight-room-direct.exr",
