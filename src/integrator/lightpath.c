@@ -17,6 +17,7 @@ typedef struct shoot_job {
   uint64_t first, end, key;
   size_t rec_size;
   int only_specular;
+  const lp_aim *aim;
   lp_visit_fn visit;
   void *user;
   chunk_buf *bufs;
@@ -45,7 +46,9 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
   float pmf;
   uint32_t li = light_select_power(&c->ls, ul, &pmf);
   light_emit e;
-  if (!(pmf > 0) || !light_sample_emit(s, &s->lights[li], u, &e)) return;
+  if (!(pmf > 0)) return;
+  if (!(j->aim && light_sample_emit_toward(s, &s->lights[li], u, j->aim->c, j->aim->r, &e)) && !light_sample_emit(s, &s->lights[li], u, &e)) return;
+  if (c3_black(e.beta)) return;
   rgb beta = c3_scale(e.beta, 1 / pmf);
   ray r = {e.o, e.d, INFINITY};
   if (s->lights[li].type == LIGHT_AREA) r.o = offset_origin(e.o, v3(0, 0, 0), e.n, e.d);
@@ -97,12 +100,12 @@ static void shoot_chunk(void *user, int64_t item, int thread) {
 
 /* Shoots paths [first, first + npaths) and appends their records to *all (n of cap). */
 static valo_status shoot_round(const render_ctx *c, uint64_t key, uint64_t first, uint64_t npaths, size_t rec_size, int only_specular,
-                               lp_visit_fn visit, void *user, thread_stats *ts, unsigned char **all, uint64_t *n, uint64_t *mcap,
+                               const lp_aim *aim, lp_visit_fn visit, void *user, thread_stats *ts, unsigned char **all, uint64_t *n, uint64_t *mcap,
                                valo_error *err) {
   int64_t chunks = (int64_t)((npaths + CHUNK - 1) / CHUNK);
   chunk_buf *bufs = calloc((size_t)(chunks ? chunks : 1), sizeof *bufs);
   if (!bufs) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  shoot_job j = {c, first, first + npaths, key, rec_size, only_specular, visit, user, bufs, ts};
+  shoot_job j = {c, first, first + npaths, key, rec_size, only_specular, aim, visit, user, bufs, ts};
   parallel_for(c->threads, chunks, shoot_chunk, &j);
   valo_status st = VALO_OK;
   for (int64_t k = 0; k < chunks && st == VALO_OK; k++) {
@@ -126,7 +129,7 @@ static valo_status shoot_round(const render_ctx *c, uint64_t key, uint64_t first
 
 /* Either rounds until `target` records (npaths == 0), or exactly npaths paths. */
 static valo_status shoot(const render_ctx *c, uint64_t key, uint64_t target, uint64_t npaths, size_t rec_size, int only_specular,
-                         lp_visit_fn visit, void *user, lp_set *out, valo_error *err) {
+                         const lp_aim *aim, lp_visit_fn visit, void *user, lp_set *out, valo_error *err) {
   memset(out, 0, sizeof *out);
   if ((target == 0 && npaths == 0) || c->ls.table.n == 0) return VALO_OK;
   thread_stats *ts = calloc((size_t)c->threads, sizeof *ts);
@@ -135,14 +138,14 @@ static valo_status shoot(const render_ctx *c, uint64_t key, uint64_t target, uin
   unsigned char *all = NULL;
   valo_status st = VALO_OK;
   if (npaths) {
-    st = shoot_round(c, key, 0, npaths, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
+    st = shoot_round(c, key, 0, npaths, rec_size, only_specular, aim, visit, user, ts, &all, &n, &mcap, err);
     emitted = npaths;
   } else {
     uint64_t cap = target * MAX_EMIT_FACTOR, round = 4 * CHUNK;
     if (cap < 65536) cap = 65536;
     while (n < target && emitted < cap) {
       round = (round + CHUNK - 1) / CHUNK * CHUNK;
-      st = shoot_round(c, key, emitted, round, rec_size, only_specular, visit, user, ts, &all, &n, &mcap, err);
+      st = shoot_round(c, key, emitted, round, rec_size, only_specular, aim, visit, user, ts, &all, &n, &mcap, err);
       emitted += round;
       if (st) break;
       /* next round: what the rate so far says reaches the target */
@@ -161,12 +164,12 @@ static valo_status shoot(const render_ctx *c, uint64_t key, uint64_t target, uin
   return VALO_OK;
 }
 
-valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
-                            void *user, lp_set *out, valo_error *err) {
-  return shoot(c, key, target, 0, rec_size, only_specular, visit, user, out, err);
+valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, const lp_aim *aim,
+                            lp_visit_fn visit, void *user, lp_set *out, valo_error *err) {
+  return shoot(c, key, target, 0, rec_size, only_specular, only_specular ? aim : NULL, visit, user, out, err);
 }
 
 valo_status lightpath_shoot_paths(const render_ctx *c, uint64_t key, uint64_t npaths, size_t rec_size, lp_visit_fn visit, void *user,
                                   lp_set *out, valo_error *err) {
-  return shoot(c, key, 0, npaths, rec_size, 0, visit, user, out, err);
+  return shoot(c, key, 0, npaths, rec_size, 0, NULL, visit, user, out, err);
 }

@@ -28,8 +28,12 @@ typedef struct lp_set { unsigned char *rec; uint32_t n; uint64_t emitted; } lp_s
 /* Shoots paths keyed by `key` until target records are stored. only_specular: end a path
  * after its first non-delta bounce (caustic paths). The caller divides powers by
  * out->emitted. out->rec is malloc'd (free it). */
-valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, lp_visit_fn visit,
-                            void *user, lp_set *out, valo_error *err);
+/* aim (only_specular paths, or NULL): a sphere around every surface with a delta lobe;
+ * area and point lights then emit only into the cone it subtends (light_sample_emit_toward):
+ * a path that misses it could not be L S+ D, so the records' estimate is the same. */
+typedef struct lp_aim { vec3 c; float r; } lp_aim;
+valo_status lightpath_shoot(const render_ctx *c, uint64_t key, uint64_t target, size_t rec_size, int only_specular, const lp_aim *aim,
+                            lp_visit_fn visit, void *user, lp_set *out, valo_error *err);
 /* Shoots exactly npaths paths (all their records kept): for estimators that must stay
  * unbiased, where a stopping rule on the records stored would not. */
 valo_status lightpath_shoot_paths(const render_ctx *c, uint64_t key, uint64_t npaths, size_t rec_size, lp_visit_fn visit, void *user,

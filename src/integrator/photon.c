@@ -8,7 +8,9 @@
  *    near constant. Every hit on a surface with a non-delta lobe stores a photon
  *    (position, power, incoming direction octahedron-packed: 28 bytes) in the global
  *    map; a second emission keeps only L S+ D photons (those that reached a diffuse
- *    surface through specular ones), in the caustic map. Emission runs in rounds sized
+ *    surface through specular ones), in the caustic map, its paths leaving area and point
+ *    lights only toward a sphere around every surface that may have a delta lobe (Jensen's
+ *    projection maps: a path that misses it cannot be L S+ D). Emission runs in rounds sized
  *    from the rate seen so far until each map holds its target; rounds are split into
  *    fixed chunks whose photons are concatenated in chunk order, so the maps are the same
  *    for any thread count. Both maps live in the shared point kd-tree.
@@ -39,7 +41,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { P_GLOBAL, P_CAUSTIC, P_K, P_RADIUS, P_GATHER, P_CAUSTIC_RADIUS, P_ALPHA };
+enum { P_GLOBAL, P_CAUSTIC, P_K, P_RADIUS, P_GATHER, P_CAUSTIC_RADIUS, P_ALPHA, P_AIM };
 static const integrator_param photon_params[] = {
     {"global", IPARAM_INT, 100000, 0, 1e8, "photons stored in the global map per pass (pbrt-v2's default count)"},
     {"caustic", IPARAM_INT, 20000, 0, 1e8, "photons stored in the caustic map per pass"},
@@ -48,6 +50,7 @@ static const integrator_param photon_params[] = {
     {"gather", IPARAM_INT, 32, 0, 4096, "final-gathering rays per camera sample (0: use the global map at the first hit)"},
     {"caustic_radius", IPARAM_FLOAT, 0, 0, 1e30, "first pass's search radius, caustic map; 0 = automatic (k photons, at most 1/40 of the bounding-sphere radius)"},
     {"alpha", IPARAM_FLOAT, 0.7, 0.05, 1, "radius reduction per pass (Knaus & Zwicker's alpha): r_i^2 = r_0^2 prod (j + alpha) / (j + 1); 1 keeps the radius"},
+    {"aim", IPARAM_INT, 1, 0, 1, "1: caustic photons leave area and point lights only toward a sphere around the specular surfaces (Jensen's projection maps); 0: in every direction"},
     {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 #define SQUEEZE 16.0f
@@ -82,6 +85,7 @@ typedef struct photon_map { point_tree tree; photon *ph; uint32_t n; float r2; }
 typedef struct photon_state {
   photon_map global, caustic;
   int has_specular;        /* any delta lobe in the scene: else no caustic map */
+  lp_aim aim;              /* a sphere around every triangle with a delta lobe: caustic photons are aimed at it */
   float r2cap_global, r2cap_caustic; /* the automatic first radius's bound */
 } photon_state;
 
@@ -102,10 +106,30 @@ static void photon_destroy(void *st) {
 static valo_status photon_create(const render_ctx *c, void **out, valo_error *err) {
   photon_state *ps = calloc(1, sizeof *ps);
   if (!ps) return err_set(err, VALO_ERR_NOMEM, "out of memory");
-  for (uint32_t i = 0; i < c->s->nmats && !ps->has_specular; i++) {
-    bsdf b = bsdf_from_material(&c->s->mats[i]);
-    ps->has_specular = b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR || b.type == BSDF_THIN_DIELECTRIC;
+  const scene *s = c->s;
+  unsigned char *spec = calloc(s->nmats ? s->nmats : 1, 1);
+  if (!spec) { free(ps); return err_set(err, VALO_ERR_NOMEM, "out of memory"); }
+  for (uint32_t i = 0; i < s->nmats; i++) {
+    bsdf b = bsdf_from_material(&s->mats[i]);
+    ps->has_specular |= b.type == BSDF_MIRROR || b.type == BSDF_DIELECTRIC || b.type == BSDF_CONDUCTOR || b.type == BSDF_THIN_DIELECTRIC;
+    /* inside the aim: every material that may have a delta lobe (all but the purely smooth
+     * kinds; a blend may pick a delta material) */
+    spec[i] = s->mats[i].type == MAT_BLEND || !(b.type == BSDF_DIFFUSE || b.type == BSDF_PHONG || b.type == BSDF_ROUGH_CONDUCTOR ||
+                                                 b.type == BSDF_ROUGH_DIELECTRIC || b.type == BSDF_ROUGH_PLASTIC);
   }
+  /* the aim: the bounding box of the triangles with a delta lobe, as a sphere */
+  vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+  for (uint32_t t = 0; t < s->ntris; t++) {
+    if (!spec[s->tri_mat[t]]) continue;
+    for (int k = 0; k < 3; k++) {
+      vec3 p = s->pos[s->idx[3 * t + k]];
+      lo = v3(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
+      hi = v3(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
+    }
+  }
+  free(spec);
+  ps->aim.c = v3_scale(v3_add(lo, hi), 0.5f);
+  ps->aim.r = lo.x <= hi.x ? 0.5f * v3_len(v3_sub(hi, lo)) * 1.0001f + 1e-6f * s->radius : INFINITY;
   float rg = 0.1f * c->s->radius, rc = 0.025f * c->s->radius;
   ps->r2cap_global = rg * rg;
   ps->r2cap_caustic = rc * rc;
@@ -127,10 +151,10 @@ static int visit_caustic(void *user, const lp_vertex *v, void *rec) {
 
 /* Shoots map m: `target` photons stored, powers divided by the paths emitted, the kd-tree
  * built and the photons put in tree order. */
-static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, uint64_t target, uint64_t key, valo_error *err) {
+static valo_status shoot_map(const render_ctx *c, photon_map *m, int caustic, const lp_aim *aim, uint64_t target, uint64_t key, valo_error *err) {
   map_free(m);
   lp_set set;
-  valo_status st = lightpath_shoot(c, key, target, sizeof(photon), caustic, caustic ? visit_caustic : visit_global, NULL, &set, err);
+  valo_status st = lightpath_shoot(c, key, target, sizeof(photon), caustic, aim, caustic ? visit_caustic : visit_global, NULL, &set, err);
   if (st) return st;
   photon *all = (photon *)set.rec;
   uint32_t n = set.n;
@@ -178,12 +202,12 @@ static valo_status photon_prepare(void *state, const render_ctx *c, int sample_i
   uint64_t key = rng_mix64(c->seed * 0x9e3779b97f4a7c15ULL + (uint64_t)sample_index + STREAM_PHOTON);
   float shrink = (float)radius_shrink(sample_index, c->param[P_ALPHA]);
   int k = (int)c->param[P_K];
-  valo_status st = shoot_map(c, &ps->global, 0, (uint64_t)c->param[P_GLOBAL], key, err);
+  valo_status st = shoot_map(c, &ps->global, 0, NULL, (uint64_t)c->param[P_GLOBAL], key, err);
   if (st) return st;
   float r = (float)c->param[P_RADIUS];
   ps->global.r2 = (r > 0 ? r * r : auto_radius2(&ps->global, k, ps->r2cap_global)) * shrink;
   if (!ps->has_specular) { map_free(&ps->caustic); return VALO_OK; }
-  st = shoot_map(c, &ps->caustic, 1, (uint64_t)c->param[P_CAUSTIC], rng_mix64(key + 1), err);
+  st = shoot_map(c, &ps->caustic, 1, c->param[P_AIM] > 0 ? &ps->aim : NULL, (uint64_t)c->param[P_CAUSTIC], rng_mix64(key + 1), err);
   if (st) return st;
   r = (float)c->param[P_CAUSTIC_RADIUS];
   ps->caustic.r2 = (r > 0 ? r * r : auto_radius2(&ps->caustic, k, ps->r2cap_caustic)) * shrink;

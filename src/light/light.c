@@ -280,3 +280,34 @@ int light_sample_emit(const scene *s, const light *l, const float u[4], light_em
   }
   return c3_finite(o->beta) && !c3_black(o->beta);
 }
+
+int light_sample_emit_toward(const scene *s, const light *l, const float u[4], vec3 c, float r, light_emit *o) {
+  if (l->type != LIGHT_AREA && l->type != LIGHT_POINT) return 0;
+  vec3 p = l->p;
+  float b0 = 0, b1 = 0;
+  if (l->type == LIGHT_AREA) {
+    sample_uniform_triangle(u[0], u[1], &b0, &b1);
+    p = v3_add(v3_add(v3_scale(l->v[0], b0), v3_scale(l->v[1], b1)), v3_scale(l->v[2], 1 - b0 - b1));
+  }
+  vec3 dc = v3_sub(c, p);
+  float dist = v3_len(dc);
+  if (!(dist > r * 1.001f)) return 0; /* inside the sphere: every direction */
+  float sin_max = r / dist, cos_max = sqrtf(fmaxf(0, 1 - sin_max * sin_max));
+  frame f = frame_from_n(v3_scale(dc, 1 / dist));
+  o->o = p;
+  o->d = frame_to_world(&f, sample_uniform_cone(u[2], u[3], cos_max));
+  float inv_pdf = 2 * PI_F * (1 - cos_max);
+  if (l->type == LIGHT_POINT) {
+    o->n = v3(0, 0, 0);
+    o->beta = c3_scale(l->L, inv_pdf);
+    return 1;
+  }
+  float cosn = v3_dot(o->d, l->n);
+  o->n = v3_scale(l->n, cosn >= 0 ? 1.0f : -1.0f); /* the side it leaves from */
+  float tu, tv;
+  scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
+  rgb Le = light_area_radiance(s, l, l->n, o->d, tu, tv); /* zero behind a one-sided light */
+  /* Le |cos| / ((1/A) pdf_cone) */
+  o->beta = c3_scale(Le, fabsf(cosn) * l->area * inv_pdf);
+  return 1;
+}

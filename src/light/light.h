@@ -156,4 +156,10 @@ float light_power(const scene *s, const light *l);
  * u: four uniform numbers. Returns 0 when the sample carries nothing. */
 typedef struct light_emit { vec3 o, d, n; rgb beta; } light_emit;
 int light_sample_emit(const scene *s, const light *l, const float u[4], light_emit *out);
+/* The same ray of light, its direction drawn uniformly in the cone that the sphere (c, r)
+ * subtends from the point drawn (Jensen's projection maps: caustic photons aimed at the
+ * specular objects), beta its flux for that density (zero where the light does not emit
+ * that way). Area and point lights only, from outside the sphere: else 0 and nothing is
+ * drawn (the caller falls back to light_sample_emit). */
+int light_sample_emit_toward(const scene *s, const light *l, const float u[4], vec3 c, float r, light_emit *out);
 #endif
