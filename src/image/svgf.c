@@ -13,7 +13,7 @@
 #define NORMAL_POW 7      /* normals: max(0, n_p . n_q)^(2^7) */
 #define REPROJ_DEPTH 0.05f  /* a history pixel is the same surface within 5 % of depth */
 #define REPROJ_NORMAL 0.9f  /* and a normal within about 25 degrees */
-#define REPROJ_ALBEDO 0.3f  /* and an albedo within 0.3 (summed over r, g, b) */
+#define REPROJ_ALBEDO 0.3f  /* and, after a move, an albedo within 0.3 (summed over r, g, b) */
 #define MOMENTS_MIN 4.0f    /* fewer samples: the variance from the 5x5 neighbourhood */
 
 struct svgf {
