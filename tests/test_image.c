@@ -374,6 +374,28 @@ static int bloom(void) {
   return 0;
 }
 
+/* The denoisers' shared measures. The contrast of an 8-pixel checkerboard (light squares
+ * over dark ones, green) in the window x 32..63, y 16..47 of a W-wide image, and the
+ * truth's. */
+static void checker_contrast(const float *out, const float *truth, int W, double *con, double *con_t) {
+  double hi[2] = {0, 0}, lo[2] = {0, 0};
+  for (int y = 16; y < 48; y++)
+    for (int x = 32; x < 64; x++) {
+      int i = 3 * (y * W + x) + 1, dark = !((x / 8 + y / 8) & 1);
+      (dark ? lo : hi)[0] += out[i];
+      (dark ? lo : hi)[1] += truth[i];
+    }
+  *con = hi[0] / lo[0];
+  *con_t = hi[1] / lo[1];
+}
+/* The mean red of the columns either side of x = W/2 (the normal edge). */
+static void edge_means(const float *out, int W, int H, double *l, double *r) {
+  *l = *r = 0;
+  for (int y = 0; y < H; y++) { *l += out[3 * (y * W + W / 2 - 1)]; *r += out[3 * (y * W + W / 2)]; }
+  *l /= H;
+  *r /= H;
+}
+
 /* ---- the still-image denoiser (image/denoise.h) on images whose truth is known: a
  * constant image stays constant; a noisy smooth ramp (Gaussian noise of known variance)
  * comes at least 4x closer to it in relMSE; a checkerboard in albedo under a smooth
@@ -429,14 +451,8 @@ static int denoiser(void) {
       }
     }
   CHECK(denoise_image(&in, out, 2) == 0, "denoise");
-  double hi[2] = {0, 0}, lo[2] = {0, 0};
-  for (int y = 16; y < 48; y++)
-    for (int x = 32; x < 64; x++) {
-      int i = 3 * (y * W + x) + 1, dark = !((x / 8 + y / 8) & 1);
-      (dark ? lo : hi)[0] += out[i];
-      (dark ? lo : hi)[1] += truth[i];
-    }
-  double con = hi[0] / lo[0], con_t = hi[1] / lo[1];
+  double con, con_t;
+  checker_contrast(out, truth, W, &con, &con_t);
   fprintf(stderr, "denoiser: checkerboard contrast %.4f (truth %.4f)\n", con, con_t);
   CHECK(fabs(con / con_t - 1) < 0.02, "checkerboard contrast %.4f against %.4f", con, con_t);
   /* two surfaces: normals +z on the left half (radiance 0.3), +x on the right (0.9) */
@@ -453,9 +469,8 @@ static int denoiser(void) {
       }
     }
   CHECK(denoise_image(&in, out, 2) == 0, "denoise");
-  double l = 0, r = 0;
-  for (int y = 0; y < H; y++) { l += out[3 * (y * W + W / 2 - 1)]; r += out[3 * (y * W + W / 2)]; }
-  l /= H; r /= H;
+  double l, r;
+  edge_means(out, W, H, &l, &r);
   fprintf(stderr, "denoiser: beside the normal edge %.4f | %.4f (truth 0.3 | 0.9)\n", l, r);
   CHECK(fabs(l / 0.3 - 1) < 0.02 && fabs(r / 0.9 - 1) < 0.02, "the edge bled: %.4f | %.4f", l, r);
   free(col); free(var); free(alb); free(nrm); free(dep); free(out); free(out3); free(truth);
@@ -561,14 +576,8 @@ static int svgf_filter(void) {
       }
     }
   CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
-  double hi[2] = {0, 0}, lo[2] = {0, 0};
-  for (int y = 16; y < 48; y++)
-    for (int x = 32; x < 64; x++) {
-      int i = 3 * (y * W + x) + 1, dark = !((x / 8 + y / 8) & 1);
-      (dark ? lo : hi)[0] += out[i];
-      (dark ? lo : hi)[1] += truth[i];
-    }
-  double con = hi[0] / lo[0], con_t = hi[1] / lo[1];
+  double con, con_t;
+  checker_contrast(out, truth, W, &con, &con_t);
   fprintf(stderr, "svgf: checkerboard contrast %.4f (truth %.4f)\n", con, con_t);
   CHECK(fabs(con / con_t - 1) < 0.02, "checkerboard contrast %.4f against %.4f", con, con_t);
   /* two surfaces: normals +z on the left half (radiance 0.3), +x on the right (0.9) */
@@ -585,9 +594,8 @@ static int svgf_filter(void) {
       }
     }
   CHECK(svgf_run(s, &f, out, 2) == 0, "svgf");
-  double l = 0, r = 0;
-  for (int y = 0; y < H; y++) { l += out[3 * (y * W + W / 2 - 1)]; r += out[3 * (y * W + W / 2)]; }
-  l /= H; r /= H;
+  double l, r;
+  edge_means(out, W, H, &l, &r);
   fprintf(stderr, "svgf: beside the normal edge %.4f | %.4f (truth 0.3 | 0.9)\n", l, r);
   CHECK(fabs(l / 0.3 - 1) < 0.02 && fabs(r / 0.9 - 1) < 0.02, "the edge bled: %.4f | %.4f", l, r);
   svgf_destroy(s); svgf_destroy(s3);

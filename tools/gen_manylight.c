@@ -118,10 +118,6 @@ static void lamps(FILE *obj, FILE *mtl, int n, v3 lo, v3 hi, double edge, double
   }
 }
 
-/* n lamps lying flat `gap` in front of the room's ceiling (y = 2.5), back (z = -2), left
- * (x = -2) and right (x = 2) faces, facing into the room: equilateral, of edge `edge`,
- * radiance L0 times 1, 20^(1/2) or 20 (a third each), tinted. Lamps are spread over the
- * faces in proportion to their areas. */
 /* Two triangles in one plane (2D points) overlap: no edge normal of either separates them. */
 static int tri2_overlap(const double a[3][2], const double b[3][2]) {
   for (int s = 0; s < 2; s++) {
@@ -145,33 +141,45 @@ static int tri2_overlap(const double a[3][2], const double b[3][2]) {
  * share of light from overlaps). Placed by rejection: a lamp that would overlap one
  * already on its face is drawn again. */
 #define WALL_LAMPS_MAX 2048
-static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, double L0) {
+/* Lamp i's centre, normal and turn: `gap` in front of the room's ceiling (y = 2.5), back
+ * (z = -2), left (x = -2) or right (x = 2) face, facing into the room, the faces drawn in
+ * proportion to their areas; with `apart`, drawn again while it overlaps a lamp placed
+ * before on its face (i lamps so far). */
+static void wall_place(int i, double edge, double gap, int apart, v3 *c, v3 *nn, double *rot) {
   static double placed[WALL_LAMPS_MAX][3][2];
   static int face_of[WALL_LAMPS_MAX];
+  double tri[3][2];
+  int face;
+  for (;;) {
+    double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd();
+    double m = edge; /* keep whole triangles on their face */
+    if (a < 16) { *c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); *nn = mk(0, -1, 0); face = 0; }
+    else if (a < 26) { *c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); *nn = mk(0, 0, 1); face = 1; }
+    else if (a < 36) { *c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); *nn = mk(1, 0, 0); face = 2; }
+    else { *c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); *nn = mk(-1, 0, 0); face = 3; }
+    *rot = 2 * PI * rnd();
+    if (!apart) return;
+    v3 p[3];
+    lamp_points(*c, *nn, edge, *rot, p);
+    for (int k = 0; k < 3; k++) {
+      tri[k][0] = face == 2 || face == 3 ? p[k].z : p[k].x;
+      tri[k][1] = face == 0 ? p[k].z : p[k].y;
+    }
+    int clash = 0;
+    for (int j = 0; j < i && !clash; j++) clash = face_of[j] == face && tri2_overlap(tri, (const double(*)[2])placed[j]);
+    if (!clash) break;
+  }
+  memcpy(placed[i], tri, sizeof tri);
+  face_of[i] = face;
+}
+
+/* n lamps lying flat on the walls (wall_place, none overlapping), equilateral, of edge
+ * `edge`, radiance L0 times 1, 20^(1/2) or 20 (a third each), tinted. */
+static void wall_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, double L0) {
   for (int i = 0; i < n && i < WALL_LAMPS_MAX; i++) {
     v3 c, nn;
-    double rot, tri[3][2];
-    int face;
-    for (;;) {
-      double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd();
-      double m = edge; /* keep whole triangles on their face */
-      if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); face = 0; }
-      else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); face = 1; }
-      else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); face = 2; }
-      else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); face = 3; }
-      rot = 2 * PI * rnd();
-      v3 p[3];
-      lamp_points(c, nn, edge, rot, p);
-      for (int k = 0; k < 3; k++) {
-        tri[k][0] = face == 2 || face == 3 ? p[k].z : p[k].x;
-        tri[k][1] = face == 0 ? p[k].z : p[k].y;
-      }
-      int clash = 0;
-      for (int j = 0; j < i && !clash; j++) clash = face_of[j] == face && tri2_overlap(tri, (const double(*)[2])placed[j]);
-      if (!clash) break;
-    }
-    memcpy(placed[i], tri, sizeof tri);
-    face_of[i] = face;
+    double rot;
+    wall_place(i, edge, gap, 1, &c, &nn, &rot);
     double R, G, B;
     double sat = 0.1 + 0.4 * rnd(), hue = rnd();
     hsv(hue, sat, 1, &R, &G, &B);
@@ -189,31 +197,10 @@ static void heldout_lamps(FILE *obj, FILE *mtl, int n, double edge, double gap, 
     double sat = 0.15 + 0.45 * rnd(), hue = rnd();
     hsv(hue, sat, 1, &pal[t][0], &pal[t][1], &pal[t][2]);
   }
-  static double placed[WALL_LAMPS_MAX][3][2];
-  static int face_of[WALL_LAMPS_MAX];
   for (int i = 0; i < n && i < WALL_LAMPS_MAX; i++) {
     v3 c, nn;
-    double rot, tri[3][2];
-    int face;
-    for (;;) {
-      double a = rnd() * (16.0 + 3 * 10.0), u = rnd(), v = rnd(), m = edge;
-      if (a < 16) { c = mk(-2 + m + (4 - 2 * m) * u, 2.5 - gap, -2 + m + (4 - 2 * m) * v); nn = mk(0, -1, 0); face = 0; }
-      else if (a < 26) { c = mk(-2 + m + (4 - 2 * m) * u, m + (2.5 - 2 * m) * v, -2 + gap); nn = mk(0, 0, 1); face = 1; }
-      else if (a < 36) { c = mk(-2 + gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(1, 0, 0); face = 2; }
-      else { c = mk(2 - gap, m + (2.5 - 2 * m) * v, -2 + m + (4 - 2 * m) * u); nn = mk(-1, 0, 0); face = 3; }
-      rot = 2 * PI * rnd();
-      if (!apart) break;
-      v3 p[3];
-      lamp_points(c, nn, edge, rot, p);
-      for (int k = 0; k < 3; k++) {
-        tri[k][0] = face == 2 || face == 3 ? p[k].z : p[k].x;
-        tri[k][1] = face == 0 ? p[k].z : p[k].y;
-      }
-      int clash = 0;
-      for (int j = 0; j < i && !clash; j++) clash = face_of[j] == face && tri2_overlap(tri, (const double(*)[2])placed[j]);
-      if (!clash) break;
-    }
-    if (apart) { memcpy(placed[i], tri, sizeof tri); face_of[i] = face; }
+    double rot;
+    wall_place(i, edge, gap, apart, &c, &nn, &rot);
     int t = (int)(8 * rnd()), level = (int)(3 * rnd());
     double L = L0 * pow(20.0, 0.5 * level);
     lamp(obj, mtl, i, c, nn, edge, rot, pal[t][0] * L, pal[t][1] * L, pal[t][2] * L);

@@ -25,8 +25,8 @@ struct svgf {
   /* this frame: the albedo divided out, its radiance (finite), its moments, a-trous colour
    * and variance (ping-pong), depth gradient */
   float *alb, *rad, *cmom, *c[2], *v[2], *gz, *sd;
-  unsigned char *kind; /* 0 nothing hit, 1 a surface, 2 a lamp (no albedo): never mixed */
-  float *kindf;        /* the same as floats (the vectorised a-trous loop) */
+  float *kind;         /* 0 nothing hit, 1 a surface, 2 a lamp (no albedo): never mixed (floats for
+                          the vectorised a-trous loop) */
 };
 
 float svgf_history(const svgf *s, int x, int y) { return s->have ? s->hlen[(size_t)y * s->w + x] : 0; }
@@ -55,9 +55,8 @@ svgf *svgf_create(int w, int h) {
   size_t np = (size_t)w * h;
   /* one block: 3+3+3+2+1+3+1 history, 3+3+3+2+1 prior, 3+3+2+3+3+1+1+1+1 frame */
   float *b = calloc(np * 46, sizeof(float));
-  s->kind = calloc(np, 1);
-  s->kindf = calloc(np, sizeof(float));
-  if (!b || !s->kind || !s->kindf) { free(b); free(s->kind); free(s->kindf); free(s); return NULL; }
+  s->kind = calloc(np, sizeof(float));
+  if (!b || !s->kind) { free(b); free(s->kind); free(s); return NULL; }
   float **slot[] = {&s->hcol, &s->halb, &s->hemi, &s->hmom, &s->hlen, &s->hnrm, &s->hdep, &s->pcol, &s->palb, &s->pemi, &s->pmom, &s->plen,
                     &s->alb, &s->rad, &s->cmom, &s->c[0], &s->c[1], &s->v[0], &s->v[1], &s->gz, &s->sd};
   const int size[] = {3, 3, 3, 2, 1, 3, 1, 3, 3, 3, 2, 1, 3, 3, 2, 3, 3, 1, 1, 1, 1};
@@ -72,7 +71,6 @@ void svgf_destroy(svgf *s) {
   if (!s) return;
   free(s->hcol); /* the block */
   free(s->kind);
-  free(s->kindf);
   free(s);
 }
 
@@ -203,8 +201,7 @@ static void st_integrate(void *user, int64_t y, int thread) {
     for (int c = 0; c < 3; c++) s->hnrm[3 * p + c] = f->normal[3 * p + c];
     float d = f->depth[p], asum = s->halb[3 * p] + s->halb[3 * p + 1] + s->halb[3 * p + 2], la = lum3(&s->alb[3 * p]);
     s->hdep[p] = d;
-    s->kind[p] = !(d > 0) ? 0 : asum < ALBEDO_MIN ? 2 : 1;
-    s->kindf[p] = s->kind[p];
+    s->kind[p] = !(d > 0) ? 0.0f : asum < ALBEDO_MIN ? 2.0f : 1.0f;
     /* the variance of the estimate, divided by the albedo as the colour is */
     s->v[0][p] = j->known && N >= MOMENTS_MIN ? fmaxf(0, m2 - m1 * m1) / N / (la * la) : -1;
     /* depth gradient: the smaller one-sided difference on each axis (edges do not count) */
@@ -385,7 +382,7 @@ static void st_atrous(void *user, int64_t yy, int thread) {
   float *row = malloc((size_t)w * 10 * sizeof *row);
   if (!row) { j->failed = 1; return; }
   float *lp = row, *iz0 = lp + w, *iz1 = iz0 + w, *ar = iz1 + w, *ag = ar + w, *ab = ag + w, *ws = ab + w, *vs = ws + w, *surf = vs + w;
-  const float *kf = s->kindf;
+  const float *kf = s->kind;
   size_t p0 = (size_t)y * w;
   for (int x = 0; x < w; x++) {
     size_t p = p0 + x;

@@ -94,6 +94,13 @@ static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float
   scene_tri_uv(s, l->tri, bb1, bb2, tu, tv);
 }
 
+/* A uniform point on area light l's triangle from (u1, u2), with its barycentrics
+ * (of v[0] and v[1]). */
+static vec3 area_point(const light *l, float u1, float u2, float *b0, float *b1) {
+  sample_uniform_triangle(u1, u2, b0, b1);
+  return v3_add(v3_add(v3_scale(l->v[0], *b0), v3_scale(l->v[1], *b1)), v3_scale(l->v[2], 1 - *b0 - *b1));
+}
+
 int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g) {
   *g = 1;
   switch (l->type) {
@@ -128,7 +135,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
   o->delta = 0;
   switch (l->type) {
   case LIGHT_AREA: {
-    vec3 a = l->v[0], b = l->v[1], c = l->v[2];
+    vec3 a = l->v[0];
     vec3 n = l->n;
     vec3 dir[3];
     float omega = solid_angle_if_used(l, p, dir);
@@ -151,8 +158,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
       o->pdf = 1 / omega;
       return isfinite(o->pdf) && o->pdf > 0;
     }
-    sample_uniform_triangle(u1, u2, &b0, &b1);
-    pl = v3_add(v3_add(v3_scale(a, b0), v3_scale(b, b1)), v3_scale(c, 1 - b0 - b1));
+    pl = area_point(l, u1, u2, &b0, &b1);
     vec3 d = v3_sub(pl, p);
     float d2 = v3_len2(d);
     if (!(d2 > 0)) return 0;
@@ -221,10 +227,8 @@ int light_sample_emit(const scene *s, const light *l, const float u[4], light_em
   o->n = v3(0, 0, 0);
   switch (l->type) {
   case LIGHT_AREA: {
-    vec3 a = l->v[0], b = l->v[1], c = l->v[2];
     float b0, b1;
-    sample_uniform_triangle(u[0], u[1], &b0, &b1);
-    o->o = v3_add(v3_add(v3_scale(a, b0), v3_scale(b, b1)), v3_scale(c, 1 - b0 - b1));
+    o->o = area_point(l, u[0], u[1], &b0, &b1);
     vec3 n = l->n;
     float uu = u[2], side = 1;
     if (l->two_sided) { side = uu < 0.5f ? 1.0f : -1.0f; uu = uu < 0.5f ? 2 * uu : 2 * uu - 1; }
@@ -285,10 +289,7 @@ int light_sample_emit_toward(const scene *s, const light *l, const float u[4], v
   if (l->type != LIGHT_AREA && l->type != LIGHT_POINT) return 0;
   vec3 p = l->p;
   float b0 = 0, b1 = 0;
-  if (l->type == LIGHT_AREA) {
-    sample_uniform_triangle(u[0], u[1], &b0, &b1);
-    p = v3_add(v3_add(v3_scale(l->v[0], b0), v3_scale(l->v[1], b1)), v3_scale(l->v[2], 1 - b0 - b1));
-  }
+  if (l->type == LIGHT_AREA) p = area_point(l, u[0], u[1], &b0, &b1);
   vec3 dc = v3_sub(c, p);
   float dist = v3_len(dc);
   if (!(dist > r * 1.001f)) return 0; /* inside the sphere: every direction */
