@@ -9,7 +9,8 @@
  * starting exactly on a surface, kd-tree against brute force exactly (except where a ray
  * grazes brute force's triangle so closely that its t's error bound covers the kd-tree's
  * farther hit) and Embree within tolerance (nearly axis-aligned walls fell out of cells
- * they reach). walk_matches_trace checks the instruments of bench_raykernel --bound. */
+ * they reach). The same shadow rays in batches (accel_occluded_n, Embree's streams) agree
+ * alike. walk_matches_trace checks the instruments of bench_raykernel --bound. */
 #include "harness.h"
 #include "load/load.h"
 #include "scene/scene.h"
@@ -153,8 +154,22 @@ static int check_scene_rays(const char *path, int nrays, const char *kind, int a
       if (strict || fabsf(bh[i].t - stmax[i]) > 1e-4f * stmax[i]) { if (bad_occl++ < 5) fprintf(stderr, "ray %d: occluded %d vs brute %d\n", i, o, bo[i]); }
     }
   }
-  fprintf(stderr, "%s on %s: %d rays, %d hits, %d ties on shared edges, %d hit mismatches, %d shadow mismatches\n", kind, path,
-          nrays, nhit, tie, bad_hit, bad_occl);
+  /* The same shadow rays in batches of up to 300 (accel_occluded_n: Embree's streams). */
+  int bad_occl_n = 0;
+  ray *sr_n = malloc(300 * sizeof *sr_n);
+  uint8_t blocked[300];
+  for (int i0 = 0; i0 < nrays; i0 += 300) {
+    int m = nrays - i0 < 300 ? nrays - i0 : 300;
+    for (int k = 0; k < m; k++) { sr_n[k] = rays[i0 + k]; sr_n[k].tmax = stmax[i0 + k]; }
+    accel_occluded_n(a, sr_n, blocked, m);
+    for (int k = 0, i = i0; k < m; k++, i++)
+      if (blocked[k] != bo[i] && (strict || fabsf(bh[i].t - stmax[i]) > 1e-4f * stmax[i])) {
+        if (bad_occl_n++ < 5) fprintf(stderr, "ray %d in a batch: occluded %d vs brute %d\n", i, blocked[k], bo[i]);
+      }
+  }
+  free(sr_n);
+  fprintf(stderr, "%s on %s: %d rays, %d hits, %d ties on shared edges, %d hit mismatches, %d shadow mismatches (%d in batches)\n", kind,
+          path, nrays, nhit, tie, bad_hit, bad_occl, bad_occl_n);
   accel_destroy(a);
   free(rays); free(stmax); free(bh); free(bf); free(bo);
   scene_free(s);
@@ -165,6 +180,7 @@ static int check_scene_rays(const char *path, int nrays, const char *kind, int a
   int allowed = strict ? 0 : nrays / 10000;
   CHECK(bad_hit <= allowed, "%d closest-hit mismatches (allowed %d)", bad_hit, allowed);
   CHECK(bad_occl <= allowed, "%d shadow-query mismatches (allowed %d)", bad_occl, allowed);
+  CHECK(bad_occl_n <= allowed, "%d shadow-query mismatches in batches (allowed %d)", bad_occl_n, allowed);
   return 0;
 }
 

@@ -112,6 +112,10 @@ typedef struct valo_options {
                              the environment) are not drawn; seen through a mirror or
                              glass, and the light they cast, they are (Mitsuba's
                              hide_emitters); VALO_UNSET = no */
+  int batch;              /* camera samples a thread traces together, stage by stage, with
+                             an integrator that can (path): 1 to 1024, 1 = one path at a
+                             time; the image is the same bit for bit on the kd-tree, the
+                             same in distribution with Embree; VALO_UNSET = 256 */
 } valo_options;
 
 #define VALO_AOVS_AO 2

@@ -34,6 +34,9 @@ typedef struct accel_ops {
   /* Any hit with 0 < t < r->tmax. */
   int (*occluded)(const accel *a, const ray *r);
   void (*destroy)(accel *a);
+  /* n any-hit queries at once (blocked[i] = occluded(r[i])), or NULL: one at a time.
+   * Embree's stream query (rtcOccluded1M) groups the rays into packets. */
+  void (*occluded_n)(const accel *a, const ray *r, uint8_t *blocked, int n);
 } accel_ops;
 struct accel { const accel_ops *ops; };
 
@@ -60,6 +63,10 @@ valo_status accel_create(const char *kind, const vec3 *pos, uint32_t npos, const
                          const accel_filter *filter, accel **out, valo_error *err);
 static inline int accel_intersect(const accel *a, const ray *r, hit *h) { return a->ops->intersect(a, r, h); }
 static inline int accel_occluded(const accel *a, const ray *r) { return a->ops->occluded(a, r); }
+static inline void accel_occluded_n(const accel *a, const ray *r, uint8_t *blocked, int n) {
+  if (a->ops->occluded_n) { a->ops->occluded_n(a, r, blocked, n); return; }
+  for (int i = 0; i < n; i++) blocked[i] = (uint8_t)a->ops->occluded(a, &r[i]);
+}
 static inline void accel_destroy(accel *a) { if (a) a->ops->destroy(a); }
 
 valo_status kdtree_create(const vec3 *pos, const uint32_t *idx, uint32_t ntris, int threads, const accel_filter *filter, accel **out,

@@ -1,5 +1,5 @@
 /* embree.c — owns the Embree 3 backend behind accel.h: one triangle geometry on the
- * scene's own vertex/index arrays (shared; copied when no spare vertex follows), robust (watertight) scene flag, rtcIntersect1/rtcOccluded1. Every
+ * scene's own vertex/index arrays (shared; copied when no spare vertex follows), robust (watertight) scene flag, rtcIntersect1/rtcOccluded1 (and rtcOccluded1M for a batch). Every
  * candidate hit Embree finds is tested again by valo's own watertight test
  * (geometry/triangle.h, the kd-tree's), whose error valo's offset ray origins are made
  * for: Embree's own test, less precise on large triangles, let a ray find the surface it
@@ -129,6 +129,53 @@ static int em_occluded(const accel *a, const ray *r) {
   rtcOccluded1(e->scn, &q.ctx, &ry);
   return ry.tfar < 0;
 }
+/* The stream query's context: the rays, found by the id each Embree ray carries. */
+typedef struct em_query_n {
+  struct RTCIntersectContext ctx;
+  const embree_accel *e;
+  const ray *r;
+} em_query_n;
+
+/* em_verify for the rays of a stream (RTCRayN is SoA: ... tfar mask id flags, id at
+ * 10 N). */
+static void em_verify_n(const struct RTCFilterFunctionNArguments *args) {
+  const em_query_n *q = (const em_query_n *)args->context;
+  const unsigned *ids = (const unsigned *)args->ray + 10 * (size_t)args->N;
+  for (unsigned i = 0; i < args->N; i++) {
+    if (args->valid[i] != -1) continue;
+    const ray *r = &q->r[ids[i]];
+    unsigned prim = ((const unsigned *)args->hit)[5 * args->N + i];
+    float v[9], t, b1, b2;
+    em_corners(q->e, prim, v);
+    ray_shear sh = ray_shear_make(r->o, r->d);
+    if (!tri_intersect(&sh, v, r->tmax, &t, &b1, &b2) && em_left(v, r->o, r->d)) args->valid[i] = 0;
+  }
+}
+
+/* em_occluded for n rays, given to Embree as streams of up to 256 (rtcOccluded1M). */
+static void em_occluded_n(const accel *a, const ray *r, uint8_t *blocked, int n) {
+  const embree_accel *e = (const embree_accel *)a;
+  em_query_n q;
+  rtcInitIntersectContext(&q.ctx);
+  q.ctx.filter = em_verify_n;
+  q.e = e;
+  enum { CHUNK = 256 };
+  struct RTCRay ry[CHUNK];
+  for (int k0 = 0; k0 < n; k0 += CHUNK) {
+    int m = n - k0 < CHUNK ? n - k0 : CHUNK;
+    q.r = r + k0;
+    for (int i = 0; i < m; i++) {
+      const ray *ri = &r[k0 + i];
+      struct RTCRay *y = &ry[i];
+      y->org_x = ri->o.x; y->org_y = ri->o.y; y->org_z = ri->o.z;
+      y->dir_x = ri->d.x; y->dir_y = ri->d.y; y->dir_z = ri->d.z;
+      y->tnear = 0; y->tfar = ri->tmax; y->time = 0; y->mask = 0xFFFFFFFF; y->id = (unsigned)i; y->flags = 0;
+    }
+    rtcOccluded1M(e->scn, &q.ctx, ry, (unsigned)m, sizeof(struct RTCRay));
+    for (int i = 0; i < m; i++) blocked[k0 + i] = ry[i].tfar < 0;
+  }
+}
+
 static void em_destroy(accel *a) {
   embree_accel *e = (embree_accel *)a;
   if (!e) return;
@@ -136,7 +183,7 @@ static void em_destroy(accel *a) {
   if (e->dev) rtcReleaseDevice(e->dev);
   free(e);
 }
-static const accel_ops em_ops = {"embree", em_intersect, em_occluded, em_destroy};
+static const accel_ops em_ops = {"embree", em_intersect, em_occluded, em_destroy, em_occluded_n};
 
 int embree_available(void) { return 1; }
 

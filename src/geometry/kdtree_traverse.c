@@ -280,4 +280,4 @@ void kdtree_free(kdtree *kd) {
   free(kd->tv); free(kd->nodes); free(kd->prims); free(kd->ids); free(kd->gfilt); free(kd);
 }
 static void kd_destroy(accel *a) { kdtree_free((kdtree *)a); }
-const accel_ops kdtree_ops = {"kdtree", kd_intersect, kd_occluded, kd_destroy};
+const accel_ops kdtree_ops = {"kdtree", kd_intersect, kd_occluded, kd_destroy, NULL};

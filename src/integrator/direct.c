@@ -29,8 +29,10 @@ int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *be
   return 0;
 }
 
+ray segment_ray_from(const isect *it, vec3 p_to, vec3 n_to) { return segment_ray(offset_origin_isect(it, v3_sub(p_to, it->p)), it->p, p_to, n_to); }
+
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
-  ray r = segment_ray(offset_origin_isect(it, v3_sub(p_to, it->p)), it->p, p_to, n_to);
+  ray r = segment_ray_from(it, p_to, n_to);
   ts->rays++;
   return accel_occluded(c->acc, &r);
 }

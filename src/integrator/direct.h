@@ -17,8 +17,9 @@ ray segment_ray(vec3 o, vec3 from, vec3 p_to, vec3 n_to);
  * from the last origin) and *it, and in *before the distance from r's origin to that
  * last origin; 0 when nothing solid lies within r.tmax. */
 int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *before, thread_stats *ts);
-/* Is the segment from it (leaving towards p_to) blocked? (segment_ray from it's offset
- * origin) */
+/* segment_ray from it's offset origin (leaving towards p_to) to p_to. */
+ray segment_ray_from(const isect *it, vec3 p_to, vec3 n_to);
+/* Is the segment from it (leaving towards p_to) blocked? (segment_ray_from) */
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);
 /* Picks a light for point p (the sampler's next 1D value) and samples it (the next 2D):
  * returns its index with *pmf and *ls, or UINT32_MAX when nothing came out. it: the

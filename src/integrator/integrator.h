@@ -47,6 +47,7 @@ typedef struct render_ctx {
   double time_budget;      /* seconds, or 0 */
 } render_ctx;
 #define PATH_HARD_CAP 1024
+#define LI_BATCH_MAX 1024 /* camera rays per li_n call */
 
 /* Integrators (ARCHITECTURE.md, "Growing the integrator interface"). Per-ray ones give
  * li() and get the shared tile loop. Those that work on the whole scene before the camera
@@ -86,6 +87,9 @@ typedef struct integrator_ops {
   const integrator_param *params; /* table ended by a NULL name, or NULL */
   /* Radiance arriving along camera ray r. */
   rgb (*li)(const render_ctx *c, ray r, sampler *smp, thread_stats *ts);
+  /* Optional: li for n <= LI_BATCH_MAX camera rays at once (out[i] from r[i] and smp[i]),
+   * the same numbers as n calls of li, with the rays of each stage queried together. */
+  void (*li_n)(const render_ctx *c, const ray *r, sampler *smp, thread_stats *ts, rgb *out, int n);
   valo_status (*create)(const render_ctx *c, void **state, valo_error *err);
   valo_status (*prepare)(void *state, const render_ctx *c, int sample_index, valo_error *err);
   void (*destroy)(void *state);

@@ -68,6 +68,7 @@ valo_status session_create(const scene *s, const valo_options *opts, const integ
   ss->ctx.acc = ss->acc;
   ss->ctx.max_depth = o.max_depth;
   ss->ctx.rr_depth = o.rr_depth;
+  ss->batch = integ->li_n && o.batch > 1 ? (o.batch < LI_BATCH_MAX ? o.batch : LI_BATCH_MAX) : 1;
   ss->ctx.hide_emitters = o.hide_emitters > 0;
   ss->ctx.param = ss->param;
   ss->ctx.seed = (uint64_t)o.seed;

@@ -49,6 +49,7 @@ struct session {
   camera cam_still;        /* the scene camera fitted to the film (frame 0 of an animation) */
   cam_lens lens;           /* this frame's camera and lens */
   pixel_filter filter;     /* the lens's pixel filter (lens.filter: NULL for the box of one pixel) */
+  int batch;               /* camera samples traced together by integ->li_n (1: li one by one) */
   int splat;               /* samples splatted through filter (film.wsum; tiles.c renders tiles
                               in four rounds so that no two threads reach one pixel) */
   cam_view view_prev;      /* the previous frame's */

@@ -25,25 +25,71 @@ int tiles_set_view(session *ss, int f) {
   return bad;
 }
 
-void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts) {
+/* A camera sample's start: its sampler, the splat's jitter (the numbers camera_ray
+ * takes), the camera ray and the AOVs of its first hit. */
+typedef struct cam_sample {
+  int x, y;
+  sampler smp;
+  ray r;
+  float w, jx, jy;
+} cam_sample;
+
+static void sample_start(session *ss, int x, int y, int si, thread_stats *ts, cam_sample *cs) {
   uint64_t pix = (uint64_t)y * (uint64_t)ss->opt.width + (uint64_t)x;
   /* the random numbers of the frame's pixel, so that a crop is that part of the frame's image */
   uint64_t frame_pix = (uint64_t)(y + ss->crop_y) * (uint64_t)ss->frame_w + (uint64_t)(x + ss->crop_x);
+  cs->x = x;
+  cs->y = y;
+  cs->smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
+  cs->jx = cs->jy = 0;
+  if (ss->splat) { /* camera_ray's jitter over the pixel, the same numbers */
+    sampler j = cs->smp;
+    sampler_set_dim(&j, SDIM_FILM);
+    sampler_2d(&j, &cs->jx, &cs->jy);
+  }
+  cs->r = camera_ray(&ss->lens, x, y, &cs->smp, &cs->w);
+  ts->rays++;
+  if (ss->film.aov) aov_record(ss, cs->r, &ss->film.aov[AOV_FLOATS * pix], &cs->smp, ts);
+}
+
+static void sample_finish(session *ss, const cam_sample *cs, rgb L, thread_stats *ts) {
+  uint64_t pix = (uint64_t)cs->y * (uint64_t)ss->opt.width + (uint64_t)cs->x;
+  if (ss->splat) film_add_splat(&ss->film, pix, (float)cs->x + cs->jx, (float)cs->y + cs->jy, L, &ss->filter, ts);
+  else film_add(&ss->film, pix, L, cs->w, ts);
+}
+
+void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts) {
   for (int si = s0; si < s1; si++) {
-    sampler smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
-    float w;
-    float jx = 0, jy = 0;
-    if (ss->splat) { /* camera_ray's jitter over the pixel, the same numbers */
-      sampler j = smp;
-      sampler_set_dim(&j, SDIM_FILM);
-      sampler_2d(&j, &jx, &jy);
-    }
-    ray ry = camera_ray(&ss->lens, x, y, &smp, &w);
-    ts->rays++;
-    if (ss->film.aov) aov_record(ss, ry, &ss->film.aov[AOV_FLOATS * pix], &smp, ts);
-    rgb L = ss->integ->li(&ss->ctx, ry, &smp, ts);
-    if (ss->splat) film_add_splat(&ss->film, pix, (float)x + jx, (float)y + jy, L, &ss->filter, ts);
-    else film_add(&ss->film, pix, L, w, ts);
+    cam_sample cs;
+    sample_start(ss, x, y, si, ts, &cs);
+    sample_finish(ss, &cs, ss->integ->li(&ss->ctx, cs.r, &cs.smp, ts), ts);
+  }
+}
+
+/* Samples traced together (integ->li_n): taken in the tile loop's order and added to the
+ * film in that order, so each pixel sums its samples as tiles_sample_pixel does. */
+typedef struct sample_batch {
+  int n;
+  cam_sample cs[LI_BATCH_MAX];
+  ray r[LI_BATCH_MAX];
+  sampler smp[LI_BATCH_MAX];
+  rgb L[LI_BATCH_MAX];
+} sample_batch;
+
+static void batch_flush(session *ss, sample_batch *b, thread_stats *ts) {
+  for (int i = 0; i < b->n; i++) {
+    b->r[i] = b->cs[i].r;
+    b->smp[i] = b->cs[i].smp;
+  }
+  ss->integ->li_n(&ss->ctx, b->r, b->smp, ts, b->L, b->n);
+  for (int i = 0; i < b->n; i++) sample_finish(ss, &b->cs[i], b->L[i], ts);
+  b->n = 0;
+}
+
+static void batch_pixel(session *ss, sample_batch *b, int x, int y, int s0, int s1, thread_stats *ts) {
+  for (int si = s0; si < s1; si++) {
+    sample_start(ss, x, y, si, ts, &b->cs[b->n++]);
+    if (b->n == ss->batch) batch_flush(ss, b, ts);
   }
 }
 
@@ -64,13 +110,22 @@ uint64_t tiles_render_tile(session *ss, int64_t tile, int s0, int s1, const uint
   int x0, y0, x1, y1;
   tiles_rect(ss, tile, &x0, &y0, &x1, &y1);
   uint64_t taken = 0;
+  sample_batch bs, *b = ss->batch > 1 ? &bs : NULL; /* on the stack: about 150 KB */
+  bs.n = 0;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
-      if (!target) { tiles_sample_pixel(ss, x, y, s0, s1, ts); taken += (uint64_t)(s1 - s0); continue; }
-      size_t pix = (size_t)y * (size_t)ss->opt.width + (size_t)x;
-      int c = (int)ss->film.count[pix], t = (int)target[pix];
-      if (t > c) { tiles_sample_pixel(ss, x, y, c, t, ts); taken += (uint64_t)(t - c); }
+      int a = s0, e = s1;
+      if (target) {
+        size_t pix = (size_t)y * (size_t)ss->opt.width + (size_t)x;
+        a = (int)ss->film.count[pix];
+        e = (int)target[pix];
+      }
+      if (e <= a) continue;
+      if (b) batch_pixel(ss, b, x, y, a, e, ts);
+      else tiles_sample_pixel(ss, x, y, a, e, ts);
+      taken += (uint64_t)(e - a);
     }
+  if (b && b->n) batch_flush(ss, b, ts);
   return taken;
 }
 

@@ -1,9 +1,11 @@
 /* tiles.h — owns the per-ray tile loop (pbrt's ImageTileIntegrator): TILE x TILE tiles,
  * each pixel's samples taken in sample order, each sample a camera ray through the lens
- * (set per frame here), the AOVs of its first hit, and the integrator's li(); and the
- * source of a pass's tiles: this process's thread pool (tiles_local), or under MPI rank 0
- * handing them out to every rank (dist_master, render/dist.h), which calls back into the
- * loop here. The session holds one and the loop never asks which. */
+ * (set per frame here), the AOVs of its first hit, and the integrator's li() — or, for
+ * integrators with li_n, up to session.batch samples at once, added to the film in the
+ * same order; and the source of a pass's tiles: this process's thread pool
+ * (tiles_local), or under MPI rank 0 handing them out to every rank (dist_master,
+ * render/dist.h), which calls back into the loop here. The session holds one and the
+ * loop never asks which. */
 #ifndef VALO_TILES_H
 #define VALO_TILES_H
 #include "render/session.h"
