@@ -69,7 +69,7 @@ static int benchmark_frames(void) {
   /* restir-di: frame 6 carries the history of frames 1-5, as a sequence's frame 5 does
    * (on a still camera: the default scene has no camera animation) */
   const char *ml = scene();
-  const char *p = "candidates=4 iterations=1 spatial=2 unbiased=0";
+  const char *p = "candidates=4 iterations=1 spatial=2 unbiased=0 reservoirs=2"; /* over the viewer's reservoirs=1 */
   const char *b[] = {"view", ml, "--integrator", "restir-di", "--param", p, "--res", "48x36", "--benchmark", "6", "--no-denoise", "-o", scratch_path("restir-frame.exr"), NULL};
   rc = run_cli(b, 0, 300, g_out, sizeof g_out);
   CHECK(rc == 0 && sscanf(last_line(g_out), "fps %lf", &fps) == 1 && fps > 0, "restir-di benchmark: exit %d, last line %s", rc, last_line(g_out));
@@ -354,6 +354,7 @@ static int live_denoise(void) {
     valo_render_destroy(r);
     o.max_depth = -1;
     snprintf(o.integrator, sizeof o.integrator, "%s", integ[k]);
+    if (k) snprintf(o.params, sizeof o.params, "reservoirs=1"); /* the viewer's */
     o.aovs = k ? 1 : 1 | VALO_AOVS_VARIANCE;
     CHECK(valo_render_create(room, &o, &r, &err) == VALO_OK, "%s", err.message);
     o.threads = 1;

@@ -22,7 +22,7 @@
  * rounds cost more than they gain once history builds up, and let a bright sample spread);
  * restir-gi with one round of 2 neighbours. The user's --param entries come after it and win. */
 static const char realtime_params[] =
-    "restir-di.candidates=4 restir-di.iterations=0 restir-di.unbiased=0 "
+    "restir-di.candidates=4 restir-di.iterations=0 restir-di.unbiased=0 restir-di.reservoirs=1 "
     "restir-gi.candidates=4 restir-gi.iterations=1 restir-gi.spatial=2 restir-gi.direct_iterations=0 restir-gi.unbiased=0";
 
 static void usage_view(FILE *f) {

@@ -26,6 +26,7 @@ int restir_wrs_take(float *w_sum, float w, float u);
 
 typedef struct restir_cfg {
   int candidates, temporal, spatial, iterations, unbiased, jacobian;
+  int reservoirs; /* per pixel (restir-di), the candidates split among them */
   float history, radius, normal_threshold, depth_threshold;
 } restir_cfg;
 
@@ -37,6 +38,10 @@ typedef struct restir_cfg {
  * evaluation (for the shadow ray); returns 1 when a sample was kept. */
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
                          sampler *rng, di_res *r, light_li *kept);
+/* The same with candidate j taken as child first + j of `of` (a pixel's M candidates
+ * split among its reservoirs: each takes the next children of the M). */
+int restir_di_candidates_of(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, uint32_t first,
+                            uint32_t of, const sampler *smp, sampler *rng, di_res *r, light_li *kept);
 /* p^ of DI sample y at a surface point, with the unshadowed contribution in *contrib and
  * the light's evaluation in *li (for the shadow ray). */
 float restir_di_target(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, const di_sample *y, rgb *contrib,

@@ -20,7 +20,10 @@
   {"unbiased", IPARAM_INT, 1, 0, 1, "1: pairwise MIS with visibility (unbiased); 0: 1/M (biased, darker)"},                        \
   {"normal_threshold", IPARAM_FLOAT, 0.9, -1, 1, "reuse only from pixels whose normal has at least this cosine with ours (25 deg)"}, \
   {"depth_threshold", IPARAM_FLOAT, 0.1, 0, 10, "... and whose depth differs from ours by at most this fraction"}
-const integrator_param restir_di_params[] = {DI_PARAMS_COMMON, {NULL, IPARAM_INT, 0, 0, 0, NULL}};
+const integrator_param restir_di_params[] = {
+    DI_PARAMS_COMMON,
+    {"reservoirs", IPARAM_INT, 4, 1, 8, "K: reservoirs per pixel (at most one per candidate), the candidates split among them, each with its own history; shaded as their mean"},
+    {NULL, IPARAM_INT, 0, 0, 0, NULL}};
 
 /* ---- DI target: unshadowed f * Le * |cos| * g at pixel g for light sample y (in y's
  * measure); p^ is its luminance. */
@@ -51,11 +54,16 @@ static int di_visible(const render_ctx *c, const gpix *g, const light_li *li, th
 
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,
                          sampler *rng, di_res *r, light_li *kept) {
+  return restir_di_candidates_of(c, it, b, fr, wo, M, 0, (uint32_t)M, smp, rng, r, kept);
+}
+
+int restir_di_candidates_of(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, uint32_t first,
+                            uint32_t of, const sampler *smp, sampler *rng, di_res *r, light_li *kept) {
   memset(r, 0, sizeof *r);
   float phat_kept = 0;
   light_site at = light_locate(&c->ls, it->p);
   for (int i = 0; i < M; i++) {
-    sampler cs = sampler_child(smp, (uint32_t)i, (uint32_t)M);
+    sampler cs = sampler_child(smp, first + (uint32_t)i, of);
     float ul = sampler_1d(&cs), u1, u2;
     sampler_2d(&cs, &u1, &u2);
     float u = rnd(rng);
@@ -94,19 +102,26 @@ int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, co
 void restir_stage_di_initial(void *user, int64_t row, int thread) {
   stage_job *j = user;
   restir_state *s = j->s;
+  int K = s->reservoirs, M = s->dcfg.candidates;
   for (int x = 0; x < s->width; x++) {
     size_t pix = (size_t)row * s->width + x;
     const gpix *g = &s->g[pix];
-    di_res *r = &s->di[j->dst][pix];
-    memset(r, 0, sizeof *r);
+    di_res *r = &s->di[j->dst][pix * (size_t)K];
+    memset(r, 0, (size_t)K * sizeof *r);
     if (!g->valid) continue;
     sampler smp = sampler_make_kind(j->c->seed, pix, (uint64_t)j->f->frame, (sampler_kind)j->c->sampler_kind);
     sampler_set_dim(&smp, SDIM_RESTIR_CAND);
-    sampler rng = restir_pixel_stream(j->c, j->f, pix, RDIM_CAND);
-    light_li li;
-    /* visibility reuse: a shadowed survivor passes nothing on */
-    if (restir_di_candidates(j->c, &g->it, &g->b, &g->fr, g->wo, s->dcfg.candidates, &smp, &rng, r, &li) && !di_visible(j->c, g, &li, &j->f->ts[thread]))
-      r->W = 0;
+    sampler rng = restir_pixel_stream(j->c, j->f, pix, RDIM_CAND); /* each candidate's choice, in turn */
+    /* the pixel's M candidates (children 0..M-1 of M) split among its K reservoirs */
+    for (int k = 0, first = 0; k < K; k++) {
+      int m = M / K + (k < M % K);
+      light_li li;
+      /* visibility reuse: a shadowed survivor passes nothing on */
+      if (restir_di_candidates_of(j->c, &g->it, &g->b, &g->fr, g->wo, m, (uint32_t)first, (uint32_t)M, &smp, &rng, &r[k], &li) &&
+          !di_visible(j->c, g, &li, &j->f->ts[thread]))
+        r[k].W = 0;
+      first += m;
+    }
   }
 }
 

@@ -6,9 +6,11 @@
 #include "integrator/restir.h"
 #include "core/streams.h"
 
-/* Parameter indices: restir-gi's table extends restir-di's (the first nine are the same). */
+/* Parameter indices: restir-gi's table extends restir-di's first nine; restir-di's tenth
+ * is P_RESERVOIRS. */
 enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIASED, P_NORMAL, P_DEPTH, P_DIRECT, P_JACOBIAN, P_DIRECT_SPATIAL,
        P_DIRECT_ITER };
+enum { P_RESERVOIRS = P_DIRECT };
 extern const integrator_param restir_di_params[];
 
 /* ---- per-pixel random streams: (seed, pixel, frame); stages use fixed dimensions */
@@ -34,7 +36,9 @@ typedef struct restir_state {
   restir_cfg dcfg, gcfg;        /* DI settings; GI settings (gi only) */
   int direct_restir;          /* gi: direct light by restir-di */
   gpix *g, *g_prev;
-  di_res *di[2], *di_prev;    /* ping-pong buffers of this frame; last frame's final */
+  di_res *di[2], *di_prev;    /* ping-pong buffers of this frame; last frame's final:
+                                 `reservoirs` per pixel, pixel p's k-th at p K + k */
+  int reservoirs;             /* K: dcfg's, at most one per candidate */
   gi_res *gr[2], *gr_prev;
   int di_final, gi_final;     /* which ping-pong buffer holds the final reservoirs */
   int have_prev;
