@@ -518,9 +518,9 @@ static int gi_reuse_lowers_error(void) { return reuse_lowers_error(1); }
  * history, shaded as their mean. Unbiased (a still of 4 reservoirs of 2 candidates
  * converges to Mitsuba's direct light as one of 8 does); in a still-camera sequence
  * (frame 12, three seeds) four reservoirs' frame has less than 0.6x one reservoir's
- * error (measured 0.44x) and history still lowers it (measured 1.35x; one reservoir
- * 1.31x: on this small room the fall is alike, on the held-out rooms of
- * docs/performance.md §8 four fall 2x where one falls 1.4x); the default is 4, in
+ * error (measured 0.40x) and history still lowers it (measured 1.46x; one reservoir
+ * 1.31x: on this small room the falls are closer than on the held-out rooms of
+ * docs/performance.md §8, where four fall 2x and one 1.4x); the default is 4, in
  * sequences and stills, bit
  * for bit; K above the candidates is the candidates' count. */
 static int di_reservoirs(void) {

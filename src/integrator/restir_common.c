@@ -230,7 +230,7 @@ static void stage_reuse(void *user, int64_t row, int thread) {
       rng = restir_pixel_stream(j->c, j->f, pix, RDIM_TEMPORAL + 7 * (uint32_t)rj->gi);
       int64_t q = reproject(s, cfg, j->f, g);
       if (q >= 0) { from[1] = (size_t)q; gs[1] = &s->g_prev[q]; n = 2; }
-      cap = rj->gi ? cfg->history : cfg->history * (float)cfg->candidates;
+      cap = cfg->history; /* GI: times one; DI: times a reservoir's own candidates (below) */
     } else if (g->valid) {
       rng = restir_pixel_stream(j->c, j->f, pix, RDIM_SPATIAL + 256 * (uint32_t)rj->round + 7 * (uint32_t)rj->gi);
       n += neighbours(s, cfg, x, (int)row, g, &rng, from + 1);
@@ -247,14 +247,16 @@ static void stage_reuse(void *user, int64_t row, int thread) {
       /* reservoir k merges the k-th of the history or of the same neighbours, its choices
        * from its own stream (k = 0: the pixel's) */
       size_t K = (size_t)s->reservoirs;
+      int M = cfg->candidates;
       for (size_t k = 0; k < K; k++) {
+        float cap_k = cap * (float)(M / (int)K + ((int)k < M % (int)K)); /* history x the reservoir's M */
         const di_res *in[65];
         in[0] = &s->di[j->src][pix * K + k];
         for (int i = 1; i < n; i++) in[i] = temporal ? &s->di_prev[from[i] * K + k] : &s->di[j->src][from[i] * K + k];
         sampler rk = k ? sampler_child(&rng, (uint32_t)k, (uint32_t)K) : rng;
         if (k) sampler_set_dim(&rk, rng.dim);
         if (n == 1) s->di[j->dst][pix * K + k] = *in[0];
-        else restir_di_merge(j->c, cfg->unbiased, gs, in, n, cap, &rk, &j->f->ts[thread], &s->di[j->dst][pix * K + k]);
+        else restir_di_merge(j->c, cfg->unbiased, gs, in, n, cap_k, &rk, &j->f->ts[thread], &s->di[j->dst][pix * K + k]);
       }
     }
   }
