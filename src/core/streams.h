@@ -12,12 +12,12 @@
  *                 numbers varies, hashed rather than taken from a dimension
  *   pixel child   sampler_child(pixel stream, j, n): final gathering (photon), per-light
  *                 cones (vsl), compensation and sampled shadow rays (vpl), RIS
- *                 candidates (restir: candidate j of reservoir k is child k M + j of
- *                 K M), restir-gi's path from its sample point
+ *                 candidates (restir: children 0..M-1 of M, the next M/K of them for
+ *                 each of restir-di's K reservoirs), restir-gi's path from its sample point
  *   restir pixel  sampler_make(seed ^ STREAM_RESTIR_PIXEL, pixel, frame): reservoir choices
- *                 (restir-di's K reservoirs per pixel: candidates' choices in turn from
- *                 RDIM_CAND, K M <= 1024; reservoir k >= 1 merges from child k of K of
- *                 the merge's stream, at its dimension)
+ *                 (restir-di's K reservoirs per pixel: the M candidates' choices in
+ *                 turn from RDIM_CAND; reservoir k >= 1 merges from child k of K of the
+ *                 merge's stream, at its dimension)
  *   guide pixel   sampler_make_kind(seed ^ STREAM_GUIDE, pixel, training sample): guided's
  *                 training paths (the pixel stream's layout)
  *   light paths   sampler_make_kind(key, 0, path index) with key from the pass:

@@ -249,7 +249,7 @@ static void stage_reuse(void *user, int64_t row, int thread) {
       size_t K = (size_t)s->reservoirs;
       int M = cfg->candidates;
       for (size_t k = 0; k < K; k++) {
-        float cap_k = cap * (float)(M / (int)K + ((int)k < M % (int)K)); /* history x the reservoir's M */
+        float cap_k = cap * (float)restir_share(M, (int)K, (int)k); /* history x the reservoir's M */
         const di_res *in[65];
         in[0] = &s->di[j->src][pix * K + k];
         for (int i = 1; i < n; i++) in[i] = temporal ? &s->di_prev[from[i] * K + k] : &s->di[j->src][from[i] * K + k];
@@ -311,7 +311,6 @@ static int spatial_rounds(const restir_cfg *k, const frame_ctx *f) {
   if (k->spatial <= 0) return 0;
   return k->iterations >= 0 ? k->iterations : f->sequence ? 1 : 0;
 }
-
 
 static int run_stage(const render_ctx *c, const frame_ctx *f, parallel_fn fn, void *job) {
   parallel_for(c->threads, c->height, fn, job);

@@ -114,7 +114,7 @@ void restir_stage_di_initial(void *user, int64_t row, int thread) {
     sampler rng = restir_pixel_stream(j->c, j->f, pix, RDIM_CAND); /* each candidate's choice, in turn */
     /* the pixel's M candidates (children 0..M-1 of M) split among its K reservoirs */
     for (int k = 0, first = 0; k < K; k++) {
-      int m = M / K + (k < M % K);
+      int m = restir_share(M, K, k);
       light_li li;
       /* visibility reuse: a shadowed survivor passes nothing on */
       if (restir_di_candidates_of(j->c, &g->it, &g->b, &g->fr, g->wo, m, (uint32_t)first, (uint32_t)M, &smp, &rng, &r[k], &li) &&

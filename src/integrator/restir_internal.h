@@ -11,6 +11,8 @@
 enum { P_CANDIDATES, P_TEMPORAL, P_HISTORY, P_SPATIAL, P_RADIUS, P_ITER, P_UNBIASED, P_NORMAL, P_DEPTH, P_DIRECT, P_JACOBIAN, P_DIRECT_SPATIAL,
        P_DIRECT_ITER };
 enum { P_RESERVOIRS = P_DIRECT };
+/* Reservoir k's share of a pixel's M candidates among K (the first M % K take one more). */
+static inline int restir_share(int M, int K, int k) { return M / K + (k < M % K); }
 extern const integrator_param restir_di_params[];
 
 /* ---- per-pixel random streams: (seed, pixel, frame); stages use fixed dimensions */

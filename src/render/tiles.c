@@ -25,31 +25,31 @@ int tiles_set_view(session *ss, int f) {
   return bad;
 }
 
-/* A camera sample's start: its sampler, the splat's jitter (the numbers camera_ray
- * takes), the camera ray and the AOVs of its first hit. */
+/* A camera sample: its pixel, the camera ray's filter weight and the splat's jitter (the
+ * numbers camera_ray takes). */
 typedef struct cam_sample {
   int x, y;
-  sampler smp;
-  ray r;
   float w, jx, jy;
 } cam_sample;
 
-static void sample_start(session *ss, int x, int y, int si, thread_stats *ts, cam_sample *cs) {
+/* Starts sample si of pixel (x, y): its sampler *smp, the camera ray *r and the AOVs of
+ * its first hit. */
+static void sample_start(session *ss, int x, int y, int si, thread_stats *ts, cam_sample *cs, ray *r, sampler *smp) {
   uint64_t pix = (uint64_t)y * (uint64_t)ss->opt.width + (uint64_t)x;
   /* the random numbers of the frame's pixel, so that a crop is that part of the frame's image */
   uint64_t frame_pix = (uint64_t)(y + ss->crop_y) * (uint64_t)ss->frame_w + (uint64_t)(x + ss->crop_x);
   cs->x = x;
   cs->y = y;
-  cs->smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
+  *smp = sampler_make_kind((uint64_t)ss->opt.seed, frame_pix, (uint64_t)si, ss->sampler_kind);
   cs->jx = cs->jy = 0;
   if (ss->splat) { /* camera_ray's jitter over the pixel, the same numbers */
-    sampler j = cs->smp;
+    sampler j = *smp;
     sampler_set_dim(&j, SDIM_FILM);
     sampler_2d(&j, &cs->jx, &cs->jy);
   }
-  cs->r = camera_ray(&ss->lens, x, y, &cs->smp, &cs->w);
+  *r = camera_ray(&ss->lens, x, y, smp, &cs->w);
   ts->rays++;
-  if (ss->film.aov) aov_record(ss, cs->r, &ss->film.aov[AOV_FLOATS * pix], &cs->smp, ts);
+  if (ss->film.aov) aov_record(ss, *r, &ss->film.aov[AOV_FLOATS * pix], smp, ts);
 }
 
 static void sample_finish(session *ss, const cam_sample *cs, rgb L, thread_stats *ts) {
@@ -61,8 +61,10 @@ static void sample_finish(session *ss, const cam_sample *cs, rgb L, thread_stats
 void tiles_sample_pixel(session *ss, int x, int y, int s0, int s1, thread_stats *ts) {
   for (int si = s0; si < s1; si++) {
     cam_sample cs;
-    sample_start(ss, x, y, si, ts, &cs);
-    sample_finish(ss, &cs, ss->integ->li(&ss->ctx, cs.r, &cs.smp, ts), ts);
+    ray r;
+    sampler smp;
+    sample_start(ss, x, y, si, ts, &cs, &r, &smp);
+    sample_finish(ss, &cs, ss->integ->li(&ss->ctx, r, &smp, ts), ts);
   }
 }
 
@@ -77,10 +79,6 @@ typedef struct sample_batch {
 } sample_batch;
 
 static void batch_flush(session *ss, sample_batch *b, thread_stats *ts) {
-  for (int i = 0; i < b->n; i++) {
-    b->r[i] = b->cs[i].r;
-    b->smp[i] = b->cs[i].smp;
-  }
   ss->integ->li_n(&ss->ctx, b->r, b->smp, ts, b->L, b->n);
   for (int i = 0; i < b->n; i++) sample_finish(ss, &b->cs[i], b->L[i], ts);
   b->n = 0;
@@ -88,8 +86,8 @@ static void batch_flush(session *ss, sample_batch *b, thread_stats *ts) {
 
 static void batch_pixel(session *ss, sample_batch *b, int x, int y, int s0, int s1, thread_stats *ts) {
   for (int si = s0; si < s1; si++) {
-    sample_start(ss, x, y, si, ts, &b->cs[b->n++]);
-    if (b->n == ss->batch) batch_flush(ss, b, ts);
+    sample_start(ss, x, y, si, ts, &b->cs[b->n], &b->r[b->n], &b->smp[b->n]);
+    if (++b->n == ss->batch) batch_flush(ss, b, ts);
   }
 }
 
@@ -110,7 +108,7 @@ uint64_t tiles_render_tile(session *ss, int64_t tile, int s0, int s1, const uint
   int x0, y0, x1, y1;
   tiles_rect(ss, tile, &x0, &y0, &x1, &y1);
   uint64_t taken = 0;
-  sample_batch bs, *b = ss->batch > 1 ? &bs : NULL; /* on the stack: about 150 KB */
+  sample_batch bs, *b = ss->batch > 1 ? &bs : NULL; /* on the stack: about 100 KB */
   bs.n = 0;
   for (int y = y0; y < y1; y++)
     for (int x = x0; x < x1; x++) {
