@@ -4,13 +4,41 @@
  * Russian roulette (digest 000: divide by the continuation probability). Emission found
  * by BSDF-sampled rays is MIS-weighted against the NEE that could have found it, so
  * nothing is counted twice. Scenes with participating media or null surfaces take the
- * walk of path_media.c. */
+ * walk of path_media.c. One path at a time (path_radiance) and a batch stage by stage
+ * (path_radiance_n) share the vertex (path_vertex). */
 #include "integrator/path_common.h"
 #include "integrator/integrator.h"
 #include "core/sampling.h"
 
+/* One vertex of an RGB path at the surface it (reached along *r), depth below the
+ * maximum: the light sample, added to *L when nothing can block it and otherwise left in
+ * *se with its shadow ray in *sray (*has_shadow 1) for the caller to test; then the BSDF sample and Russian
+ * roulette, which update *r, *st and *beta. Returns 1 when the path goes on. */
+static int path_vertex(const render_ctx *c, int depth, isect *it, ray *r, path_state *st, rgb *beta, sampler *smp, thread_stats *ts, rgb *L,
+                       ray *sray, rgb *se, int *has_shadow) {
+  vec3 wo = v3_neg(r->d);
+  bsdf b2, b = bsdf_at_blend(c->s, it, &b2); /* a blend: both its BSDFs */
+  frame fr = shading_frame(it, &b, wo);      /* opaque surfaces are two-sided */
+  sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
+  direct_sample d;
+  *has_shadow = 0;
+  if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, it, &b, &fr, wo, smp, ts, 1, &d)) {
+    rgb e = c3_mul(*beta, c3_scale(c3_mul(d.f_cos, d.Li), d.scale));
+    if (d.visible) *L = c3_add(*L, e);
+    else {
+      *sray = segment_ray_from(it, d.p_light, d.n_light);
+      *se = e;
+      *has_shadow = 1;
+    }
+  }
+  rgb weight;
+  sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
+  if (!path_continue(it, &b, &fr, wo, smp, ts, st, &weight, r)) return 0;
+  *beta = c3_mul(*beta, weight);
+  return path_survive(st, beta, depth, c->rr_depth, smp);
+}
+
 rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, int count_first_emission) {
-  const scene *s = c->s;
   rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
   path_state st = path_state_start(r.o); /* camera rays count emission fully */
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
@@ -21,31 +49,28 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
     int surface = path_trace_vertex(c, &r, &st, ts, &it, &Le, &w);
     if (!c3_black(Le) && (depth > 0 || count_first_emission)) L = c3_add(L, c3_scale(c3_mul(beta, Le), w));
     if (!surface || depth >= max_depth) break;
-    vec3 wo = v3_neg(r.d);
-
-    bsdf b2, b = bsdf_at_blend(s, &it, &b2); /* a blend: both its BSDFs */
-    frame fr = shading_frame(&it, &b, wo); /* opaque surfaces are two-sided */
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
-    if (bsdf_has_smooth(&b)) L = c3_add(L, c3_mul(beta, estimate_direct(c, &it, &b, &fr, wo, smp, ts)));
-
-    rgb weight;
-    sampler_set_dim(smp, sdim_bounce(depth, SDIM_LOBE));
-    if (!path_continue(&it, &b, &fr, wo, smp, ts, &st, &weight, &r)) break;
-    beta = c3_mul(beta, weight);
-    if (!path_survive(&st, &beta, depth, c->rr_depth, smp)) break;
+    ray sray = r;
+    rgb se = c3(0, 0, 0);
+    int pending, go = path_vertex(c, depth, &it, &r, &st, &beta, smp, ts, &L, &sray, &se, &pending);
+    if (pending) {
+      ts->rays++;
+      if (!accel_occluded(c->acc, &sray)) L = c3_add(L, se);
+    }
+    if (!go) break;
   }
   return L;
 }
 
 /* path_radiance for n camera rays at once, stage by stage (a wavefront): the live paths'
- * rays are traced one after another, each hit is shaded (its emission, its light sample
- * and the next ray), and the shadow rays of the whole stage then go to the accelerator
- * together (accel_occluded_n: Embree's streams). Every path draws the same numbers and
- * adds the same terms in the same order as path_radiance, so out[i] is its result bit
- * for bit. */
+ * rays are traced one after another, each hit shaded as it is found (its emission, its
+ * light sample and the next ray), and the shadow rays of the whole stage then go to the
+ * accelerator together (accel_occluded_n: Embree's streams). Every path draws the same
+ * numbers and adds the same terms in the same order as path_radiance, so out[i] is its
+ * result bit for bit. (Tracing the whole stage before shading it, with the hits' vertex
+ * data prefetched, measured 1.08x slower on Veach's MIS file: a hit's data is in cache
+ * when it is shaded at once.) */
 static void path_radiance_n(const render_ctx *c, const ray *r0, sampler *smp, thread_stats *ts, int count_first_emission, rgb *out,
                             int n) {
-  const scene *s = c->s;
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
   ray r[LI_BATCH_MAX], shadow[LI_BATCH_MAX];
   path_state st[LI_BATCH_MAX];
@@ -64,33 +89,16 @@ static void path_radiance_n(const render_ctx *c, const ray *r0, sampler *smp, th
     int next = 0, nshadow = 0;
     for (int k = 0; k < nlive; k++) {
       int i = live[k];
-      rgb *L = &out[i];
       isect it;
       rgb Le;
       float w;
       int surface = path_trace_vertex(c, &r[i], &st[i], ts, &it, &Le, &w);
-      if (!c3_black(Le) && (depth > 0 || count_first_emission)) *L = c3_add(*L, c3_scale(c3_mul(beta[i], Le), w));
+      if (!c3_black(Le) && (depth > 0 || count_first_emission)) out[i] = c3_add(out[i], c3_scale(c3_mul(beta[i], Le), w));
       if (!surface || depth >= max_depth) continue;
-      vec3 wo = v3_neg(r[i].d);
-      bsdf b2, b = bsdf_at_blend(s, &it, &b2);
-      frame fr = shading_frame(&it, &b, wo);
-      sampler_set_dim(&smp[i], sdim_bounce(depth, SDIM_LIGHT_PICK));
-      direct_sample d;
-      if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, &it, &b, &fr, wo, &smp[i], ts, 1, &d)) {
-        rgb e = c3_mul(beta[i], c3_scale(c3_mul(d.f_cos, d.Li), d.scale));
-        if (d.visible) *L = c3_add(*L, e);
-        else { /* added after the stage's shadow rays, before anything else reaches L */
-          shadow[nshadow] = segment_ray_from(&it, d.p_light, d.n_light);
-          pend[nshadow] = e;
-          owner[nshadow++] = i;
-        }
-      }
-      rgb weight;
-      sampler_set_dim(&smp[i], sdim_bounce(depth, SDIM_LOBE));
-      if (!path_continue(&it, &b, &fr, wo, &smp[i], ts, &st[i], &weight, &r[i])) continue;
-      beta[i] = c3_mul(beta[i], weight);
-      if (!path_survive(&st[i], &beta[i], depth, c->rr_depth, &smp[i])) continue;
-      live[next++] = i;
+      int pending, go = path_vertex(c, depth, &it, &r[i], &st[i], &beta[i], &smp[i], ts, &out[i], &shadow[nshadow], &pend[nshadow],
+                                   &pending);
+      if (pending) owner[nshadow++] = i; /* added after the stage's shadow rays, before anything else reaches out[i] */
+      if (go) live[next++] = i;
     }
     ts->rays += (uint64_t)nshadow;
     accel_occluded_n(c->acc, shadow, blocked, nshadow);
