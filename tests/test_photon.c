@@ -7,7 +7,8 @@
  *  - scenes/caustic.json (a glass sphere's caustic) against Mitsuba 3
  *    (tests/data/caustic-mitsuba.exr): mean within 3 %, every lit 32x32 block-channel
  *    within 10 %; tests/data/caustic-far (a small lamp's sharp caustic, our held-out
- *    kind) the same (32 passes, label reference);
+ *    kind) the same (32 passes, label reference), and from a camera that sees the lamp
+ *    through the ball (no fireflies at the lamp's image);
  *  - progressive radius reduction makes it consistent: with a deliberately wide first
  *    radius, the caustic's error falls with the passes at the default alpha and does not
  *    with alpha = 1 (a fixed radius);
@@ -113,8 +114,9 @@ static int photon_converges(void) {
 }
 
 /* A photon render of scene `path` (options o) against the EXR ref: mean per channel within
- * mean_tol, every lit 32x32 block-channel within block_tol. */
-static int against(const char *path, const char *refp, valo_options *o, double mean_tol, double block_tol, cmp_result *out) {
+ * mean_tol, every lit 32x32 block-channel within block_tol, and (when rel_tol > 0) the
+ * image's relMSE below rel_tol. */
+static int against(const char *path, const char *refp, valo_options *o, double mean_tol, double block_tol, double rel_tol, cmp_result *out) {
   image ref;
   valo_error err;
   CHECK(image_read(refp, &ref, &err) == VALO_OK, "%s", err.message);
@@ -131,8 +133,12 @@ static int against(const char *path, const char *refp, valo_options *o, double m
   valo_scene_destroy(sc);
   cmp_result cr;
   compare_images(img, ref.rgb, ref.w, ref.h, 32, &cr);
-  fprintf(stderr, "%s, %d passes (%.1f s): mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit 32x32 block-channels %.2f%% at (%d,%d,%d)\n",
-          path, st.spp_done, st.render_seconds, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2], cr.lit_blocks,
+  double rel = 0;
+  for (int i = 0; i < 3 * ref.w * ref.h; i++) rel += (img[i] - ref.rgb[i]) * (img[i] - ref.rgb[i]) / (ref.rgb[i] * ref.rgb[i] + 1e-2);
+  rel /= 3.0 * ref.w * ref.h;
+  fprintf(stderr,
+          "%s, %d passes (%.1f s): relMSE %.5f; mean error R %.2f%% G %.2f%% B %.2f%%; worst of %d lit 32x32 block-channels %.2f%% at (%d,%d,%d)\n",
+          path, st.spp_done, st.render_seconds, rel, 100 * cr.mean_err[0], 100 * cr.mean_err[1], 100 * cr.mean_err[2], cr.lit_blocks,
           100 * cr.worst_block, cr.worst_bx, cr.worst_by, cr.worst_c);
   free(img);
   image_free(&ref);
@@ -140,6 +146,7 @@ static int against(const char *path, const char *refp, valo_options *o, double m
   for (int k = 0; k < 3; k++) CHECK(cr.mean_err[k] < mean_tol, "channel %d mean off by %.2f%%", k, 100 * cr.mean_err[k]);
   CHECK(cr.lit_blocks >= 24, "only %d lit block-channels", cr.lit_blocks);
   CHECK(cr.worst_block < block_tol, "block (%d,%d) channel %d off by %.2f%%", cr.worst_bx, cr.worst_by, cr.worst_c, 100 * cr.worst_block);
+  CHECK(rel_tol <= 0 || rel < rel_tol, "relMSE %.5f (allowed %.5f)", rel, rel_tol);
   return 0;
 }
 
@@ -147,7 +154,7 @@ static int photon_caustic(void) {
   valo_options o;
   valo_options_init(&o);
   o.spp = test_full() ? 96 : 16;
-  return against(VALO_SOURCE_DIR "/scenes/caustic.json", VALO_SOURCE_DIR "/tests/data/caustic-mitsuba.exr", &o, 0.03, 0.10, NULL);
+  return against(VALO_SOURCE_DIR "/scenes/caustic.json", VALO_SOURCE_DIR "/tests/data/caustic-mitsuba.exr", &o, 0.03, 0.10, 0, NULL);
 }
 
 static int photon_caustic_far(void) {
@@ -155,7 +162,20 @@ static int photon_caustic_far(void) {
   valo_options_init(&o);
   o.spp = 32;
   return against(VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far.json", VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-far-mitsuba.exr", &o,
-                 0.03, 0.10, NULL);
+                 0.03, 0.10, 0, NULL);
+}
+
+/* The same scene from a camera that sees the lamp through the ball (a view the method was
+ * not tuned on): the lamp's image in the glass is emission reached through a delta chain,
+ * and neither the final gather nor the caustic map may add fireflies there (issue 58's
+ * 35 % block). Against Mitsuba 3's path tracer at 131 072 spp; the relMSE bound is a
+ * quarter of what path's own fireflies leave there at 1 024 spp (0.060). */
+static int photon_lamp_through_glass(void) {
+  valo_options o;
+  valo_options_init(&o);
+  o.spp = 32;
+  return against(VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-lampview.json",
+                 VALO_SOURCE_DIR "/tests/data/caustic-far/caustic-lampview-mitsuba.exr", &o, 0.03, 0.10, 0.02, NULL);
 }
 
 static int photon_cornell_mirror(void) {
@@ -170,7 +190,7 @@ static int photon_cornell_mirror(void) {
   valo_options o;
   valo_options_init(&o);
   o.spp = test_full() ? 16 : 4;
-  return against(scratch_file("mirror.json", json), refp, &o, 0.02, 0.10, NULL);
+  return against(scratch_file("mirror.json", json), refp, &o, 0.02, 0.10, 0, NULL);
 }
 
 /* The caustic's error (lit 16x16 block-channels, mean) at 2 and at 24 passes with a first
@@ -344,6 +364,7 @@ int main(int argc, char **argv) {
                                     {"photon_converges", photon_converges},
                                     {"photon_caustic", photon_caustic},
                                     {"photon_caustic_far", photon_caustic_far},
+                                    {"photon_lamp_through_glass", photon_lamp_through_glass},
                                     {"photon_cornell_mirror", photon_cornell_mirror},
                                     {"photon_consistent", photon_consistent},
                                     {"photon_threads", photon_threads}, {"photon_blend", photon_blend}, {"photon_aim", photon_aim},
