@@ -1027,6 +1027,62 @@ static int guide_quadtree(void) {
   return rc;
 }
 
+/* The learned BSDF fraction (guide_record_moments, chosen in guide_refine): a diffuse
+ * surface facing +z under the three lobes above (bin 0) must keep the quadtree in its
+ * mixture, and under uniform light (bin 1: cosine sampling of the BSDF is exact there)
+ * must take fraction 1; vertices drawn from the mixture with fraction 1/2. */
+static float lobe_light(vec3 d, const vec3 *lobes, const float *widths, const float *values) {
+  float v = d.y > 0 ? 0.1f : 0;
+  for (int l = 0; l < 3; l++)
+    if (v3_dot(d, lobes[l]) > 1 - widths[l]) v += values[l];
+  return v;
+}
+static int guide_fraction_choice(void) {
+  guide g;
+  bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
+  CHECK(guide_init(&g, box, 1000000, 1e9) == 0, "init");
+  guide_set_scale(&g, 100);
+  const vec3 lobes[3] = {v3_norm(v3(0.3f, 0.2f, 0.93f)), v3_norm(v3(-0.8f, 0.1f, -0.3f)), v3(0, -1, 0)};
+  const float widths[3] = {0.02f, 0.3f, 0.6f}, values[3] = {50, 5, 1};
+  const vec3 at = v3(0.1f, 0.2f, 0.3f);
+  for (int pass = 0; pass < 2; pass++) { /* the quadtrees: bin 0 the lobes, bin 1 uniform */
+    for (int k = 0; k < 200000; k++) {
+      sampler sm = sampler_make(31 + pass, (uint64_t)k, 0);
+      float u1, u2;
+      sampler_2d(&sm, &u1, &u2);
+      vec3 d = sample_uniform_sphere(u1, u2);
+      gleaf *l = (gleaf *)guide_leaf(&g, at);
+      guide_record(&g, l, 0, d, lobe_light(d, lobes, widths, values) * 4 * PI_F);
+      guide_record(&g, l, 1, d, 4 * PI_F);
+    }
+    CHECK(guide_refine(&g) == 0, "refine");
+  }
+  const gleaf *l = guide_leaf(&g, at);
+  CHECK(l->frac[0] < 0 && l->frac[1] < 0, "a fraction learned without moments");
+  for (int k = 0; k < 100000; k++) {
+    sampler sm = sampler_make(41, (uint64_t)k, 0);
+    float ul = sampler_1d(&sm), u1, u2;
+    sampler_2d(&sm, &u1, &u2);
+    for (int b = 0; b < 2; b++) {
+      vec3 d;
+      float pg;
+      if (ul < 0.5f) d = guide_sample(l, b, u1, u2, &pg);
+      else { d = sample_cosine_hemisphere(u1, u2); pg = guide_pdf(l, b, d); }
+      float pb = fmaxf(d.z, 0) * INV_PI_F, q = 0.5f * pb + 0.5f * pg, L = b ? 1 : lobe_light(d, lobes, widths, values);
+      double X = 0.8 * INV_PI_F * fmax(d.z, 0) * L / q;
+      guide_record_moments(&g, (gleaf *)l, b, X / g.scale, q, pb, pg);
+    }
+  }
+  CHECK(guide_refine(&g) == 0, "refine");
+  l = guide_leaf(&g, at);
+  fprintf(stderr, "guide fractions learned: lobes %.2f, uniform light %.2f\n", l->frac[0], l->frac[1]);
+  CHECK(l->frac[0] >= 0 && l->frac[0] < 1, "under the lobes the quadtree was dropped (fraction %g)", l->frac[0]);
+  CHECK(l->frac[1] == 1, "under uniform light the quadtree was kept (fraction %g)", l->frac[1]);
+  CHECK(l->frac[2] < 0, "a bin without moments learned %g", l->frac[2]);
+  guide_free(&g);
+  return 0;
+}
+
 static int alias_table_chi2(void) {
   float w[7] = {1, 0, 3.5f, 0.01f, 7, 2, 0.5f};
   alias_table t;
@@ -1630,6 +1686,7 @@ int main(int argc, char **argv) {
                                     {"alias_table", alias_table_chi2},
                                     {"bilinear_distribution", bilinear_distribution},
                                     {"guide_quadtree", guide_quadtree},
+                                    {"guide_fraction_choice", guide_fraction_choice},
                                     {"chi2_rejects_wrong_pdf", chi2_rejects_wrong_pdf},
                                     {"rough_conductor", rough_conductor},
                                     {"rough_dielectric", rough_dielectric},

@@ -60,6 +60,31 @@ static int threads_bit_identical(void) {
   return 0;
 }
 
+/* guided: its trees (and each leaf's learned BSDF fraction) come from fixed-point sums, so
+ * the image does not depend on the thread count either. */
+static int guided_threads_identical(void) {
+  float *px[3];
+  int w = 0, h = 0;
+  const int threads[3] = {1, 2, 7};
+  for (int k = 0; k < 3; k++) {
+    valo_options o;
+    valo_options_init(&o);
+    o.threads = threads[k];
+    o.seed = 5;
+    o.spp = 16;
+    snprintf(o.integrator, sizeof o.integrator, "guided");
+    px[k] = render_json_text(scene_json, &o, &w, &h);
+    CHECK(px[k], "render failed");
+  }
+  double sum = 0;
+  for (int i = 0; i < w * h * 3; i++) sum += px[0][i];
+  CHECK(sum > 0, "image is black");
+  size_t n = (size_t)w * h * 3 * sizeof(float);
+  CHECK(memcmp(px[0], px[1], n) == 0 && memcmp(px[0], px[2], n) == 0, "1, 2 and 7 threads differ");
+  for (int k = 0; k < 3; k++) free(px[k]);
+  return 0;
+}
+
 /* --crop / film.crop_*: the film is a window of the frame, and each of its pixels takes the
  * frame pixel's random numbers, so a crop is that part of the whole image bit for bit:
  * pixels and depth AOV, for the perspective camera with the Gaussian filter, and for
@@ -385,7 +410,7 @@ static int cancel_mid_pass(void) {
 }
 
 int main(int argc, char **argv) {
-  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"crop_is_part_of_frame", crop_is_part_of_frame}, {"media_threads_identical", media_threads_identical}, {"exr_bytes_identical", exr_bytes_identical},
+  static const test_case cases[] = {{"threads_bit_identical", threads_bit_identical}, {"guided_threads_identical", guided_threads_identical}, {"crop_is_part_of_frame", crop_is_part_of_frame}, {"media_threads_identical", media_threads_identical}, {"exr_bytes_identical", exr_bytes_identical},
                                     {"adaptive_threads_identical", adaptive_threads_identical}, {"batch_same_image", batch_same_image},
                                     {"cancel_keeps_passes", cancel_keeps_passes}, {"cancel_mid_pass", cancel_mid_pass}, {NULL, NULL}};
   return test_main(argc, argv, cases);

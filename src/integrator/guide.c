@@ -8,6 +8,9 @@
 #define QT_DEPTH 20
 #define FIX_BITS 32
 #define FIX_MAX_UNITS 16.0
+#define M2_MAX_UNITS 4096.0
+
+const float guide_fraction[GUIDE_FRACTIONS] = {0.25f, 0.5f, 0.75f, 1.0f};
 
 static void qtree_free(qtree *t) { free(t->n); memset(t, 0, sizeof *t); }
 static void stree_free(stree *t) { free(t->n); memset(t, 0, sizeof *t); }
@@ -80,6 +83,7 @@ int guide_init(guide *g, bbox box, uint64_t max_nodes, double spatial_c) {
   g->leaves = calloc(1, sizeof *g->leaves);
   if (!g->sn || !g->leaves) { guide_free(g); return -1; }
   g->nsn = g->capsn = g->nleaves = g->capleaves = 1;
+  for (int b = 0; b < GUIDE_BINS; b++) g->leaves[0].frac[b] = -1;
   g->sn[0].lo = box.lo;
   g->sn[0].hi = box.hi;
   g->sn[0].mid = 0.5f * (box.lo.x + box.hi.x);
@@ -202,6 +206,38 @@ void guide_record(const guide *g, gleaf *l, int b, vec3 d, float value) {
   }
 }
 
+void guide_record_moments(const guide *g, gleaf *l, int b, double x, float q, float pb, float pg) {
+  if (!(x > 0) || !(q > 0) || !(g->scale > 0)) return;
+  for (int k = 0; k < GUIDE_FRACTIONS; k++) {
+    double a = guide_fraction[k], qa = a * pb + (1 - a) * pg;
+    double units = qa > 0 ? x * x * q / qa : M2_MAX_UNITS; /* a cannot draw this direction: as bad as it gets */
+    uint64_t fx = (uint64_t)(fmin(units, M2_MAX_UNITS) * (double)(1ULL << FIX_BITS));
+    atomic_fetch_add_explicit(&l->m2[b][k], fx, memory_order_relaxed);
+  }
+}
+
+/* The fraction the pass's second moments choose (unchanged when nothing was recorded). */
+static void learn_fraction(gleaf *l, int b) {
+  uint64_t m[GUIDE_FRACTIONS];
+  int best = 0;
+  for (int k = 0; k < GUIDE_FRACTIONS; k++) {
+    m[k] = atomic_load_explicit(&l->m2[b][k], memory_order_relaxed);
+    atomic_store_explicit(&l->m2[b][k], 0, memory_order_relaxed);
+    if (m[k] < m[best]) best = k;
+  }
+  if (m[GUIDE_FRACTIONS - 1] == 0 && m[best] == 0) return;
+  if ((double)m[GUIDE_FRACTIONS - 1] <= GUIDE_PURE_MARGIN * (double)m[best]) best = GUIDE_FRACTIONS - 1;
+  l->frac[b] = guide_fraction[best];
+}
+
+double guide_pure_share(const guide *g) {
+  uint64_t n = 0, pure = 0;
+  for (uint32_t i = 0; i < g->nleaves; i++)
+    for (int b = 0; b < GUIDE_BINS; b++)
+      if (g->leaves[i].frac[b] >= 0) { n++; pure += g->leaves[i].frac[b] == 1; }
+  return n ? (double)pure / (double)n : 0;
+}
+
 /* Each quadrant with a child gets the child's total (children come after their parents). */
 static void qtree_sum_up(qtree *t) {
   for (uint32_t i = t->count; i-- > 0;)
@@ -282,6 +318,7 @@ int guide_refine(guide *g) {
   for (uint32_t i = 0; i < g->nleaves; i++)
     for (int b = 0; b < GUIDE_BINS; b++) {
       gleaf *l = &g->leaves[i];
+      learn_fraction(l, b);
       g->nodes -= l->sampling[b].count;
       stree_free(&l->sampling[b]);
       qtree nb;
@@ -305,6 +342,7 @@ int guide_refine(guide *g) {
     gleaf *src = &g->leaves[li], *dst = &g->leaves[nl];
     memset(dst, 0, sizeof *dst);
     for (int b = 0; b < GUIDE_BINS; b++) {
+      dst->frac[b] = src->frac[b];
       if (stree_copy(g, &src->sampling[b], &dst->sampling[b])) return -1;
       if (!src->building[b].count) continue;
       dst->building[b].n = malloc(src->building[b].count * sizeof(qnode));

@@ -13,7 +13,14 @@
  * do not depend on the order in which threads add them: a pass gives the same trees for
  * any thread count. Sampling trees hold each node's quadrant shares as floats.
  * The node count is capped (guide->max_nodes over all quadtrees); past it no quadtree
- * grows further. */
+ * grows further.
+ * Each leaf and bin also learns its BSDF fraction (the share of directions drawn from
+ * the BSDF rather than the quadtree), as Müller's 2019 production guiding learns it, here
+ * by choosing among GUIDE_FRACTIONS values: every recorded vertex adds, for each value
+ * a, the second moment its contribution X (drawn with the mixture pdf q) would have under
+ * a, X^2 q / (a p_bsdf + (1 - a) p_guide) (its expectation is the second moment of
+ * sampling with a), in the same fixed point; guide_refine picks the smallest, and
+ * fraction 1 (no quadtree at all, cheaper) when it is within GUIDE_PURE_MARGIN of it. */
 #ifndef VALO_GUIDE_H
 #define VALO_GUIDE_H
 #include "core/vec.h"
@@ -33,9 +40,14 @@ typedef struct snode {           /* p: the quadrants' shares; for sampling, the 
 typedef struct stree { snode *n; uint32_t count; } stree;        /* a sampling tree; count 0: none */
 
 #define GUIDE_BINS 6 /* a leaf's quadtrees, one per major axis of the shading normal (+x, -x, +y, ...) */
+#define GUIDE_FRACTIONS 4    /* the BSDF fractions a leaf's bin chooses among: guide_fraction[] */
+#define GUIDE_PURE_MARGIN 1.1 /* fraction 1 is taken within this factor of the best second moment */
+extern const float guide_fraction[GUIDE_FRACTIONS];
 typedef struct gleaf {
   stree sampling[GUIDE_BINS];
   qtree building[GUIDE_BINS];
+  float frac[GUIDE_BINS];     /* the learned BSDF fraction; < 0: none learned (the integrator's default) */
+  _Atomic uint64_t m2[GUIDE_BINS][GUIDE_FRACTIONS]; /* this pass's second moments per fraction (fixed point) */
   _Atomic uint32_t records;   /* path vertices recorded in this pass (lit or not) */
 } gleaf;
 typedef struct gsnode { vec3 lo, hi; float mid; int axis; uint32_t child; uint32_t leaf; } gsnode; /* split at mid (the middle of axis); child 0: a leaf */
@@ -70,6 +82,11 @@ float guide_pdf(const gleaf *l, int b, vec3 d);
 /* Adds value (radiance / pdf, >= 0) at direction d to the building tree of bin b of leaf
  * l (of g), and counts a vertex there. */
 void guide_record(const guide *g, gleaf *l, int b, vec3 d, float value);
+/* Adds a recorded vertex's second moments: x = its contribution X over the guide's scale,
+ * q its mixture pdf, pb and pg the BSDF's and the quadtree's pdfs of its direction. */
+void guide_record_moments(const guide *g, gleaf *l, int b, double x, float q, float pb, float pg);
+/* The share of leaf-bins (of those that learned one) whose fraction is 1. */
+double guide_pure_share(const guide *g);
 /* Ends a pass (serial): the building trees become the sampling ones, leaves split, new
  * building trees refined. Returns -1 when out of memory. */
 int guide_refine(guide *g);

@@ -26,13 +26,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { P_TRAIN, P_FRACTION, P_SPATIAL, P_NODES };
+enum { P_TRAIN, P_FRACTION, P_SPATIAL, P_NODES, P_LEARN_FRACTION };
 static const integrator_param guided_params[] = {
     {"train_spp", IPARAM_INT, -1, -1, 1 << 20,
      "samples per pixel that learn, in passes of 1, 2, 4, ... (-1: half the render's spp, or a quarter of its --time)"},
     {"bsdf_fraction", IPARAM_FLOAT, 0.5, 0.01, 1, "share of directions drawn from the BSDF rather than from the learned distribution"},
     {"spatial_threshold", IPARAM_FLOAT, 12000, 1, 1e9, "a spatial leaf splits past this many records times sqrt(2^pass)"},
     {"max_nodes", IPARAM_INT, 4000000, 1024, 1e9, "directional quadtree nodes at most, over all leaves (48 bytes each)"},
+    {"learn_fraction", IPARAM_INT, 1, 0, 1,
+     "1: each leaf and normal bin learns its BSDF fraction (0.25, 0.5, 0.75 or 1) from the training passes; 0: bsdf_fraction everywhere"},
     {NULL, 0, 0, 0, 0, NULL}};
 
 typedef struct gstate {
@@ -47,7 +49,10 @@ typedef struct gstate {
 } gstate;
 
 #define MAXV 48
-typedef struct gvert { gleaf *l; int bin; vec3 d; rgb beta, L0, ex; float pdf; } gvert; /* L0: the path's radiance when it left; ex: what it does not learn */
+/* L0: the path's radiance when it left; ex: what it does not learn; fc: the luminance of
+ * f |cos| of its direction, pb and pg the BSDF's and the quadtree's pdfs there (pg < 0:
+ * no quadtree to compare with, no moments) */
+typedef struct gvert { gleaf *l; int bin; vec3 d; rgb beta, L0, ex; float pdf, fc, pb, pg; } gvert;
 typedef struct recorder { guide *g; _Atomic uint32_t *probe; gvert v[MAXV]; int n; } recorder;
 
 static void rec_value(recorder *rc, gleaf *l, int bin, vec3 d, float value) {
@@ -68,7 +73,10 @@ static void rec_flush(recorder *rc, rgb L) {
     const gvert *v = &rc->v[k];
     rgb acc = c3_sub(c3_sub(L, v->L0), v->ex);
     rgb Lin = c3(channel_ratio(acc.r, v->beta.r), channel_ratio(acc.g, v->beta.g), channel_ratio(acc.b, v->beta.b));
-    rec_value(rc, v->l, v->bin, v->d, c3_lum(Lin) / v->pdf);
+    float lin = c3_lum(Lin);
+    rec_value(rc, v->l, v->bin, v->d, lin / v->pdf);
+    if (v->l && !rc->probe && v->pg >= 0 && rc->g->scale > 0)
+      guide_record_moments(rc->g, v->l, v->bin, (double)v->fc * lin / v->pdf / rc->g->scale, v->pdf, v->pb, v->pg);
   }
   rc->n = 0;
 }
@@ -76,6 +84,7 @@ static void rec_flush(recorder *rc, rgb L) {
 static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp, thread_stats *ts, recorder *rc) {
   const scene *s = c->s;
   float alpha_b = (float)c->param[P_FRACTION];
+  int learned = c->param[P_LEARN_FRACTION] > 0;
   rgb L = c3(0, 0, 0), beta = c3(1, 1, 1);
   path_state st = path_state_start(r.o);
   int max_depth = c->max_depth >= 0 ? c->max_depth : PATH_HARD_CAP;
@@ -99,7 +108,8 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     gleaf *lf = smooth && (g->pass > 0 || rc) ? (gleaf *)guide_leaf(g, it.p) : NULL; /* recording writes its building tree */
     int bin = guide_bin(fr.n);
     const gleaf *gl = lf && guide_can_sample(lf, bin) ? lf : NULL;
-    float ag = gl ? 1 - alpha_b : 0; /* probability of sampling the guide */
+    float ab = gl && learned && gl->frac[bin] >= 0 ? gl->frac[bin] : alpha_b;
+    float ag = gl ? 1 - ab : 0; /* probability of sampling the guide (0 where the leaf learned fraction 1) */
     vec3 wo_l = frame_to_local(&fr, wo);
     if (smooth) { /* next-event estimation, MIS against the mixture */
       sampler_set_dim(smp, sdim_bounce(depth, SDIM_LIGHT_PICK));
@@ -122,18 +132,18 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     ts->surface_samples++;
     vec3 wi;
     rgb weight;
-    float pm;
+    float pm, pb = 0, pg = -1, fc = 0; /* for the moments: pg < 0 leaves them out */
     int delta = 0;
     float eta_scale = 1;
     if (ag > 0 && ul < ag) {
-      float pg;
       wi = guide_sample(gl, bin, u1, u2, &pg);
       vec3 wi_l = frame_to_local(&fr, wi);
       rgb f = bsdf_eval(&b, wo_l, wi_l);
-      float pb = bsdf_pdf(&b, wo_l, wi_l);
+      pb = bsdf_pdf(&b, wo_l, wi_l);
       pm = ag * pg + (1 - ag) * pb;
       if (!c3_finite(f) || !isfinite(pb)) { ts->lost[VALO_LOSS_BSDF_NONFINITE]++; break; }
       if (c3_black(f) || !(pm > 0) || !sides_agree(&it, wo_l, wi_l, wo, wi, ts)) break;
+      fc = c3_lum(f) * fabsf(wi_l.z);
       weight = c3_scale(f, fabsf(wi_l.z) / pm);
     } else {
       bsdf_sample bs;
@@ -145,8 +155,12 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
         weight = c3_scale(bs.weight, 1 / (1 - ag));
         pm = bs.pdf;
       } else {
-        pm = (1 - ag) * bs.pdf + (ag > 0 ? ag * guide_pdf(gl, bin, wi) : 0);
+        /* the quadtree's pdf: for the mixture, and while learning for the moments */
+        if (gl && (ag > 0 || (rc && learned))) pg = guide_pdf(gl, bin, wi);
+        pm = (1 - ag) * bs.pdf + (ag > 0 ? ag * pg : 0);
         weight = c3_scale(bs.weight, bs.pdf / pm);
+        pb = bs.pdf;
+        fc = c3_lum(bs.weight) * bs.pdf;
       }
     }
     st.specular = delta;
@@ -155,7 +169,7 @@ static rgb guided_walk(const render_ctx *c, const guide *g, ray r, sampler *smp,
     st.eta_acc /= eta_scale;
     r = spawn_ray(&it, wi);
     beta = c3_mul(beta, weight);
-    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){lf, bin, wi, beta, L, c3(0, 0, 0), pm};
+    if (rc && !delta && rc->n < MAXV) rc->v[rc->n++] = (gvert){lf, bin, wi, beta, L, c3(0, 0, 0), pm, fc, pb, learned ? pg : -1};
     if (!path_survive(&st, &beta, depth, c->rr_depth, smp)) break;
   }
   if (rc) rec_flush(rc, L);
@@ -242,8 +256,9 @@ static valo_status guided_prepare(void *state, const render_ctx *c, int sample_i
     gs->done = 1;
     guide_stop(&gs->g);
     gs->seconds = now_seconds() - gs->t0;
-    log_note("guided: learned in %d passes (%d spp); %u spatial leaves, %llu quadtree nodes%s", gs->passes, sample_index, gs->g.nleaves,
-             (unsigned long long)gs->g.nodes, gs->g.full ? " (the max_nodes cap was reached)" : "");
+    log_note("guided: learned in %d passes (%d spp); %u spatial leaves, %llu quadtree nodes%s; BSDF fraction 1 (unguided) in %.0f %% of leaf-bins",
+             gs->passes, sample_index, gs->g.nleaves, (unsigned long long)gs->g.nodes, gs->g.full ? " (the max_nodes cap was reached)" : "",
+             100 * guide_pure_share(&gs->g));
   }
   return VALO_OK;
 }
