@@ -3,8 +3,9 @@
  * and a learned distribution of incident radiance (guide.h, Müller et al. 2017; each
  * vertex learns the light that arrived along its sampled direction, less the emission its
  * own next-event estimation could have found): with
- * probability 1 - bsdf_fraction the direction comes from the SD-tree leaf of the
- * shading point, and the mixture's pdf is the one every MIS weight uses (the emission a
+ * probability 1 - the BSDF fraction (the leaf's and normal bin's learned one, or
+ * bsdf_fraction) the direction comes from the SD-tree leaf of the shading point, and
+ * the mixture's pdf is the one every MIS weight uses (the emission a
  * sampled ray finds, and next-event estimation's light samples), so the estimate stays
  * unbiased. The render's own samples learn, in passes of 1, 2, 4, ... samples per pixel:
  * each pass records into the tree that the next one samples (refined between passes, in
