@@ -16,6 +16,8 @@ OUT = os.path.join(ROOT, "tests", "data", "mitsuba-xml")
 # name: (scene file under ../shared/scenes, its defaults); tests/test_mitsuba.c passes the
 # same values with --define.
 SCENES = {"veach-mis": ("veach-mis/mitsuba-source/scene.xml", {"integrator": "path", "resx": "320", "resy": "180"}),
+          # the path-guiding lab's torus in a glass block (valo renders its file with guided)
+          "torus": ("torus/mitsuba-source/scene.xml", {"integrator": "path", "resx": "256", "resy": "192"}),
           # Sponza's own scene file, changed only where Mitsuba 3 cannot render it (the file says
           # how), reading its serialized mesh and textures from ../shared.
           "sponza-serialized": ("@tests/data/mitsuba-xml/sponza-serialized.xml", {"resx": "128", "resy": "72"}),
