@@ -212,7 +212,7 @@ void guide_record_moments(const guide *g, gleaf *l, int b, double x, float q, fl
     double a = guide_fraction[k], qa = a * pb + (1 - a) * pg;
     double units = qa > 0 ? x * x * q / qa : M2_MAX_UNITS; /* a cannot draw this direction: as bad as it gets */
     uint64_t fx = (uint64_t)(fmin(units, M2_MAX_UNITS) * (double)(1ULL << FIX_BITS));
-    atomic_fetch_add_explicit(&l->m2[b][k], fx, memory_order_relaxed);
+    if (fx) atomic_fetch_add_explicit(&l->m2[b][k], fx, memory_order_relaxed);
   }
 }
 

@@ -19,7 +19,8 @@
  * by choosing among GUIDE_FRACTIONS values: every recorded vertex adds, for each value
  * a, the second moment its contribution X (drawn with the mixture pdf q) would have under
  * a, X^2 q / (a p_bsdf + (1 - a) p_guide) (its expectation is the second moment of
- * sampling with a), in the same fixed point; guide_refine picks the smallest, and
+ * sampling with a), in the same fixed point (cut at 4096 units: a sum wraps only past
+ * 2^20 such records, and a leaf splits long before); guide_refine picks the smallest, and
  * fraction 1 (no quadtree at all, cheaper) when it is within GUIDE_PURE_MARGIN of it. */
 #ifndef VALO_GUIDE_H
 #define VALO_GUIDE_H

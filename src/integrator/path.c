@@ -12,8 +12,9 @@
 
 /* One vertex of an RGB path at the surface it (reached along *r), depth below the
  * maximum: the light sample, added to *L when nothing can block it and otherwise left in
- * *se with its shadow ray in *sray (*has_shadow 1) for the caller to test; then the BSDF sample and Russian
- * roulette, which update *r, *st and *beta. Returns 1 when the path goes on. */
+ * *se with its shadow ray in *sray (*has_shadow 1) for the caller to test; then the BSDF
+ * sample and Russian roulette, which update *r, *st and *beta. Returns 1 when the path
+ * goes on. */
 static int path_vertex(const render_ctx *c, int depth, isect *it, ray *r, path_state *st, rgb *beta, sampler *smp, thread_stats *ts, rgb *L,
                        ray *sray, rgb *se, int *has_shadow) {
   vec3 wo = v3_neg(r->d);
