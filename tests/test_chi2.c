@@ -987,25 +987,35 @@ static int guide_sf(void *c, sampler *s, vec3 *dir) {
   return pdf > 0;
 }
 static double guide_pf(void *c, vec3 d) { return guide_pdf(c, 0, d); }
+/* The light of the tests below: a dim upper half and three lobes (a narrow bright one). */
+static const float lobe_widths[3] = {0.02f, 0.3f, 0.6f}, lobe_values[3] = {50, 5, 1};
+static vec3 lobe_axis(int l) { return l == 0 ? v3_norm(v3(0.3f, 0.2f, 0.93f)) : l == 1 ? v3_norm(v3(-0.8f, 0.1f, -0.3f)) : v3(0, -1, 0); }
+static float lobe_light(vec3 d) {
+  float v = d.y > 0 ? 0.1f : 0;
+  for (int l = 0; l < 3; l++)
+    if (v3_dot(d, lobe_axis(l)) > 1 - lobe_widths[l]) v += lobe_values[l];
+  return v;
+}
+/* A guide over the box [-1, 1]^3 whose fixed-point unit is 100. */
+static int guide_for_test(guide *g) {
+  bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
+  if (guide_init(g, box, 1000000, 1e9) != 0) return -1;
+  guide_set_scale(g, 100);
+  return 0;
+}
+
 static int guide_quadtree(void) {
   guide g;
-  bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
-  CHECK(guide_init(&g, box, 1000000, 1e9) == 0, "init");
-  guide_set_scale(&g, 100);
-  const vec3 lobes[3] = {v3_norm(v3(0.3f, 0.2f, 0.93f)), v3_norm(v3(-0.8f, 0.1f, -0.3f)), v3(0, -1, 0)};
-  const float widths[3] = {0.02f, 0.3f, 0.6f}, values[3] = {50, 5, 1};
+  CHECK(guide_for_test(&g) == 0, "init");
+  const vec3 lobes[3] = {lobe_axis(0), lobe_axis(1), lobe_axis(2)};
+  const float *widths = lobe_widths;
   for (int pass = 0; pass < 2; pass++) {
     for (int k = 0; k < 200000; k++) {
       sampler sm = sampler_make(21 + pass, (uint64_t)k, 0);
       float u1, u2;
       sampler_2d(&sm, &u1, &u2);
       vec3 d = sample_uniform_sphere(u1, u2);
-      float v = d.y > 0 ? 0.1f : 0;
-      for (int l = 0; l < 3; l++) {
-        float c = v3_dot(d, lobes[l]);
-        if (c > 1 - widths[l]) v += values[l];
-      }
-      guide_record(&g, (gleaf *)guide_leaf(&g, v3(0.1f, 0.2f, 0.3f)), 0, d, v * 4 * PI_F);
+      guide_record(&g, (gleaf *)guide_leaf(&g, v3(0.1f, 0.2f, 0.3f)), 0, d, lobe_light(d) * 4 * PI_F);
     }
     CHECK(guide_refine(&g) == 0, "refine");
   }
@@ -1031,19 +1041,9 @@ static int guide_quadtree(void) {
  * surface facing +z under the three lobes above (bin 0) must keep the quadtree in its
  * mixture, and under uniform light (bin 1: cosine sampling of the BSDF is exact there)
  * must take fraction 1; vertices drawn from the mixture with fraction 1/2. */
-static float lobe_light(vec3 d, const vec3 *lobes, const float *widths, const float *values) {
-  float v = d.y > 0 ? 0.1f : 0;
-  for (int l = 0; l < 3; l++)
-    if (v3_dot(d, lobes[l]) > 1 - widths[l]) v += values[l];
-  return v;
-}
 static int guide_fraction_choice(void) {
   guide g;
-  bbox box = {v3(-1, -1, -1), v3(1, 1, 1)};
-  CHECK(guide_init(&g, box, 1000000, 1e9) == 0, "init");
-  guide_set_scale(&g, 100);
-  const vec3 lobes[3] = {v3_norm(v3(0.3f, 0.2f, 0.93f)), v3_norm(v3(-0.8f, 0.1f, -0.3f)), v3(0, -1, 0)};
-  const float widths[3] = {0.02f, 0.3f, 0.6f}, values[3] = {50, 5, 1};
+  CHECK(guide_for_test(&g) == 0, "init");
   const vec3 at = v3(0.1f, 0.2f, 0.3f);
   for (int pass = 0; pass < 2; pass++) { /* the quadtrees: bin 0 the lobes, bin 1 uniform */
     for (int k = 0; k < 200000; k++) {
@@ -1052,7 +1052,7 @@ static int guide_fraction_choice(void) {
       sampler_2d(&sm, &u1, &u2);
       vec3 d = sample_uniform_sphere(u1, u2);
       gleaf *l = (gleaf *)guide_leaf(&g, at);
-      guide_record(&g, l, 0, d, lobe_light(d, lobes, widths, values) * 4 * PI_F);
+      guide_record(&g, l, 0, d, lobe_light(d) * 4 * PI_F);
       guide_record(&g, l, 1, d, 4 * PI_F);
     }
     CHECK(guide_refine(&g) == 0, "refine");
@@ -1068,7 +1068,7 @@ static int guide_fraction_choice(void) {
       float pg;
       if (ul < 0.5f) d = guide_sample(l, b, u1, u2, &pg);
       else { d = sample_cosine_hemisphere(u1, u2); pg = guide_pdf(l, b, d); }
-      float pb = fmaxf(d.z, 0) * INV_PI_F, q = 0.5f * pb + 0.5f * pg, L = b ? 1 : lobe_light(d, lobes, widths, values);
+      float pb = fmaxf(d.z, 0) * INV_PI_F, q = 0.5f * pb + 0.5f * pg, L = b ? 1 : lobe_light(d);
       double X = 0.8 * INV_PI_F * fmax(d.z, 0) * L / q;
       guide_record_moments(&g, (gleaf *)l, b, X / g.scale, q, pb, pg);
     }
