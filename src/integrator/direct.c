@@ -33,8 +33,7 @@ ray segment_ray_from(const isect *it, vec3 p_to, vec3 n_to) { return segment_ray
 
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts) {
   ray r = segment_ray_from(it, p_to, n_to);
-  ts->rays++;
-  return accel_occluded(c->acc, &r);
+  return ctx_occluded(c, &r, ts);
 }
 
 /* An emitting sphere's sample: a direction in its cone k, and the first solid surface
@@ -116,20 +115,11 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
          (out->visible || !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts));
 }
 
-static rgb direct_rgb(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                      thread_stats *ts, int mis) {
-  direct_sample d;
-  if (!sample_direct(c, it, b, fr, wo, smp, ts, mis, &d)) return c3(0, 0, 0);
-  return c3_scale(c3_mul(d.f_cos, d.Li), d.scale);
-}
-
-rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                    thread_stats *ts) {
-  return direct_rgb(c, it, b, fr, wo, smp, ts, 1);
-}
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                           thread_stats *ts) {
-  return direct_rgb(c, it, b, fr, wo, smp, ts, 0);
+  direct_sample d;
+  if (!sample_direct(c, it, b, fr, wo, smp, ts, 0, &d)) return c3(0, 0, 0);
+  return c3_scale(c3_mul(d.f_cos, d.Li), d.scale);
 }
 
 rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, const isect *it) {

@@ -8,6 +8,11 @@ static inline int ctx_intersect(const render_ctx *c, const ray *r, hit *h, threa
   ts->rays++;
   return accel_intersect(c->acc, r, h);
 }
+/* Is r blocked? (a shadow ray, counted) */
+static inline int ctx_occluded(const render_ctx *c, const ray *r, thread_stats *ts) {
+  ts->rays++;
+  return accel_occluded(c->acc, r);
+}
 /* The shadow ray from `from` (leaving at o, its offset origin) to p_to, which is offset
  * towards `from` too when n_to is non-zero (a point on a surface): direction p_to - o,
  * tmax just short of 1. */
@@ -30,15 +35,9 @@ uint32_t direct_light_sample(const render_ctx *c, vec3 p, const isect *it, sampl
 /* The density (per steradian at p) with which direct_light_sample picks the point p_light
  * (normal n_light) of area light li: the MIS weight of a BSDF-sampled hit there. */
 float ctx_light_pdf_area(const render_ctx *c, uint32_t li, vec3 p, vec3 p_light, vec3 n_light);
-/* Probability that estimate_direct picks light index li at shading point p. */
+/* Probability that next-event estimation picks light index li at shading point p. */
 static inline float ctx_light_pmf(const render_ctx *c, uint32_t li, vec3 p) { return light_select_pmf(&c->ls, c->s, li, p); }
 
-/* Next-event estimation at it: picks a light in proportion to power, samples it, traces
- * a shadow ray, and returns f * Li * |cos| / pdf with the power-heuristic MIS weight
- * against BSDF sampling (weight 1 for delta lights). fr: frame of the shading normal
- * (already faced for opaque BSDFs). */
-rgb estimate_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
-                    thread_stats *ts);
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
@@ -50,8 +49,10 @@ int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const fra
  * path_media.c); out->visible: nothing solid lies on it. */
 int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, int mis, direct_sample *out);
-/* The same estimate with weight 1 (light sampling alone): for integrators that never
- * count emission found by BSDF-sampled rays at non-specular vertices. */
+/* Next-event estimation at it (sample_direct, its shadow ray traced) as one RGB value,
+ * f * Li * |cos| / pdf with weight 1 (light sampling alone): for integrators that never
+ * count emission found by BSDF-sampled rays at non-specular vertices. fr: frame of the
+ * shading normal (already faced for opaque BSDFs). */
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                           thread_stats *ts);
 /* Emission arriving along r when it hits (or escapes to) a light: the area light's

@@ -76,7 +76,7 @@ static void rec_flush(recorder *rc, rgb L) {
     rgb Lin = c3(channel_ratio(acc.r, v->beta.r), channel_ratio(acc.g, v->beta.g), channel_ratio(acc.b, v->beta.b));
     float lin = c3_lum(Lin);
     rec_value(rc, v->l, v->bin, v->d, lin / v->pdf);
-    if (v->l && !rc->probe && v->pg >= 0 && rc->g->scale > 0)
+    if (v->l && !rc->probe && v->pg >= 0)
       guide_record_moments(rc->g, v->l, v->bin, (double)v->fc * lin / v->pdf / rc->g->scale, v->pdf, v->pb, v->pg);
   }
   rc->n = 0;

@@ -53,10 +53,7 @@ rgb path_radiance(const render_ctx *c, ray r, sampler *smp, thread_stats *ts, in
     ray sray = r;
     rgb se = c3(0, 0, 0);
     int pending, go = path_vertex(c, depth, &it, &r, &st, &beta, smp, ts, &L, &sray, &se, &pending);
-    if (pending) {
-      ts->rays++;
-      if (!accel_occluded(c->acc, &sray)) L = c3_add(L, se);
-    }
+    if (pending && !ctx_occluded(c, &sray, ts)) L = c3_add(L, se);
     if (!go) break;
   }
   return L;

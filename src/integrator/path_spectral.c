@@ -26,7 +26,7 @@ spec4 nk_fresnel(const nk_curve *nk, vec3 wo, vec3 wi, const wavelengths *wl) {
 }
 
 /* Next-event estimation with f and Li upsampled separately and multiplied per
- * wavelength (estimate_direct multiplies them per RGB channel). */
+ * wavelength (path.c multiplies them per RGB channel). */
 static spec4 direct_spectral(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, const wavelengths *wl, const nk_curve *nk) {
   direct_sample d;
