@@ -25,8 +25,8 @@ struct embree_accel {
   accel_filter filter; /* alpha: filter.pass NULL when no triangle needs it */
   const float *vb;     /* the geometry's vertex and index buffers (the second test) */
   const unsigned *ib;
-  float far;           /* EM_FAR of the largest coordinate: a closest hit whose plane lies
-                        * farther than this from the ray's origin needs no second test */
+  float far2;          /* (EM_FAR of the largest coordinate)^2: a closest hit whose plane
+                        * lies farther than its root from the ray's origin needs no second test */
 };
 
 /* A query's context: Embree's first, so that a filter can reach the rest. */
@@ -95,7 +95,7 @@ static void em_verify(const struct RTCFilterFunctionNArguments *args) {
 #define EM_FAR 0x1p-12f
 
 /* The closest hit: Embree's. Where its triangle's plane lies near the ray's origin (the
- * origin's distance from it, t |Ng.d| / |Ng|, below e->far), valo's test checks it again:
+ * origin's distance from it, t |Ng.d| / |Ng|, below EM_FAR of the scene's size), valo's test checks it again:
  * where that test does not find it and the ray does not even cross the plane ahead
  * (Embree's error on a large triangle exceeds valo's offset: the surface the ray leaves),
  * the query goes on past it (at most four times), and where the two tests disagree on an
@@ -123,7 +123,7 @@ static int em_intersect(const accel *a, const ray *r, hit *h) {
     float nd = rh.hit.Ng_x * r->d.x + rh.hit.Ng_y * r->d.y + rh.hit.Ng_z * r->d.z;
     float n2 = rh.hit.Ng_x * rh.hit.Ng_x + rh.hit.Ng_y * rh.hit.Ng_y + rh.hit.Ng_z * rh.hit.Ng_z;
     float dist = h->t * fabsf(nd);                     /* the origin's distance from the plane, times |Ng| */
-    if (dist * dist > e->far * e->far * n2) return 1; /* false for NaN: tested */
+    if (dist * dist > e->far2 * n2) return 1;         /* false for NaN: tested */
     float v[9];
     em_corners(e, rh.hit.primID, v);
     if (tri_intersect(&q.sh, v, q.tmax, &h->t, &h->b1, &h->b2)) return 1; /* valo's own numbers */
@@ -241,7 +241,7 @@ valo_status embree_create(const vec3 *pos, uint32_t npos, const uint32_t *idx, u
     if (filter && filter->pass && filter->tri_flags) e->filter = *filter;
     float big = 0;
     for (uint32_t i = 0; i < maxv; i++) big = fmaxf(big, fmaxf(fabsf(pos[i].x), fmaxf(fabsf(pos[i].y), fabsf(pos[i].z))));
-    e->far = EM_FAR * big;
+    e->far2 = (EM_FAR * big) * (EM_FAR * big);
     e->vb = vb;
     e->ib = ib;
     if (e->filter.pass) {
