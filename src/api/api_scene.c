@@ -52,6 +52,12 @@ VALO_API int valo_scene_has_light(const valo_scene *vs) {
   return vs->s->nlights > 0;
 }
 
+VALO_API unsigned valo_scene_overlapping_lights(const valo_scene *vs) {
+  unsigned n = 0;
+  for (uint32_t i = 0; i < vs->s->nlights; i++) n += vs->s->lights[i].shares_plane != 0;
+  return n;
+}
+
 VALO_API void valo_scene_destroy(valo_scene *vs) {
   if (!vs) return;
   scene_free(vs->s);

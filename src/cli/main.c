@@ -281,6 +281,10 @@ static int cmd_render(int argc, char **argv) {
     if (resume) fprintf(stderr, "valo: resuming from %s at %d spp\n", resume, st.spp_done);
     if (!valo_scene_has_light(sc))
       fprintf(stderr, "valo: warning: the scene has no light: the image will be black\n");
+    unsigned ov = valo_scene_overlapping_lights(sc);
+    if (ov)
+      fprintf(stderr, "valo: note: %u area lights overlap another in their plane; a ray there meets one of them, and their shadow "
+                      "rays look for the first surface\n", ov);
   }
   g_render = r;
   struct sigaction sa;

@@ -36,6 +36,37 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return ctx_occluded(c, &r, ts);
 }
 
+int ctx_light_first_blocked(const render_ctx *c, vec3 o, vec3 p_to, uint32_t tri, thread_stats *ts) {
+  ray r = {o, v3_sub(p_to, o), 1 + 1e-4f};
+  hit h;
+  float t;
+  if (c->s->has_media) {
+    isect hi;
+    float before;
+    if (!ctx_intersect_solid(c, r, &h, &hi, &before, ts)) return 0;
+    float len = v3_len(r.d);
+    t = h.t + (len > 0 ? before / len : 0);
+  } else {
+    if (!ctx_intersect(c, &r, &h, ts)) return 0;
+    t = h.t;
+  }
+  if (h.tri == tri) return 0;
+  return t < 1 - 1e-4f || c->s->tri_light[h.tri] >= 0;
+}
+
+int ctx_light_emits(const render_ctx *c, vec3 p, vec3 d, uint32_t tri, thread_stats *ts) {
+  float back = 1e-3f * c->s->radius; /* from just in front of p, towards it and a little past */
+  ray r = {v3_add(p, v3_scale(d, back)), v3_scale(d, -back), 1.01f};
+  hit h;
+  if (!ctx_intersect(c, &r, &h, ts) || h.tri == tri || h.t < 0.99f) return 1;
+  return c->s->tri_light[h.tri] < 0;
+}
+
+int ctx_light_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, uint32_t first_tri, thread_stats *ts) {
+  if (first_tri == UINT32_MAX) return ctx_segment_blocked(c, it, p_to, n_to, ts);
+  return ctx_light_first_blocked(c, offset_origin_isect(it, v3_sub(p_to, it->p)), p_to, first_tri, ts);
+}
+
 /* An emitting sphere's sample: a direction in its cone k, and the first solid surface
  * along it, which must be one of the sphere's triangles; *pmf is the sphere's. */
 static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, const isect *it, float u1, float u2, thread_stats *ts,
@@ -57,6 +88,7 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   ls->L = light_tri_radiance(s, h.tri, hi.ng, v3_neg(wi), hi.u, hi.v);
   ls->pdf = k->pdf;
   ls->visible = 1;
+  ls->first_tri = UINT32_MAX;
   return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
 }
 
@@ -106,13 +138,14 @@ int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b
   out->n_light = ls.n_light;
   out->far = isinf(ls.dist);
   out->visible = ls.visible;
+  out->first_tri = ls.first_tri;
   return 1;
 }
 
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out) {
   return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) &&
-         (out->visible || !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts));
+         (out->visible || !ctx_light_blocked(c, it, out->p_light, out->n_light, out->first_tri, ts));
 }
 
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

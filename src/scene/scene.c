@@ -395,6 +395,7 @@ valo_status scene_commit(scene *s, valo_error *err) {
     sp->l1 = l0 + (sp->end - sp->first);
     for (uint32_t l = sp->l0; l < sp->l1; l++) s->lights[l].sphere = g + 1;
   }
+  if (scene_flag_light_overlaps(s)) return err_set(err, VALO_ERR_NOMEM, "%s: out of memory", s->path);
   valo_status mst = commit_media(s, err);
   if (mst) return mst;
   int any_normal_map = 0;

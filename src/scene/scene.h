@@ -142,6 +142,8 @@ typedef struct light {
   int tex_ke;      /* its material's emission texture, -1: none */
   uint32_t sphere; /* area, after commit: 1 + the index of the emitting sphere (scene.spheres)
                       whose triangles it is one of, when that sphere is sampled whole; 0: none */
+  int shares_plane; /* area, after commit: another area light overlaps it in its plane
+                       (light_overlap.c): its shadow rays ask which one a ray meets first */
 } light;
 
 /* A sphere of scene_add_sphere: its triangles [first, end), its centre and radius (its
@@ -283,6 +285,8 @@ void material_pbr_specular(material *m, float ior, float factor, rgb color);
 int material_has_maps(const material *m);
 /* Validates and derives bounds and area lights; frames a camera if none was given. */
 valo_status scene_commit(scene *s, valo_error *err);
+/* Sets light.shares_plane on the area lights (light_overlap.c); -1 when out of memory. */
+int scene_flag_light_overlaps(scene *s);
 /* The proximity-AO settings of the JSON shape triangle t belongs to (NULL: none). */
 const shape_ao *scene_shape_ao(const scene *s, uint32_t t);
 /* The medium a ray in medium `cur` is in after crossing triangle t (winding normal ng)
