@@ -75,6 +75,24 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   vec3 wi = light_cone_sample(k, u1, u2);
   ray r = {it ? offset_origin_isect(it, wi) : p, wi, INFINITY};
   hit h;
+  const light *l0 = &s->lights[k->sp->l0];
+  if (!s->has_media && l0->tex_ke < 0) {
+    /* Nothing to pass through, and one radiance over the sphere: no per-triangle data is
+     * read (a random triangle's would be two cache misses). The sphere's triangles are the
+     * range [first, end); its mesh is convex and p outside it, so the triangle met first
+     * faces p and emits the sphere's radiance towards it. */
+    if (!ctx_intersect(c, &r, &h, ts) || h.tri < k->sp->first || h.tri >= k->sp->end) return UINT32_MAX;
+    memset(ls, 0, sizeof *ls);
+    ls->wi = wi;
+    ls->dist = h.t;
+    ls->p_light = v3_add(r.o, v3_scale(wi, h.t));
+    ls->n_light = v3_norm(v3_sub(ls->p_light, k->sp->c));
+    ls->L = l0->L;
+    ls->pdf = k->pdf;
+    ls->visible = 1;
+    ls->first_tri = UINT32_MAX;
+    return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : k->sp->l0 + (h.tri - k->sp->first);
+  }
   isect hi;
   float before;
   if (!ctx_intersect_solid(c, r, &h, &hi, &before, ts)) return UINT32_MAX;
