@@ -36,7 +36,20 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return ctx_occluded(c, &r, ts);
 }
 
-int ctx_light_first_blocked(const render_ctx *c, vec3 o, vec3 p_to, uint32_t tri, thread_stats *ts) {
+int light_in_overlap(const scene *s, uint32_t li, vec3 p) {
+  for (uint32_t k = s->light_ov0[li]; k < s->light_ov0[li + 1]; k++) {
+    const light *l = &s->lights[s->light_ov[k]];
+    vec3 e0 = v3_sub(l->v[1], l->v[0]), e1 = v3_sub(l->v[2], l->v[0]), q = v3_sub(p, l->v[0]);
+    float n2 = v3_len2(l->ng);
+    float b1 = v3_dot(v3_cross(q, e1), l->ng) / n2, b2 = v3_dot(v3_cross(e0, q), l->ng) / n2;
+    if (b1 >= -1e-4f && b2 >= -1e-4f && b1 + b2 <= 1 + 1e-4f) return 1;
+  }
+  return 0;
+}
+
+int ctx_light_tie_lost(const render_ctx *c, vec3 o, vec3 p_to, uint32_t ov_light, thread_stats *ts) {
+  if (ov_light == UINT32_MAX || !light_in_overlap(c->s, ov_light, p_to)) return 0;
+  uint32_t tri = c->s->lights[ov_light].tri;
   ray r = {o, v3_sub(p_to, o), 1 + 1e-4f};
   hit h;
   float t;
@@ -54,17 +67,20 @@ int ctx_light_first_blocked(const render_ctx *c, vec3 o, vec3 p_to, uint32_t tri
   return t < 1 - 1e-4f || c->s->tri_light[h.tri] >= 0;
 }
 
-int ctx_light_emits(const render_ctx *c, vec3 p, vec3 d, uint32_t tri, thread_stats *ts) {
-  float back = 1e-3f * c->s->radius; /* from just in front of p, towards it and a little past */
+int ctx_light_emits(const render_ctx *c, vec3 p, vec3 d, uint32_t li, thread_stats *ts) {
+  const scene *s = c->s;
+  if (!s->lights[li].shares_plane || !light_in_overlap(s, li, p)) return 1;
+  float back = 1e-3f * s->radius; /* from just in front of p, towards it and a little past */
   ray r = {v3_add(p, v3_scale(d, back)), v3_scale(d, -back), 1.01f};
   hit h;
-  if (!ctx_intersect(c, &r, &h, ts) || h.tri == tri || h.t < 0.99f) return 1;
-  return c->s->tri_light[h.tri] < 0;
+  if (!ctx_intersect(c, &r, &h, ts) || h.tri == s->lights[li].tri || h.t < 0.99f) return 1;
+  return s->tri_light[h.tri] < 0;
 }
 
-int ctx_light_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, uint32_t first_tri, thread_stats *ts) {
-  if (first_tri == UINT32_MAX) return ctx_segment_blocked(c, it, p_to, n_to, ts);
-  return ctx_light_first_blocked(c, offset_origin_isect(it, v3_sub(p_to, it->p)), p_to, first_tri, ts);
+int ctx_light_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, uint32_t ov_light, thread_stats *ts) {
+  if (ov_light != UINT32_MAX && light_in_overlap(c->s, ov_light, p_to))
+    return ctx_light_tie_lost(c, offset_origin_isect(it, v3_sub(p_to, it->p)), p_to, ov_light, ts);
+  return ctx_segment_blocked(c, it, p_to, n_to, ts);
 }
 
 /* An emitting sphere's sample: a direction in its cone k, and the first solid surface
@@ -90,7 +106,7 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
     ls->L = l0->L;
     ls->pdf = k->pdf;
     ls->visible = 1;
-    ls->first_tri = UINT32_MAX;
+    ls->ov_light = UINT32_MAX;
     return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : k->sp->l0 + (h.tri - k->sp->first);
   }
   isect hi;
@@ -106,7 +122,7 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   ls->L = light_tri_radiance(s, h.tri, hi.ng, v3_neg(wi), hi.u, hi.v);
   ls->pdf = k->pdf;
   ls->visible = 1;
-  ls->first_tri = UINT32_MAX;
+  ls->ov_light = UINT32_MAX;
   return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
 }
 
@@ -156,14 +172,14 @@ int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b
   out->n_light = ls.n_light;
   out->far = isinf(ls.dist);
   out->visible = ls.visible;
-  out->first_tri = ls.first_tri;
+  out->ov_light = ls.ov_light;
   return 1;
 }
 
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out) {
   return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) &&
-         (out->visible || !ctx_light_blocked(c, it, out->p_light, out->n_light, out->first_tri, ts));
+         (out->visible || !ctx_light_blocked(c, it, out->p_light, out->n_light, out->ov_light, ts));
 }
 
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,

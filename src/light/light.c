@@ -103,7 +103,7 @@ static vec3 area_point(const light *l, float u1, float u2, float *b0, float *b1)
 
 int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g) {
   *g = 1;
-  o->first_tri = l->type == LIGHT_AREA && l->shares_plane ? l->tri : UINT32_MAX;
+  o->ov_light = l->type == LIGHT_AREA && l->shares_plane ? (uint32_t)(l - s->lights) : UINT32_MAX;
   switch (l->type) {
   case LIGHT_AREA: {
     vec3 d = v3_sub(y, p);
@@ -134,7 +134,7 @@ int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o
 
 int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *o) {
   o->delta = 0;
-  o->first_tri = l->type == LIGHT_AREA && l->shares_plane ? l->tri : UINT32_MAX;
+  o->ov_light = l->type == LIGHT_AREA && l->shares_plane ? (uint32_t)(l - s->lights) : UINT32_MAX;
   switch (l->type) {
   case LIGHT_AREA: {
     vec3 a = l->v[0];

@@ -117,8 +117,8 @@ typedef struct light_li {
   int delta;
   int visible;   /* found as the first solid surface along a traced ray (an emitting
                     sphere's cone sample, direct.c): no shadow ray needed */
-  uint32_t first_tri; /* an area light that overlaps another in its plane (light.shares_plane):
-                         its triangle, which the shadow ray must meet first; else UINT32_MAX */
+  uint32_t ov_light; /* an area light that overlaps another in its plane (light.shares_plane):
+                         its index (direct.h, ctx_light_blocked); else UINT32_MAX */
 } light_li;
 
 /* Samples light l as seen from p; returns 0 if it contributes nothing. */

@@ -6,6 +6,8 @@
  * the shadow rays of such lights ask for the first surface instead (direct.h,
  * ctx_light_blocked). Triangles that only share an edge or a corner do not overlap. */
 #include "scene/scene.h"
+#include "core/grow.h"
+#include <string.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -57,6 +59,8 @@ static int lights_overlap(const light *a, const light *b, float tol) {
 #define OV_MAX_PAIRS 50000000ull
 
 int scene_flag_light_overlaps(scene *s) {
+  free(s->light_ov0); free(s->light_ov);
+  s->light_ov0 = s->light_ov = NULL;
   uint32_t n = 0;
   for (uint32_t i = 0; i < s->nlights; i++) {
     s->lights[i].shares_plane = 0;
@@ -78,6 +82,8 @@ int scene_flag_light_overlaps(scene *s) {
                       fmaxf(fmaxf(fabsf(s->bounds.lo.y), fabsf(s->bounds.hi.y)), fmaxf(fabsf(s->bounds.lo.z), fabsf(s->bounds.hi.z))));
   float tol = 1e-6f * fmaxf(scale, 1e-6f);
   uint64_t pairs = 0;
+  uint32_t *pr = NULL, npr = 0; /* the overlapping pairs found */
+  int oom = 0;
   for (uint32_t i = 0; i < n && pairs < OV_MAX_PAIRS; i++) {
     light *a = &s->lights[it[i].li];
     bbox ba = bbox_add(bbox_add(bbox_add(bbox_empty(), a->v[0]), a->v[1]), a->v[2]);
@@ -85,9 +91,36 @@ int scene_flag_light_overlaps(scene *s) {
       light *b = &s->lights[it[j].li];
       bbox bb = bbox_add(bbox_add(bbox_add(bbox_empty(), b->v[0]), b->v[1]), b->v[2]);
       if (bb.lo.y > ba.hi.y + tol || ba.lo.y > bb.hi.y + tol || bb.lo.z > ba.hi.z + tol || ba.lo.z > bb.hi.z + tol) continue;
-      if (lights_overlap(a, b, tol)) a->shares_plane = b->shares_plane = 1;
+      if (!lights_overlap(a, b, tol)) continue;
+      a->shares_plane = b->shares_plane = 1;
+      uint32_t *np = grow_for(pr, npr, 2 * sizeof *pr);
+      if (!np) { oom = 1; break; }
+      pr = np;
+      pr[2 * npr] = it[i].li;
+      pr[2 * npr++ + 1] = it[j].li;
     }
   }
   free(it);
+  if (!oom && npr) { /* each light's partners, both ways */
+    s->light_ov0 = calloc((size_t)s->nlights + 1, sizeof *s->light_ov0);
+    s->light_ov = malloc(2 * (size_t)npr * sizeof *s->light_ov);
+    if (s->light_ov0 && s->light_ov) {
+      for (uint32_t k = 0; k < 2 * npr; k++) s->light_ov0[pr[k] + 1]++;
+      for (uint32_t i = 0; i < s->nlights; i++) s->light_ov0[i + 1] += s->light_ov0[i];
+      uint32_t *fill = malloc((size_t)s->nlights * sizeof *fill);
+      if (fill) {
+        memcpy(fill, s->light_ov0, (size_t)s->nlights * sizeof *fill);
+        for (uint32_t k = 0; k < 2 * npr; k++) s->light_ov[fill[pr[k]]++] = pr[k ^ 1];
+        free(fill);
+      } else oom = 1;
+    } else oom = 1;
+  }
+  free(pr);
+  if (oom) {
+    free(s->light_ov0); free(s->light_ov);
+    s->light_ov0 = s->light_ov = NULL;
+    for (uint32_t i = 0; i < s->nlights; i++) s->lights[i].shares_plane = 0;
+    return -1;
+  }
   return 0;
 }

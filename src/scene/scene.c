@@ -25,7 +25,7 @@ scene *scene_new(const char *path) {
 void scene_free(scene *s) {
   if (!s) return;
   free(s->pos); free(s->nrm); free(s->uv); free(s->tan); free(s->tan_file); free(s->col); free(s->idx); free(s->tri_mat); free(s->tri_flags);
-  free(s->mats); free(s->lights); free(s->tri_light); free(s->shape_ao); free(s->cam_keys); free(s->nk);
+  free(s->mats); free(s->lights); free(s->tri_light); free(s->light_ov0); free(s->light_ov); free(s->shape_ao); free(s->cam_keys); free(s->nk);
   for (uint32_t i = 0; i < s->nmedia; i++) density_grid_free(s->media[i].grid);
   free(s->media); free(s->shape_media); free(s->tri_media); free(s->spheres);
   envmap_destroy(s->env_map);

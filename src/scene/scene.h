@@ -211,6 +211,9 @@ typedef struct scene {
   light *lights;
   uint32_t nlights, cap_lights;
   int32_t *tri_light;      /* per triangle: its area light or -1 (after commit) */
+  uint32_t *light_ov0, *light_ov; /* after commit, when lights overlap: the lights light i
+                                     overlaps in its plane are light_ov[light_ov0[i] ..
+                                     light_ov0[i + 1]) (light_overlap.c); else NULL */
   rgb env_radiance;        /* constant environment */
   int has_env;
   struct envmap *env_map;  /* equirectangular map (owned), or NULL for constant */
