@@ -36,53 +36,6 @@ int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_
   return ctx_occluded(c, &r, ts);
 }
 
-int light_in_overlap(const scene *s, uint32_t li, vec3 p) {
-  for (uint32_t k = s->light_ov0[li]; k < s->light_ov0[li + 1]; k++) {
-    const light *l = &s->lights[s->light_ov[k]];
-    vec3 e0 = v3_sub(l->v[1], l->v[0]), e1 = v3_sub(l->v[2], l->v[0]), q = v3_sub(p, l->v[0]);
-    float n2 = v3_len2(l->ng);
-    float b1 = v3_dot(v3_cross(q, e1), l->ng) / n2, b2 = v3_dot(v3_cross(e0, q), l->ng) / n2;
-    if (b1 >= -1e-4f && b2 >= -1e-4f && b1 + b2 <= 1 + 1e-4f) return 1;
-  }
-  return 0;
-}
-
-int ctx_light_tie_lost(const render_ctx *c, vec3 o, vec3 p_to, uint32_t ov_light, thread_stats *ts) {
-  if (ov_light == UINT32_MAX || !light_in_overlap(c->s, ov_light, p_to)) return 0;
-  uint32_t tri = c->s->lights[ov_light].tri;
-  ray r = {o, v3_sub(p_to, o), 1 + 1e-4f};
-  hit h;
-  float t;
-  if (c->s->has_media) {
-    isect hi;
-    float before;
-    if (!ctx_intersect_solid(c, r, &h, &hi, &before, ts)) return 0;
-    float len = v3_len(r.d);
-    t = h.t + (len > 0 ? before / len : 0);
-  } else {
-    if (!ctx_intersect(c, &r, &h, ts)) return 0;
-    t = h.t;
-  }
-  if (h.tri == tri) return 0;
-  return t < 1 - 1e-4f || c->s->tri_light[h.tri] >= 0;
-}
-
-int ctx_light_emits(const render_ctx *c, vec3 p, vec3 d, uint32_t li, thread_stats *ts) {
-  const scene *s = c->s;
-  if (!s->lights[li].shares_plane || !light_in_overlap(s, li, p)) return 1;
-  float back = 1e-3f * s->radius; /* from just in front of p, towards it and a little past */
-  ray r = {v3_add(p, v3_scale(d, back)), v3_scale(d, -back), 1.01f};
-  hit h;
-  if (!ctx_intersect(c, &r, &h, ts) || h.tri == s->lights[li].tri || h.t < 0.99f) return 1;
-  return s->tri_light[h.tri] < 0;
-}
-
-int ctx_light_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, uint32_t ov_light, thread_stats *ts) {
-  if (ov_light != UINT32_MAX && light_in_overlap(c->s, ov_light, p_to))
-    return ctx_light_tie_lost(c, offset_origin_isect(it, v3_sub(p_to, it->p)), p_to, ov_light, ts);
-  return ctx_segment_blocked(c, it, p_to, n_to, ts);
-}
-
 /* An emitting sphere's sample: a direction in its cone k, and the first solid surface
  * along it, which must be one of the sphere's triangles; *pmf is the sphere's. */
 static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, const isect *it, float u1, float u2, thread_stats *ts,
@@ -106,7 +59,6 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
     ls->L = l0->L;
     ls->pdf = k->pdf;
     ls->visible = 1;
-    ls->ov_light = UINT32_MAX;
     return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : k->sp->l0 + (h.tri - k->sp->first);
   }
   isect hi;
@@ -122,7 +74,6 @@ static uint32_t sphere_sample(const render_ctx *c, const light_cone *k, vec3 p, 
   ls->L = light_tri_radiance(s, h.tri, hi.ng, v3_neg(wi), hi.u, hi.v);
   ls->pdf = k->pdf;
   ls->visible = 1;
-  ls->ov_light = UINT32_MAX;
   return c3_black(ls->L) || !(*pmf > 0) ? UINT32_MAX : (uint32_t)lid;
 }
 
@@ -172,14 +123,13 @@ int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b
   out->n_light = ls.n_light;
   out->far = isinf(ls.dist);
   out->visible = ls.visible;
-  out->ov_light = ls.ov_light;
   return 1;
 }
 
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out) {
   return sample_direct_unshadowed(c, it, b, fr, wo, smp, ts, mis, out) &&
-         (out->visible || !ctx_light_blocked(c, it, out->p_light, out->n_light, out->ov_light, ts));
+         (out->visible || !ctx_segment_blocked(c, it, out->p_light, out->n_light, ts));
 }
 
 rgb estimate_direct_nomis(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
@@ -195,8 +145,7 @@ rgb emitted_along(const render_ctx *c, const ray *r, const hit *h, int found, co
     if (c->ls.env_index < 0) return c3(0, 0, 0);
     return light_env_radiance(s, &s->lights[c->ls.env_index], r->d);
   }
-  int32_t lid = s->tri_light[h->tri];
-  if (lid < 0) return c3(0, 0, 0);
-  return light_tri_radiance(s, h->tri, it->ng, v3_neg(r->d), it->u, it->v);
+  int32_t lid;
+  return light_hit(s, h->tri, it->p, it->ng, v3_neg(r->d), it->u, it->v, &lid);
 }
 

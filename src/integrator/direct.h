@@ -26,23 +26,6 @@ int ctx_intersect_solid(const render_ctx *c, ray r, hit *h, isect *it, float *be
 ray segment_ray_from(const isect *it, vec3 p_to, vec3 n_to);
 /* Is the segment from it (leaving towards p_to) blocked? (segment_ray_from) */
 int ctx_segment_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, thread_stats *ts);
-/* Lights that overlap another in their plane (light_overlap.c): where a sample y of such a
- * light ov_light lies inside a partner too, the two are a tie that rounding breaks for
- * each ray, and a shadow ray stopping short of y cannot see the partner. There the first
- * solid surface along the ray from o through y decides: the light counts when it is the
- * one met (ctx_light_tie_lost 0). Elsewhere on the light (and for ov_light UINT32_MAX)
- * the plain segment test is all (ctx_light_blocked). */
-/* Does point p of light li (shares_plane) lie inside one of the lights it overlaps (with a
- * margin of 1e-4 of their edges)? */
-int light_in_overlap(const scene *s, uint32_t li, vec3 p);
-int ctx_light_tie_lost(const render_ctx *c, vec3 o, vec3 p_to, uint32_t ov_light, thread_stats *ts);
-/* Is the sample at p_to (normal n_to) of light ov_light (light_li.ov_light) blocked from
- * it? ctx_segment_blocked, or where it overlaps, ctx_light_tie_lost. */
-int ctx_light_blocked(const render_ctx *c, const isect *it, vec3 p_to, vec3 n_to, uint32_t ov_light, thread_stats *ts);
-/* Light particles (photons, VPLs) leaving point p of area light li in direction d: 0 when
- * li overlaps another at p and a ray arriving at p from d meets the other there, as
- * camera and BSDF rays see the pair; else 1. */
-int ctx_light_emits(const render_ctx *c, vec3 p, vec3 d, uint32_t li, thread_stats *ts);
 /* Picks a light for point p (the sampler's next 1D value) and samples it (the next 2D):
  * returns its index with *pmf and *ls, or UINT32_MAX when nothing came out. it: the
  * surface p lies on (NULL in a medium). A light of an emitting sphere seen from outside
@@ -58,13 +41,12 @@ static inline float ctx_light_pmf(const render_ctx *c, uint32_t li, vec3 p) { re
 /* The parts of one next-event sample, for integrators that multiply them their own way
  * (per wavelength): the estimate is f_cos * Li * scale, scale = MIS weight / pdf.
  * Returns 0 when the sample contributes nothing. */
-typedef struct direct_sample { rgb f_cos, Li; float scale, light_pdf; vec3 wi, p_light, n_light; int far, visible, delta; uint32_t ov_light; } direct_sample;
+typedef struct direct_sample { rgb f_cos, Li; float scale, light_pdf; vec3 wi, p_light, n_light; int far, visible, delta; } direct_sample;
 int sample_direct(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                   thread_stats *ts, int mis, direct_sample *out);
 /* sample_direct without the shadow ray: the caller tests the segment to out->p_light
  * (out->n_light; out->far: the light is at infinity) itself (through media:
- * path_media.c); out->visible: nothing solid lies on it; out->ov_light: light_li's (a
- * light that overlaps another: ctx_light_first_blocked must pass too). */
+ * path_media.c); out->visible: nothing solid lies on it. */
 int sample_direct_unshadowed(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, sampler *smp,
                              thread_stats *ts, int mis, direct_sample *out);
 /* Next-event estimation at it (sample_direct, its shadow ray traced) as one RGB value,

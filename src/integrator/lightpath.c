@@ -49,7 +49,6 @@ static void shoot_path(const shoot_job *j, uint64_t index, chunk_buf *out, threa
   if (!(pmf > 0)) return;
   if (!(j->aim && light_sample_emit_toward(s, &s->lights[li], u, j->aim->c, j->aim->r, &e)) && !light_sample_emit(s, &s->lights[li], u, &e)) return;
   if (c3_black(e.beta)) return;
-  if (s->lights[li].type == LIGHT_AREA && !ctx_light_emits(c, e.o, e.d, li, ts)) return;
   rgb beta = c3_scale(e.beta, 1 / pmf);
   ray r = {e.o, e.d, INFINITY};
   if (s->lights[li].type == LIGHT_AREA) r.o = offset_origin(e.o, v3(0, 0, 0), e.n, e.d);

@@ -26,9 +26,7 @@ static int path_vertex(const render_ctx *c, int depth, isect *it, ray *r, path_s
   if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, it, &b, &fr, wo, smp, ts, 1, &d)) {
     rgb e = c3_mul(*beta, c3_scale(c3_mul(d.f_cos, d.Li), d.scale));
     if (d.visible) *L = c3_add(*L, e);
-    else if (d.ov_light != UINT32_MAX && light_in_overlap(c->s, d.ov_light, d.p_light)) { /* a tie with another light: tested at once */
-      if (!ctx_light_blocked(c, it, d.p_light, d.n_light, d.ov_light, ts)) *L = c3_add(*L, e);
-    } else {
+    else {
       *sray = segment_ray_from(it, d.p_light, d.n_light);
       *se = e;
       *has_shadow = 1;

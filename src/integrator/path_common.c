@@ -36,11 +36,9 @@ void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *s
     }
     return;
   }
-  int32_t lid = s->tri_light[h->tri];
-  if (lid >= 0) {
-    *Le = light_tri_radiance(s, h->tri, it->ng, v3_neg(r->d), it->u, it->v);
-    if (!c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
-  }
+  int32_t lid;
+  *Le = light_hit(s, h->tri, it->p, it->ng, v3_neg(r->d), it->u, it->v, &lid);
+  if (lid >= 0 && !c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
 }
 
 int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {

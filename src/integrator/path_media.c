@@ -59,7 +59,6 @@ static spec4 medium_direct(const render_ctx *c, vec3 p, vec3 wo, int32_t med, sa
   if (!(f > 0) || !(light_pdf > 0)) return spec_const(0);
   spec4 tr = segment_transmittance(c, segment_ray(p, p, ls.p_light, ls.n_light), med, isinf(ls.dist), key, wl, ts);
   if (spec_black(tr)) return spec_const(0);
-  if (ctx_light_tie_lost(c, p, ls.p_light, ls.ov_light, ts)) return spec_const(0);
   float w = ls.delta ? 1.0f : power_heuristic(light_pdf, f);
   return spec_scale(spec_mul(chan_from_rgb(ls.L, wl), tr), f * w / light_pdf);
 }
@@ -146,7 +145,6 @@ spec4 path_media_walk(const render_ctx *c, ray r, sampler *smp, thread_stats *ts
       if (bsdf_has_smooth(&b) && sample_direct_unshadowed(c, &it, &b, &fr, wo, smp, ts, 1, &d)) {
         ray sr = segment_ray(offset_origin_isect(&it, v3_sub(d.p_light, it.p)), it.p, d.p_light, d.n_light);
         spec4 tr = segment_transmittance(c, sr, scene_medium_after(s, it.tri, ng, d.wi, med), d.far, walk_key(smp, ~(uint32_t)depth), wl, ts);
-        if (!spec_black(tr) && ctx_light_tie_lost(c, sr.o, d.p_light, d.ov_light, ts)) tr = spec_const(0);
         /* f and Li upsampled apart and multiplied per wavelength (in RGB per channel) */
         spec4 f = chan_from_rgb(d.f_cos, wl);
         if (nk) f = spec_mul(f, nk_fresnel(nk, wo, d.wi, wl));

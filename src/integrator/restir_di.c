@@ -49,7 +49,7 @@ static float di_target_g(const render_ctx *c, const gpix *g, const di_sample *y,
   return restir_di_target(c, &g->it, &g->b, &g->fr, g->wo, y, contrib, li);
 }
 static int di_visible(const render_ctx *c, const gpix *g, const light_li *li, thread_stats *ts) {
-  return !ctx_light_blocked(c, &g->it, li->p_light, li->n_light, li->ov_light, ts);
+  return !ctx_segment_blocked(c, &g->it, li->p_light, li->n_light, ts);
 }
 
 int restir_di_candidates(const render_ctx *c, const isect *it, const bsdf *b, const frame *fr, vec3 wo, int M, const sampler *smp,

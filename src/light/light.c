@@ -26,6 +26,45 @@ rgb light_tri_radiance(const scene *s, uint32_t tri, vec3 ng, vec3 w, float u, f
   return emission_mapped(s, (c > 0 || (m->two_sided && c < 0)) ? m->emission : c3(0, 0, 0), m->tex_ke, u, v);
 }
 
+static void area_uv_at(const scene *s, const light *l, vec3 pl, float *tu, float *tv);
+/* Is p inside light l's triangle (p in its plane)? */
+static int inside_light(const light *l, vec3 p) {
+  vec3 e0 = v3_sub(l->v[1], l->v[0]), e1 = v3_sub(l->v[2], l->v[0]), q = v3_sub(p, l->v[0]);
+  float n2 = v3_len2(l->ng);
+  float b1 = v3_dot(v3_cross(q, e1), l->ng) / n2, b2 = v3_dot(v3_cross(e0, q), l->ng) / n2;
+  return b1 >= 0 && b2 >= 0 && b1 + b2 <= 1;
+}
+/* The first light in the scene's order among li and the lights it overlaps that holds p. */
+static uint32_t light_seen_at(const scene *s, uint32_t li, vec3 p) {
+  uint32_t seen = li;
+  if (!s->light_ov0) return li;
+  for (uint32_t k = s->light_ov0[li]; k < s->light_ov0[li + 1]; k++) {
+    uint32_t j = s->light_ov[k];
+    if (j < seen && inside_light(&s->lights[j], p)) seen = j;
+  }
+  return seen;
+}
+int light_hidden_at(const scene *s, uint32_t li, vec3 p) { return light_seen_at(s, li, p) != li; }
+static int hidden(const scene *s, const light *l, vec3 p) {
+  return l->shares_plane && (size_t)(l - s->lights) < s->nlights && light_hidden_at(s, (uint32_t)(l - s->lights), p);
+}
+
+rgb light_hit(const scene *s, uint32_t tri, vec3 p, vec3 ng, vec3 w, float u, float v, int32_t *lid) {
+  *lid = s->tri_light[tri];
+  if (*lid < 0) return c3(0, 0, 0);
+  if (s->lights[*lid].shares_plane) {
+    uint32_t seen = light_seen_at(s, (uint32_t)*lid, p);
+    if (seen != (uint32_t)*lid) {
+      const light *l = &s->lights[seen];
+      float tu, tv;
+      area_uv_at(s, l, p, &tu, &tv);
+      *lid = (int32_t)seen;
+      return light_area_radiance(s, l, l->n, w, tu, tv);
+    }
+  }
+  return light_tri_radiance(s, tri, ng, w, u, v);
+}
+
 float light_power(const scene *s, const light *l) {
   switch (l->type) {
   case LIGHT_AREA: return PI_F * l->area * c3_avg(l->L) * (l->two_sided ? 2.0f : 1.0f);
@@ -103,7 +142,6 @@ static vec3 area_point(const light *l, float u1, float u2, float *b0, float *b1)
 
 int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o, float *g) {
   *g = 1;
-  o->ov_light = l->type == LIGHT_AREA && l->shares_plane ? (uint32_t)(l - s->lights) : UINT32_MAX;
   switch (l->type) {
   case LIGHT_AREA: {
     vec3 d = v3_sub(y, p);
@@ -113,6 +151,7 @@ int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o
     vec3 wi = v3_scale(d, 1 / dist), n = l->n;
     float cos_l = fabsf(v3_dot(n, wi));
     if (!(cos_l > 0)) return 0;
+    if (hidden(s, l, y)) return 0;
     float tu, tv;
     area_uv_at(s, l, y, &tu, &tv);
     o->L = light_area_radiance(s, l, n, v3_neg(wi), tu, tv);
@@ -134,7 +173,6 @@ int light_eval_point(const scene *s, const light *l, vec3 p, vec3 y, light_li *o
 
 int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, light_li *o) {
   o->delta = 0;
-  o->ov_light = l->type == LIGHT_AREA && l->shares_plane ? (uint32_t)(l - s->lights) : UINT32_MAX;
   switch (l->type) {
   case LIGHT_AREA: {
     vec3 a = l->v[0];
@@ -152,6 +190,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
       float t = v3_dot(n, v3_sub(a, p)) / dn;
       if (!(t > 0)) return 0;
       pl = v3_add(p, v3_scale(w, t));
+      if (hidden(s, l, pl)) return 0;
       float tu, tv;
       area_uv_at(s, l, pl, &tu, &tv);
       o->L = light_area_radiance(s, l, n, v3_neg(w), tu, tv);
@@ -161,6 +200,7 @@ int light_sample(const scene *s, const light *l, vec3 p, float u1, float u2, lig
       return isfinite(o->pdf) && o->pdf > 0;
     }
     pl = area_point(l, u1, u2, &b0, &b1);
+    if (hidden(s, l, pl)) return 0;
     vec3 d = v3_sub(pl, p);
     float d2 = v3_len2(d);
     if (!(d2 > 0)) return 0;
@@ -240,7 +280,7 @@ int light_sample_emit(const scene *s, const light *l, const float u[4], light_em
     o->n = nn;
     float tu, tv;
     scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
-    rgb Le = light_area_radiance(s, l, n, o->d, tu, tv);
+    rgb Le = hidden(s, l, o->o) ? c3(0, 0, 0) : light_area_radiance(s, l, n, o->d, tu, tv);
     /* Le cos / ((1/A) (cos/pi) (1/2 if two-sided)) */
     o->beta = c3_scale(Le, PI_F * l->area * (l->two_sided ? 2.0f : 1.0f));
     break;
@@ -309,7 +349,7 @@ int light_sample_emit_toward(const scene *s, const light *l, const float u[4], v
   o->n = v3_scale(l->n, cosn >= 0 ? 1.0f : -1.0f); /* the side it leaves from */
   float tu, tv;
   scene_tri_uv(s, l->tri, b1, 1 - b0 - b1, &tu, &tv);
-  rgb Le = light_area_radiance(s, l, l->n, o->d, tu, tv); /* zero behind a one-sided light */
+  rgb Le = hidden(s, l, p) ? c3(0, 0, 0) : light_area_radiance(s, l, l->n, o->d, tu, tv); /* zero behind a one-sided light */
   /* Le |cos| / ((1/A) pdf_cone) */
   o->beta = c3_scale(Le, fabsf(cosn) * l->area * inv_pdf);
   return 1;

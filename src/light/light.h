@@ -117,8 +117,6 @@ typedef struct light_li {
   int delta;
   int visible;   /* found as the first solid surface along a traced ray (an emitting
                     sphere's cone sample, direct.c): no shadow ray needed */
-  uint32_t ov_light; /* an area light that overlaps another in its plane (light.shares_plane):
-                         its index (direct.h, ctx_light_blocked); else UINT32_MAX */
 } light_li;
 
 /* Samples light l as seen from p; returns 0 if it contributes nothing. */
@@ -147,6 +145,19 @@ rgb light_area_radiance(const scene *s, const light *l, vec3 ng, vec3 w, float u
  * on an emitter then needs no light record (one per emitting triangle: 20 480 on Veach's
  * MIS scene, 3 MB, where the materials are a few). */
 rgb light_tri_radiance(const scene *s, uint32_t tri, vec3 ng, vec3 w, float u, float v);
+/* Area lights that overlap in their plane (light.shares_plane, light_overlap.c): where
+ * they overlap, the one first in the scene's order is the one seen, and the others emit
+ * nothing there, for every ray (rounding, which would otherwise break the tie, breaks it
+ * differently for a ray aimed at one and a ray that finds the nearest). So light sampling
+ * gives nothing from a hidden point (light_sample, light_eval_point, light_sample_emit
+ * return 0 or black there) and a hit on one takes the radiance and the pdf of the light
+ * seen (light_hit). light_hidden_at: 1 when point p of area light li lies inside a light
+ * before it that it overlaps. */
+int light_hidden_at(const scene *s, uint32_t li, vec3 p);
+/* The light a ray that hits emitting triangle tri at p (normal ng, surface UV u, v)
+ * sees, in *lid (-1: none), and its radiance towards w: light_tri_radiance, or where
+ * tri's light is hidden at p, the light before it that covers p. */
+rgb light_hit(const scene *s, uint32_t tri, vec3 p, vec3 ng, vec3 w, float u, float v, int32_t *lid);
 float light_power(const scene *s, const light *l);
 
 /* A ray of light leaving light l (photon and VPL tracing): origin, unit direction and
