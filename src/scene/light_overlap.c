@@ -1,12 +1,10 @@
 /* light_overlap.c — owns finding area lights that overlap another in their plane
  * (light.shares_plane, and each one's list of the others, scene.light_ov). Two emitting
- * triangles in one plane whose interiors overlap are a tie for a ray that meets them
- * there: rounding decides which one it finds, and it finds one. A shadow ray aimed at one
- * of them stops short of its plane, so it cannot see the other and light sampling would
- * count both where a BSDF-sampled ray counts one; shadow rays to a sample that lies in
- * another light too ask for the first surface instead (direct.h, ctx_light_blocked).
- * Triangles that only share an edge or a corner do not overlap. Found by a sweep over
- * the lights' boxes along x, coplanarity, then separating axes in the plane. */
+ * triangles in one plane whose interiors overlap would be a tie for a ray that meets them
+ * there, broken by rounding one way for a shadow ray aimed at one and another for a ray
+ * that finds the nearest; light.h defines it instead (the first in the scene's order is
+ * seen there). Triangles that only share an edge or a corner do not overlap. Found by a
+ * sweep over the lights' boxes along x, coplanarity, then separating axes in the plane. */
 #include "scene/scene.h"
 #include "core/grow.h"
 #include <string.h>
