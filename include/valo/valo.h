@@ -160,8 +160,8 @@ VALO_API valo_status valo_scene_load_with(const char *path, const valo_load_opti
 /* Non-zero when the loaded scene has at least one light (emissive triangle, point, spot or
  * directional light, a non-black environment, or a medium that glows). */
 VALO_API int valo_scene_has_light(const valo_scene *scene);
-/* How many area lights overlap another in their plane (a tie a ray breaks by rounding;
- * their shadow rays find the first surface, docs/scene-format.md). */
+/* How many area lights overlap another in their plane (where they overlap, the first in
+ * the scene's order is the one seen: docs/scene-format.md, "lights"). */
 VALO_API unsigned valo_scene_overlapping_lights(const valo_scene *scene);
 /* Writes the JSON scene (docs/scene-format.md) that the Mitsuba scene file at path means
  * to out, atomically, with its file names made absolute; lo (may be NULL) gives its

@@ -283,8 +283,8 @@ static int cmd_render(int argc, char **argv) {
       fprintf(stderr, "valo: warning: the scene has no light: the image will be black\n");
     unsigned ov = valo_scene_overlapping_lights(sc);
     if (ov)
-      fprintf(stderr, "valo: note: %u area lights overlap another in their plane; a ray there meets one of them, and their shadow "
-                      "rays look for the first surface\n", ov);
+      fprintf(stderr, "valo: note: %u area lights overlap another in their plane; where they overlap, the first in the scene's "
+                      "order is the one seen\n", ov);
   }
   g_render = r;
   struct sigaction sa;

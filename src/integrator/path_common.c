@@ -41,15 +41,19 @@ void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *s
   if (lid >= 0 && !c3_black(*Le)) *w = path_emission_weight(c, st, 0, r->d, lid, it);
 }
 
-int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
-  hit h;
-  if (!ctx_intersect(c, r, &h, ts)) {
+int path_hit_vertex(const render_ctx *c, const ray *r, const path_state *st, const hit *h, isect *it, rgb *Le, float *w) {
+  if (!h) {
     path_vertex_emission(c, r, st, NULL, NULL, Le, w);
     return 0;
   }
-  isect_from_hit(c->s, r, &h, it);
-  path_vertex_emission(c, r, st, &h, it, Le, w);
+  isect_from_hit(c->s, r, h, it);
+  path_vertex_emission(c, r, st, h, it, Le, w);
   return 1;
+}
+
+int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w) {
+  hit h;
+  return path_hit_vertex(c, r, st, ctx_intersect(c, r, &h, ts) ? &h : NULL, it, Le, w);
 }
 
 int sides_agree(const isect *it, vec3 wo_l, vec3 wi_l, vec3 wo, vec3 wi, thread_stats *ts) {

@@ -29,6 +29,8 @@ static inline path_state path_state_start(vec3 origin) { path_state st = {1, 0, 
  * environment; black if none) and *w its MIS weight (power heuristic) against the
  * next-event estimation that could have found the same light. */
 int path_trace_vertex(const render_ctx *c, const ray *r, const path_state *st, thread_stats *ts, isect *it, rgb *Le, float *w);
+/* path_trace_vertex for a ray the caller traced: h its hit, NULL when it escaped. */
+int path_hit_vertex(const render_ctx *c, const ray *r, const path_state *st, const hit *h, isect *it, rgb *Le, float *w);
 /* The emission part of path_trace_vertex for a ray traced by the caller: h is its hit
  * (it filled from it) or NULL when it escaped. */
 void path_vertex_emission(const render_ctx *c, const ray *r, const path_state *st, const hit *h, const isect *it, rgb *Le, float *w);

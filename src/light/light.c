@@ -44,9 +44,9 @@ static uint32_t light_seen_at(const scene *s, uint32_t li, vec3 p) {
   }
   return seen;
 }
-int light_hidden_at(const scene *s, uint32_t li, vec3 p) { return light_seen_at(s, li, p) != li; }
+/* Is point p of light l (one of s's) hidden by a light before it? */
 static int hidden(const scene *s, const light *l, vec3 p) {
-  return l->shares_plane && (size_t)(l - s->lights) < s->nlights && light_hidden_at(s, (uint32_t)(l - s->lights), p);
+  return l->shares_plane && (size_t)(l - s->lights) < s->nlights && light_seen_at(s, (uint32_t)(l - s->lights), p) != (uint32_t)(l - s->lights);
 }
 
 rgb light_hit(const scene *s, uint32_t tri, vec3 p, vec3 ng, vec3 w, float u, float v, int32_t *lid) {

@@ -151,9 +151,7 @@ rgb light_tri_radiance(const scene *s, uint32_t tri, vec3 ng, vec3 w, float u, f
  * differently for a ray aimed at one and a ray that finds the nearest). So light sampling
  * gives nothing from a hidden point (light_sample, light_eval_point, light_sample_emit
  * return 0 or black there) and a hit on one takes the radiance and the pdf of the light
- * seen (light_hit). light_hidden_at: 1 when point p of area light li lies inside a light
- * before it that it overlaps. */
-int light_hidden_at(const scene *s, uint32_t li, vec3 p);
+ * seen (light_hit). */
 /* The light a ray that hits emitting triangle tri at p (normal ng, surface UV u, v)
  * sees, in *lid (-1: none), and its radiance towards w: light_tri_radiance, or where
  * tri's light is hidden at p, the light before it that covers p. */
